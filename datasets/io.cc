@@ -1,0 +1,89 @@
+#include "datasets/io.h"
+
+#include <atomic>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include <unistd.h>
+
+namespace rovo {
+namespace fs = std::filesystem;
+
+std::string TempPathFor(const std::string& path) {
+  static std::atomic<uint64_t> counter{0};
+  std::ostringstream out;
+  out << path << ".tmp." << ::getpid() << "." << counter.fetch_add(1);
+  return out.str();
+}
+
+void CommitTempFile(const std::string& tmp_path, const std::string& path) {
+  std::error_code ec;
+  fs::rename(tmp_path, path, ec);
+  if (ec) {
+    fs::remove(tmp_path, ec);
+    throw std::runtime_error(path + ": cannot move temporary file into place: " + ec.message());
+  }
+}
+
+void WriteFileAtomic(const std::string& path, const std::string& content) {
+  const fs::path parent = fs::path(path).parent_path();
+  if (!parent.empty()) EnsureWritableDir(parent.string());
+  const std::string tmp = TempPathFor(path);
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    if (!out) throw std::runtime_error(path + ": cannot open for writing");
+    out.write(content.data(), static_cast<std::streamsize>(content.size()));
+    out.flush();
+    if (!out) {
+      std::error_code ec;
+      fs::remove(tmp, ec);
+      throw std::runtime_error(path + ": write failed");
+    }
+  }
+  CommitTempFile(tmp, path);
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot open for reading");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+nlohmann::json ReadJsonFile(const std::string& path) {
+  const std::string text = ReadFile(path);
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw std::runtime_error(path + ": malformed JSON: " + e.what());
+  }
+}
+
+void WriteJsonFileAtomic(const std::string& path, const nlohmann::json& json) {
+  WriteFileAtomic(path, json.dump(2) + "\n");
+}
+
+void EnsureWritableDir(const std::string& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw std::runtime_error(dir + ": cannot create folder: " + ec.message());
+  if (::access(dir.c_str(), W_OK) != 0) throw std::runtime_error(dir + ": folder is not writable");
+}
+
+std::string HashHex(const void* data, size_t size, uint64_t seed) {
+  uint64_t h = 1469598103934665603ull ^ seed;
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (size_t i = 0; i < size; ++i) {
+    h ^= p[i];
+    h *= 1099511628211ull;
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof(buf), "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+}  // namespace rovo

@@ -1,0 +1,51 @@
+#pragma once
+// A rig of N >= 1 cameras rigidly mounted on a body frame (REP-103: x forward, y left, z up).
+// Gauge: camera 0 is the reference for online extrinsics; its cam_from_rig is held fixed and the
+// other cameras are estimated relative to it (the paper's Fig. 8).
+
+#include "datasets/camera.h"
+#include "datasets/rigid3.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace rovo {
+
+struct RigCamera {
+  std::string name;  // also the image folder name, e.g. "cam0"
+  Camera camera;
+  Rigid3 cam_from_rig;
+};
+
+struct Rig {
+  std::vector<RigCamera> cameras;
+
+  int NumCameras() const { return static_cast<int>(cameras.size()); }
+  // Rig with `scale` times the image size (intrinsics scaled accordingly), same lenses.
+  Rig Scaled(double scale) const;
+  // Replaces every camera's cam_from_rig (sizes must match).
+  Rig WithExtrinsics(const std::vector<Rigid3>& cam_from_rig) const;
+  std::vector<Rigid3> Extrinsics() const;
+  void Check(const std::string& what) const;
+};
+
+// Named rigs: "rovo4" (the paper's synthetic rig), "omnimvs4" (OmniMVS synthetic rig),
+// "rovo4_real" (the paper lab's calibrated rig, imported from OmniMVS config.yaml).
+std::vector<std::string> RigPresetNames();
+Rig MakeRigPreset(const std::string& name);  // throws std::invalid_argument for an unknown name
+
+// One perturbed set of extrinsics (the NoisyExt / OnlineExt starting point).
+struct PerturbedExtrinsics {
+  double sigma_rotation_deg = 5.0;
+  double sigma_translation_m = 0.0;
+  uint64_t seed = 0;
+  std::vector<Rigid3> cam_from_rig;  // one per camera
+};
+
+// Perturbs roll, pitch and yaw of each camera's cam_from_rig (rotation about the camera's own axes)
+// by independent zero-mean Gaussian noise, and the translation by isotropic Gaussian noise.
+PerturbedExtrinsics PerturbExtrinsics(const Rig& rig, double sigma_rotation_deg, double sigma_translation_m,
+                                      uint64_t seed);
+
+}  // namespace rovo
