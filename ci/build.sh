@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# Configures and builds rovo (Release, warnings as errors) into build/. Incremental.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+launcher=()
+if command -v ccache >/dev/null 2>&1; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DROVO_WERROR=ON "${launcher[@]}" >/dev/null
+cmake --build build -j"$(nproc)"
