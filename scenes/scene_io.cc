@@ -1,0 +1,581 @@
+// Scene folder reader/writer and content hash (layout: scenes/FORMAT.md).
+
+#include "datasets/io.h"
+#include "scenes/scene.h"
+
+#include <OpenImageIO/imageio.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+namespace rovo {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr int kFormatVersion = 1;
+const char* const kGeometryFile = "geometry.bin";
+const char* const kMotionFile = "motion.bin";
+const char* const kTrajectoryFile = "trajectory.tum";
+
+static_assert(sizeof(Eigen::Vector3f) == 12 && sizeof(Eigen::Vector2f) == 8 && sizeof(Eigen::Vector3i) == 12,
+              "mesh arrays are copied as packed float32/int32 records");
+
+bool HostIsLittleEndian() {
+  const uint32_t probe = 1;
+  unsigned char first;
+  std::memcpy(&first, &probe, 1);
+  return first == 1;
+}
+
+[[noreturn]] void Fail(const std::string& file, const std::string& field, const std::string& what) {
+  throw std::runtime_error(file + ": " + field + ": " + what);
+}
+
+// Typed access to a JSON field with errors that name the file and the field path.
+class Field {
+ public:
+  Field(const json& value, std::string file, std::string path)
+      : value_(value), file_(std::move(file)), path_(std::move(path)) {}
+
+  Field operator[](const char* key) const {
+    if (!value_.is_object()) Fail(file_, path_, "expected an object");
+    const std::string sub = path_.empty() ? key : path_ + "." + key;
+    auto it = value_.find(key);
+    if (it == value_.end()) Fail(file_, sub, "missing");
+    return Field(*it, file_, sub);
+  }
+  bool Has(const char* key) const { return value_.is_object() && value_.contains(key); }
+  Field operator[](size_t i) const {
+    return Field(value_.at(i), file_, path_ + "[" + std::to_string(i) + "]");
+  }
+  size_t ArraySize() const {
+    if (!value_.is_array()) Fail(file_, path_, "expected an array");
+    return value_.size();
+  }
+  double Number() const {
+    if (!value_.is_number()) Fail(file_, path_, "expected a number");
+    const double v = value_.get<double>();
+    if (!std::isfinite(v)) Fail(file_, path_, "not finite");
+    return v;
+  }
+  int64_t Int(int64_t lo, int64_t hi) const {
+    if (!value_.is_number_integer()) Fail(file_, path_, "expected an integer");
+    const int64_t v = value_.is_number_unsigned() ? static_cast<int64_t>(value_.get<uint64_t>()) : value_.get<int64_t>();
+    if (v < lo || v > hi) {
+      Fail(file_, path_, "value " + std::to_string(v) + " outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    }
+    return v;
+  }
+  uint64_t UInt64() const {
+    if (!value_.is_number_unsigned() && !(value_.is_number_integer() && value_.get<int64_t>() >= 0)) {
+      Fail(file_, path_, "expected a non-negative integer");
+    }
+    return value_.get<uint64_t>();
+  }
+  std::string String() const {
+    if (!value_.is_string()) Fail(file_, path_, "expected a string");
+    return value_.get<std::string>();
+  }
+  template <int N>
+  Eigen::Matrix<double, N, 1> Vector() const {
+    if (ArraySize() != N) Fail(file_, path_, "expected " + std::to_string(N) + " numbers");
+    Eigen::Matrix<double, N, 1> v;
+    for (int i = 0; i < N; ++i) v[i] = (*this)[static_cast<size_t>(i)].Number();
+    return v;
+  }
+  const std::string& file() const { return file_; }
+  const std::string& path() const { return path_; }
+
+ private:
+  const json& value_;
+  std::string file_, path_;
+};
+
+// Unit quaternion from stored x, y, z, w; normalizes only when not unit to 1e-9 (bit-exact round trips).
+Eigen::Quaterniond QuaternionFromXyzw(double x, double y, double z, double w, const std::string& file,
+                                      const std::string& field) {
+  Eigen::Quaterniond q(w, x, y, z);
+  const double n = q.norm();
+  if (!std::isfinite(n) || std::abs(n - 1.0) > 1e-3) Fail(file, field, "quaternion is not unit (norm " + std::to_string(n) + ")");
+  if (std::abs(n - 1.0) > 1e-9) q.coeffs() /= n;
+  return q;
+}
+
+Rigid3 RigidFromJson(const Field& f) {
+  const Eigen::Vector4d q = f["rotation_xyzw"].Vector<4>();
+  Rigid3 out;
+  out.rotation = QuaternionFromXyzw(q[0], q[1], q[2], q[3], f.file(), f.path() + ".rotation_xyzw");
+  out.translation = f["translation"].Vector<3>();
+  return out;
+}
+
+json RigidToJson(const Rigid3& r) {
+  const auto& q = r.rotation;
+  return json{{"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}},
+              {"translation", {r.translation.x(), r.translation.y(), r.translation.z()}}};
+}
+
+template <typename V>
+json VecJson(const V& v) {
+  json a = json::array();
+  for (int i = 0; i < v.size(); ++i) a.push_back(static_cast<double>(v[i]));
+  return a;
+}
+
+// ---- TUM: datasets' parser, our quaternion handling (bit-exact round trips) ----
+
+Trajectory ParseSceneTum(const std::string& path) {
+  Trajectory out;
+  for (const TumLine& line : ParseTumText(ReadFile(path), path)) {
+    const double* v = line.values;
+    StampedPose pose;
+    pose.timestamp = v[0];
+    pose.world_from_rig.translation = Eigen::Vector3d(v[1], v[2], v[3]);
+    pose.world_from_rig.rotation =
+        QuaternionFromXyzw(v[4], v[5], v[6], v[7], path, "line " + std::to_string(line.line_number));
+    out.push_back(pose);
+  }
+  return out;
+}
+
+// ---- binary buffers ----
+
+void AppendBytes(std::string& buffer, const void* data, size_t bytes) {
+  buffer.append(static_cast<const char*>(data), bytes);
+}
+
+class BufferCache {
+ public:
+  explicit BufferCache(std::string dir) : dir_(std::move(dir)) {}
+  const std::string& Get(const std::string& name, const std::string& json_file, const std::string& field) {
+    auto it = files_.find(name);
+    if (it != files_.end()) return it->second;
+    if (name.empty() || name.find("..") != std::string::npos || name[0] == '/') {
+      Fail(json_file, field, "buffer name '" + name + "' must be a relative path inside the scene folder");
+    }
+    const std::string path = (fs::path(dir_) / name).string();
+    if (!fs::exists(path)) Fail(json_file, field, "buffer file '" + path + "' does not exist");
+    return files_.emplace(name, ReadFile(path)).first->second;
+  }
+
+ private:
+  std::string dir_;
+  std::map<std::string, std::string> files_;
+};
+
+// Copies `count` elements of `elem_bytes` from the buffer at `offset`, checking the range.
+void CopyFromBuffer(const std::string& buffer, int64_t offset, size_t count, size_t elem_bytes, void* dst,
+                    const std::string& json_file, const std::string& field, const std::string& buffer_name) {
+  const size_t bytes = count * elem_bytes;
+  if (offset < 0 || offset % 4 != 0) Fail(json_file, field, "offset must be a non-negative multiple of 4");
+  if (static_cast<size_t>(offset) + bytes > buffer.size()) {
+    Fail(json_file, field,
+         "range [" + std::to_string(offset) + ", " + std::to_string(offset + bytes) + ") exceeds buffer '" +
+             buffer_name + "' of " + std::to_string(buffer.size()) + " bytes");
+  }
+  if (bytes > 0) std::memcpy(dst, buffer.data() + offset, bytes);
+}
+
+// ---- textures ----
+
+void WritePng(const std::string& path, const Texture& texture) {
+  const std::string tmp = TempPathFor(path);
+  auto out = OIIO::ImageOutput::create("png");
+  if (!out) throw std::runtime_error(path + ": cannot create PNG writer: " + OIIO::geterror());
+  OIIO::ImageSpec spec(texture.width, texture.height, 3, OIIO::TypeDesc::UINT8);
+  spec.attribute("png:compressionLevel", 1);
+  if (!out->open(tmp, spec) || !out->write_image(OIIO::TypeDesc::UINT8, texture.rgb.data()) || !out->close()) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw std::runtime_error(path + ": cannot write PNG: " + out->geterror());
+  }
+  CommitTempFile(tmp, path);
+}
+
+void ReadPng(const std::string& path, Texture& texture, const std::string& json_file, const std::string& field) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) Fail(json_file, field, "cannot read texture '" + path + "': " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width != texture.width || spec.height != texture.height) {
+    Fail(json_file, field,
+         "texture '" + path + "' is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+             ", scene.json says " + std::to_string(texture.width) + "x" + std::to_string(texture.height));
+  }
+  const int channels = spec.nchannels;
+  if (channels < 1 || channels > 4) Fail(json_file, field, "texture '" + path + "' has unsupported channel count");
+  std::vector<uint8_t> raw(static_cast<size_t>(spec.width) * spec.height * channels);
+  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, raw.data())) {
+    Fail(json_file, field, "cannot decode texture '" + path + "': " + in->geterror());
+  }
+  in->close();
+  const size_t pixels = static_cast<size_t>(spec.width) * spec.height;
+  texture.rgb.resize(pixels * 3);
+  for (size_t i = 0; i < pixels; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      // Gray (+alpha) replicates channel 0; RGB(A) drops alpha.
+      texture.rgb[i * 3 + c] = raw[i * channels + (channels >= 3 ? c : 0)];
+    }
+  }
+}
+
+// ---- hashing ----
+
+class Hasher {
+ public:
+  void Bytes(const void* data, size_t size) { state_ = std::strtoull(HashHex(data, size, state_).c_str(), nullptr, 16); }
+  void Str(const std::string& s) {
+    U64(s.size());
+    Bytes(s.data(), s.size());
+  }
+  void U64(uint64_t v) { Bytes(&v, sizeof(v)); }
+  void F64(double v) { Bytes(&v, sizeof(v)); }
+  void Rigid(const Rigid3& r) {
+    const double q[4] = {r.rotation.x(), r.rotation.y(), r.rotation.z(), r.rotation.w()};
+    Bytes(q, sizeof(q));
+    Bytes(r.translation.data(), sizeof(double) * 3);
+  }
+  template <typename T>
+  void Vec(const std::vector<T>& v) {
+    U64(v.size());
+    if (!v.empty()) Bytes(v.data(), v.size() * sizeof(T));
+  }
+  std::string Hex() const {
+    char buf[17];
+    std::snprintf(buf, sizeof(buf), "%016llx", static_cast<unsigned long long>(state_));
+    return buf;
+  }
+
+ private:
+  uint64_t state_ = 0;
+};
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------------
+
+void SaveScene(const Scene& scene, const std::string& dir) {
+  if (!HostIsLittleEndian()) throw std::runtime_error("SaveScene: big-endian hosts are not supported");
+  EnsureWritableDir(dir);
+  EnsureWritableDir((fs::path(dir) / "textures").string());
+  const int frames = static_cast<int>(scene.rig_trajectory.size());
+
+  json root;
+  root["format"] = "rovo-scene";
+  root["format_version"] = kFormatVersion;
+  root["metadata"] = {{"generator", scene.metadata.generator},
+                      {"generator_version", scene.metadata.generator_version},
+                      {"preset", scene.metadata.preset},
+                      {"seed", scene.metadata.seed},
+                      {"source", scene.metadata.source}};
+  root["frame_rate"] = scene.frame_rate;
+  root["rig_preset"] = scene.rig_preset;
+  root["trajectory"] = kTrajectoryFile;
+  const Lighting& l = scene.lighting;
+  root["lighting"] = {{"preset", l.preset},
+                      {"direction_to_sun", VecJson(l.direction_to_sun)},
+                      {"sun_radiance", VecJson(l.sun_radiance)},
+                      {"sun_angular_diameter_deg", l.sun_angular_diameter_deg},
+                      {"sky_zenith", VecJson(l.sky_zenith)},
+                      {"sky_horizon", VecJson(l.sky_horizon)},
+                      {"ground_albedo", VecJson(l.ground_albedo)},
+                      {"ambient", static_cast<double>(l.ambient)},
+                      {"exposure", static_cast<double>(l.exposure)}};
+
+  json textures = json::array();
+  for (size_t i = 0; i < scene.textures.size(); ++i) {
+    const Texture& t = scene.textures[i];
+    if (t.width <= 0 || t.height <= 0 || t.rgb.size() != static_cast<size_t>(t.width) * t.height * 3) {
+      throw std::runtime_error("SaveScene: texture " + std::to_string(i) + " ('" + t.name + "') has inconsistent size");
+    }
+    char name[64];
+    std::snprintf(name, sizeof(name), "textures/%03zu.png", i);
+    WritePng((fs::path(dir) / name).string(), t);
+    textures.push_back({{"name", t.name}, {"file", name}, {"width", t.width}, {"height", t.height}});
+  }
+  root["textures"] = textures;
+
+  json materials = json::array();
+  for (const Material& m : scene.materials) {
+    materials.push_back({{"name", m.name}, {"base_color", VecJson(m.base_color)}, {"texture", m.texture}});
+  }
+  root["materials"] = materials;
+
+  std::string geometry;
+  json meshes = json::array();
+  for (size_t i = 0; i < scene.meshes.size(); ++i) {
+    const Mesh& m = scene.meshes[i];
+    const size_t nv = m.positions.size(), nt = m.triangles.size();
+    if (!m.uvs.empty() && m.uvs.size() != nv) throw std::runtime_error("SaveScene: mesh '" + m.name + "': uvs size != positions size");
+    if (!m.triangle_materials.empty() && m.triangle_materials.size() != nt) {
+      throw std::runtime_error("SaveScene: mesh '" + m.name + "': triangle_materials size != triangles size");
+    }
+    json jm = {{"name", m.name}, {"material", m.material}, {"buffer", kGeometryFile},
+               {"vertex_count", nv}, {"triangle_count", nt}};
+    jm["positions_offset"] = geometry.size();
+    AppendBytes(geometry, m.positions.data(), nv * 3 * sizeof(float));
+    if (m.uvs.empty()) {
+      jm["uvs_offset"] = -1;
+    } else {
+      jm["uvs_offset"] = geometry.size();
+      AppendBytes(geometry, m.uvs.data(), nv * 2 * sizeof(float));
+    }
+    jm["triangles_offset"] = geometry.size();
+    AppendBytes(geometry, m.triangles.data(), nt * 3 * sizeof(int32_t));
+    if (m.triangle_materials.empty()) {
+      jm["triangle_materials_offset"] = -1;
+    } else {
+      jm["triangle_materials_offset"] = geometry.size();
+      AppendBytes(geometry, m.triangle_materials.data(), nt * sizeof(int32_t));
+    }
+    meshes.push_back(jm);
+  }
+  root["meshes"] = meshes;
+
+  std::string motion;
+  json objects = json::array();
+  for (const Object& o : scene.objects) {
+    json jo = {{"name", o.name}, {"mesh", o.mesh}, {"id", o.id}};
+    if (o.IsDynamic()) {
+      if (static_cast<int>(o.world_from_object_per_frame.size()) != frames) {
+        throw std::runtime_error("SaveScene: object '" + o.name + "' has " +
+                                 std::to_string(o.world_from_object_per_frame.size()) + " transforms for " +
+                                 std::to_string(frames) + " frames");
+      }
+      jo["motion"] = {{"buffer", kMotionFile}, {"offset", motion.size()}, {"frames", frames}};
+      for (const Rigid3& r : o.world_from_object_per_frame) {
+        const double rec[7] = {r.rotation.x(), r.rotation.y(), r.rotation.z(), r.rotation.w(),
+                               r.translation.x(), r.translation.y(), r.translation.z()};
+        AppendBytes(motion, rec, sizeof(rec));
+      }
+    } else {
+      jo["world_from_object"] = RigidToJson(o.world_from_object);
+    }
+    objects.push_back(jo);
+  }
+  root["objects"] = objects;
+
+  WriteFileAtomic((fs::path(dir) / kGeometryFile).string(), geometry);
+  WriteFileAtomic((fs::path(dir) / kMotionFile).string(), motion);
+  WriteFileAtomic((fs::path(dir) / kTrajectoryFile).string(), FormatTum(scene.rig_trajectory));
+  // scene.json last: a folder with a scene.json is complete.
+  WriteJsonFileAtomic((fs::path(dir) / "scene.json").string(), root);
+}
+
+Scene LoadScene(const std::string& dir) {
+  if (!HostIsLittleEndian()) throw std::runtime_error("LoadScene: big-endian hosts are not supported");
+  const std::string file = (fs::path(dir) / "scene.json").string();
+  const json doc = ReadJsonFile(file);
+  const Field root(doc, file, "");
+  if (root["format"].String() != "rovo-scene") Fail(file, "format", "expected \"rovo-scene\"");
+  const int64_t version = root["format_version"].Int(1, 1000);
+  if (version != kFormatVersion) Fail(file, "format_version", "unsupported version " + std::to_string(version));
+
+  Scene scene;
+  const Field meta = root["metadata"];
+  scene.metadata.generator = meta["generator"].String();
+  scene.metadata.generator_version = meta["generator_version"].String();
+  scene.metadata.preset = meta["preset"].String();
+  scene.metadata.seed = meta["seed"].UInt64();
+  scene.metadata.source = meta["source"].String();
+  scene.frame_rate = root["frame_rate"].Number();
+  if (!(scene.frame_rate > 0)) Fail(file, "frame_rate", "must be positive");
+  scene.rig_preset = root["rig_preset"].String();
+
+  const Field jl = root["lighting"];
+  Lighting& l = scene.lighting;
+  l.preset = jl["preset"].String();
+  l.direction_to_sun = jl["direction_to_sun"].Vector<3>();
+  l.sun_radiance = jl["sun_radiance"].Vector<3>().cast<float>();
+  l.sun_angular_diameter_deg = jl["sun_angular_diameter_deg"].Number();
+  l.sky_zenith = jl["sky_zenith"].Vector<3>().cast<float>();
+  l.sky_horizon = jl["sky_horizon"].Vector<3>().cast<float>();
+  l.ground_albedo = jl["ground_albedo"].Vector<3>().cast<float>();
+  l.ambient = static_cast<float>(jl["ambient"].Number());
+  l.exposure = static_cast<float>(jl["exposure"].Number());
+
+  const std::string trajectory_name = root["trajectory"].String();
+  const std::string trajectory_path = (fs::path(dir) / trajectory_name).string();
+  if (!fs::exists(trajectory_path)) Fail(file, "trajectory", "file '" + trajectory_path + "' does not exist");
+  scene.rig_trajectory = ParseSceneTum(trajectory_path);
+  const int64_t frames = static_cast<int64_t>(scene.rig_trajectory.size());
+
+  const Field jt = root["textures"];
+  scene.textures.resize(jt.ArraySize());
+  for (size_t i = 0; i < scene.textures.size(); ++i) {
+    const Field f = jt[i];
+    Texture& t = scene.textures[i];
+    t.name = f["name"].String();
+    t.width = static_cast<int>(f["width"].Int(1, 1 << 16));
+    t.height = static_cast<int>(f["height"].Int(1, 1 << 16));
+    const std::string png = f["file"].String();
+    if (png.empty() || png[0] == '/' || png.find("..") != std::string::npos) {
+      Fail(file, f.path() + ".file", "must be a relative path inside the scene folder");
+    }
+    ReadPng((fs::path(dir) / png).string(), t, file, f.path() + ".file");
+  }
+
+  const Field jmat = root["materials"];
+  scene.materials.resize(jmat.ArraySize());
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    const Field f = jmat[i];
+    Material& m = scene.materials[i];
+    m.name = f["name"].String();
+    m.base_color = f["base_color"].Vector<3>().cast<float>();
+    m.texture = static_cast<int>(f["texture"].Int(-1, static_cast<int64_t>(scene.textures.size()) - 1));
+  }
+  const int64_t num_materials = static_cast<int64_t>(scene.materials.size());
+
+  BufferCache buffers(dir);
+  const Field jmesh = root["meshes"];
+  scene.meshes.resize(jmesh.ArraySize());
+  for (size_t i = 0; i < scene.meshes.size(); ++i) {
+    const Field f = jmesh[i];
+    Mesh& m = scene.meshes[i];
+    m.name = f["name"].String();
+    m.material = static_cast<int>(f["material"].Int(0, num_materials - 1));
+    const std::string buffer_name = f["buffer"].String();
+    const std::string& buffer = buffers.Get(buffer_name, file, f.path() + ".buffer");
+    const int64_t nv = f["vertex_count"].Int(0, INT32_MAX);
+    const int64_t nt = f["triangle_count"].Int(0, INT32_MAX);
+    m.positions.resize(nv);
+    CopyFromBuffer(buffer, f["positions_offset"].Int(0, INT64_MAX), nv, 3 * sizeof(float), m.positions.data(), file,
+                   f.path() + ".positions_offset", buffer_name);
+    const int64_t uv_offset = f["uvs_offset"].Int(-1, INT64_MAX);
+    if (uv_offset >= 0) {
+      m.uvs.resize(nv);
+      CopyFromBuffer(buffer, uv_offset, nv, 2 * sizeof(float), m.uvs.data(), file, f.path() + ".uvs_offset", buffer_name);
+    }
+    m.triangles.resize(nt);
+    CopyFromBuffer(buffer, f["triangles_offset"].Int(0, INT64_MAX), nt, 3 * sizeof(int32_t), m.triangles.data(), file,
+                   f.path() + ".triangles_offset", buffer_name);
+    const int64_t tm_offset = f["triangle_materials_offset"].Int(-1, INT64_MAX);
+    if (tm_offset >= 0) {
+      m.triangle_materials.resize(nt);
+      CopyFromBuffer(buffer, tm_offset, nt, sizeof(int32_t), m.triangle_materials.data(), file,
+                     f.path() + ".triangle_materials_offset", buffer_name);
+    }
+    for (size_t k = 0; k < m.positions.size(); ++k) {
+      if (!m.positions[k].allFinite()) Fail(file, f.path() + ".positions_offset", "vertex " + std::to_string(k) + " is not finite");
+    }
+    for (size_t k = 0; k < m.triangles.size(); ++k) {
+      const Eigen::Vector3i& tri = m.triangles[k];
+      if (tri.minCoeff() < 0 || tri.maxCoeff() >= nv) {
+        Fail(file, f.path() + ".triangles_offset", "triangle " + std::to_string(k) + " has a vertex index outside [0, " + std::to_string(nv) + ")");
+      }
+    }
+    for (size_t k = 0; k < m.triangle_materials.size(); ++k) {
+      if (m.triangle_materials[k] < 0 || m.triangle_materials[k] >= num_materials) {
+        Fail(file, f.path() + ".triangle_materials_offset", "triangle " + std::to_string(k) + " has material " +
+             std::to_string(m.triangle_materials[k]) + " outside [0, " + std::to_string(num_materials) + ")");
+      }
+    }
+  }
+
+  const Field jo = root["objects"];
+  scene.objects.resize(jo.ArraySize());
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const Field f = jo[i];
+    Object& o = scene.objects[i];
+    o.name = f["name"].String();
+    o.mesh = static_cast<int>(f["mesh"].Int(0, static_cast<int64_t>(scene.meshes.size()) - 1));
+    o.id = static_cast<uint16_t>(f["id"].Int(0, 65535));
+    const bool has_static = f.Has("world_from_object"), has_motion = f.Has("motion");
+    if (has_static == has_motion) Fail(file, f.path(), "needs exactly one of world_from_object or motion");
+    if (has_static) {
+      o.world_from_object = RigidFromJson(f["world_from_object"]);
+      continue;
+    }
+    const Field fm = f["motion"];
+    const std::string buffer_name = fm["buffer"].String();
+    const std::string& buffer = buffers.Get(buffer_name, file, fm.path() + ".buffer");
+    const int64_t n = fm["frames"].Int(1, INT32_MAX);
+    if (n != frames) {
+      Fail(file, fm.path() + ".frames", std::to_string(n) + " transforms but the trajectory has " + std::to_string(frames) + " poses");
+    }
+    std::vector<double> rec(static_cast<size_t>(n) * 7);
+    CopyFromBuffer(buffer, fm["offset"].Int(0, INT64_MAX), static_cast<size_t>(n), 7 * sizeof(double), rec.data(), file,
+                   fm.path() + ".offset", buffer_name);
+    o.world_from_object_per_frame.resize(n);
+    for (int64_t k = 0; k < n; ++k) {
+      const double* r = &rec[k * 7];
+      Rigid3& x = o.world_from_object_per_frame[k];
+      x.rotation = QuaternionFromXyzw(r[0], r[1], r[2], r[3], file, fm.path() + " frame " + std::to_string(k));
+      x.translation = Eigen::Vector3d(r[4], r[5], r[6]);
+      if (!x.translation.allFinite()) Fail(file, fm.path(), "frame " + std::to_string(k) + " translation is not finite");
+    }
+  }
+  return scene;
+}
+
+std::string SceneHash(const Scene& scene) {
+  Hasher h;
+  h.Str("rovo-scene-1");
+  h.Str(scene.metadata.generator);
+  h.Str(scene.metadata.preset);
+  h.U64(scene.metadata.seed);
+  h.Str(scene.metadata.source);
+  h.F64(scene.frame_rate);
+  h.Str(scene.rig_preset);
+  const Lighting& l = scene.lighting;
+  h.Str(l.preset);
+  h.Bytes(l.direction_to_sun.data(), sizeof(double) * 3);
+  h.Bytes(l.sun_radiance.data(), sizeof(float) * 3);
+  h.F64(l.sun_angular_diameter_deg);
+  h.Bytes(l.sky_zenith.data(), sizeof(float) * 3);
+  h.Bytes(l.sky_horizon.data(), sizeof(float) * 3);
+  h.Bytes(l.ground_albedo.data(), sizeof(float) * 3);
+  h.Bytes(&l.ambient, sizeof(float));
+  h.Bytes(&l.exposure, sizeof(float));
+  h.U64(scene.textures.size());
+  for (const Texture& t : scene.textures) {
+    h.Str(t.name);
+    h.U64(static_cast<uint64_t>(t.width));
+    h.U64(static_cast<uint64_t>(t.height));
+    h.Vec(t.rgb);
+  }
+  h.U64(scene.materials.size());
+  for (const Material& m : scene.materials) {
+    h.Str(m.name);
+    h.Bytes(m.base_color.data(), sizeof(float) * 3);
+    h.U64(static_cast<uint64_t>(static_cast<int64_t>(m.texture)));
+  }
+  h.U64(scene.meshes.size());
+  for (const Mesh& m : scene.meshes) {
+    h.Str(m.name);
+    h.U64(static_cast<uint64_t>(m.material));
+    h.Vec(m.positions);
+    h.Vec(m.uvs);
+    h.Vec(m.triangles);
+    h.Vec(m.triangle_materials);
+  }
+  h.U64(scene.objects.size());
+  for (const Object& o : scene.objects) {
+    h.Str(o.name);
+    h.U64(static_cast<uint64_t>(o.mesh));
+    h.U64(o.id);
+    h.U64(o.IsDynamic() ? 1 : 0);
+    if (o.IsDynamic()) {
+      h.U64(o.world_from_object_per_frame.size());
+      for (const Rigid3& r : o.world_from_object_per_frame) h.Rigid(r);
+    } else {
+      h.Rigid(o.world_from_object);
+    }
+  }
+  h.U64(scene.rig_trajectory.size());
+  for (const StampedPose& p : scene.rig_trajectory) {
+    h.F64(p.timestamp);
+    h.Rigid(p.world_from_rig);
+  }
+  return h.Hex();
+}
+
+}  // namespace rovo
