@@ -1,0 +1,78 @@
+#pragma once
+// Multi-view P3P RANSAC (ROVO paper, Sec. IV-C, Algorithm 1).
+//
+// Data: per camera j, correspondences (bearing_in_cam_ij, point_in_world_ij) and the camera's
+// cam_from_rig_j. Each iteration
+//   1. picks a view j' with probability n_j' / sum_j n_j (PPS: probability proportional to size;
+//      only views with >= 3 correspondences take part),
+//   2. draws 3 distinct correspondences of j', solves P3P -> candidates cam_from_world_k,
+//   3. turns each into a rig pose rig_from_world_k = inverse(cam_from_rig_j') * cam_from_world_k,
+//   4. scores it over EVERY correspondence of EVERY view with the truncated angular cost
+//        C_k = sum_j sum_i max(0, tau - angle(bearing_ij, cam_from_rig_j * rig_from_world_k * X_ij)),
+//      angle(a, b) = atan2(|a x b|, a . b) (valid for any direction, also behind the image plane),
+//   5. keeps the candidate with the largest C_k and updates the iteration bound from its inlier ratio
+//      w (inlier: angle < tau): N = log(1 - confidence) / log(1 - w^3).
+// Ablations: sampling kUniform picks the view uniformly; kSingleView restricts hypotheses and scoring
+// to one view (the one with the most correspondences), i.e. the monocular P3P RANSAC.
+// Determinism: std::mt19937_64 seeded by Options::seed with our own uniform helpers, so the result is
+// the same on every platform for a given seed.
+
+#include "datasets/rigid3.h"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace rovo {
+
+struct BearingPointCorrespondence {
+  Eigen::Vector3d bearing_in_cam;  // unit
+  Eigen::Vector3d point_in_world;
+};
+
+enum class ViewSampling { kPps, kUniform };
+enum class RansacViews { kMultiView, kSingleView };
+ViewSampling ViewSamplingFromName(const std::string& name);  // "pps" | "uniform"; throws otherwise
+RansacViews RansacViewsFromName(const std::string& name);    // "multiview" | "single-view"
+
+struct MultiViewRansacOptions {
+  double tau_rad = 0.01;          // inlier threshold and truncation of the cost (0.57 deg)
+  int min_iterations = 20;        // at least this many hypotheses draws
+  int max_iterations = 1000;      // hard bound on draws
+  double confidence = 0.999;      // for the adaptive iteration bound
+  int min_inliers = 10;           // fewer: no consensus
+  ViewSampling sampling = ViewSampling::kPps;
+  RansacViews views = RansacViews::kMultiView;
+  uint64_t seed = 0;
+  void Check() const;  // throws std::invalid_argument naming the field
+};
+
+struct MultiViewRansacReport {
+  bool success = false;                  // a pose with >= min_inliers inliers was found
+  Rigid3 rig_from_world;
+  double score = 0.0;                    // best sum of max(0, tau - angle)
+  int num_inliers = 0;
+  int num_correspondences = 0;           // scored correspondences (all views, or the single view)
+  double inlier_ratio = 0.0;
+  int num_iterations = 0;                // draws
+  int num_hypotheses = 0;                // P3P solutions scored
+  std::vector<std::vector<char>> inliers;  // [camera][i], 1 = inlier of the best pose
+  std::vector<int> view_draws;           // how often each view was chosen
+  int single_view = -1;                  // the view used in kSingleView mode
+};
+
+// correspondences[j] are camera j's; cam_from_rig.size() must equal correspondences.size().
+MultiViewRansacReport MultiViewP3PRansac(const std::vector<std::vector<BearingPointCorrespondence>>& correspondences,
+                                         const std::vector<Rigid3>& cam_from_rig,
+                                         const MultiViewRansacOptions& options);
+
+// Portable uniform helpers on std::mt19937_64 (the standard distributions differ between libraries).
+uint64_t UniformIndex(std::mt19937_64& rng, uint64_t n);  // in [0, n), unbiased; n >= 1
+double UniformUnit(std::mt19937_64& rng);                 // in [0, 1), 53 random bits
+// Index j with probability weights[j] / sum(weights); weights >= 0 with a positive sum.
+int SampleProportional(std::mt19937_64& rng, const std::vector<double>& weights);
+
+}  // namespace rovo
