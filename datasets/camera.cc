@@ -16,6 +16,8 @@ constexpr double kDegToRad = M_PI / 180.0;
 // Unproject rejects ocam pixels whose bearing does not project back within this distance: beyond
 // the FOV edge the forward polynomial may fold back, and the inverse fit is only valid inside.
 constexpr double kOcamRoundTripTolerancePx = 0.1;
+// InFov tolerance: rounding noise of an unprojected edge pixel must not reject it.
+constexpr double kFovSlackRad = 1e-9;
 // Check() accepts an ocam inverse polynomial that is this close to the forward one over the FOV.
 constexpr double kOcamCheckInverseTolerancePx = 0.05;
 
@@ -206,7 +208,7 @@ bool Camera::InFov(const Eigen::Vector3d& point_in_cam) const {
   const double r_xy = std::hypot(point_in_cam.x(), point_in_cam.y());
   if (r_xy == 0.0 && point_in_cam.z() == 0.0) return false;
   const double angle_from_axis = std::atan2(r_xy, point_in_cam.z());
-  return angle_from_axis <= 0.5 * max_fov_deg * kDegToRad;
+  return angle_from_axis <= 0.5 * max_fov_deg * kDegToRad + kFovSlackRad;
 }
 
 std::vector<unsigned char> Camera::ValidPixelMask() const {

@@ -37,7 +37,7 @@ struct Camera {
     return uv.x() >= -0.5 && uv.y() >= -0.5 && uv.x() < width - 0.5 && uv.y() < height - 0.5;
   }
 
-  // True when the bearing's angle from the optical axis is within max_fov_deg / 2.
+  // True when the bearing's angle from the optical axis is within max_fov_deg / 2 (+1e-9 rad for rounding).
   bool InFov(const Eigen::Vector3d& point_in_cam) const;
 
   // Row-major width*height mask: 255 where the pixel centre unprojects to a valid bearing.
