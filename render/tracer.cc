@@ -1,0 +1,633 @@
+#include "render/tracer.h"
+
+#include <embree3/rtcore.h>
+#include <pmmintrin.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+#include <xmmintrin.h>
+
+#include <algorithm>
+#include <array>
+#include <cassert>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace rovo {
+namespace {
+
+constexpr int kTile = 8;
+constexpr int kTilePixels = kTile * kTile;
+constexpr float kInvPi = 0.318309886f;
+
+// splitmix64: the per-pixel hash behind the fixed sample patterns and the sensor noise.
+uint64_t Mix64(uint64_t x) {
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+float UnitFloat(uint64_t bits) { return static_cast<float>(bits >> 40) * (1.0f / 16777216.0f); }
+
+float RadicalInverse2(uint32_t i) {
+  i = (i << 16) | (i >> 16);
+  i = ((i & 0x00ff00ffu) << 8) | ((i & 0xff00ff00u) >> 8);
+  i = ((i & 0x0f0f0f0fu) << 4) | ((i & 0xf0f0f0f0u) >> 4);
+  i = ((i & 0x33333333u) << 2) | ((i & 0xccccccccu) >> 2);
+  i = ((i & 0x55555555u) << 1) | ((i & 0xaaaaaaaau) >> 1);
+  return static_cast<float>(i) * (1.0f / 4294967296.0f);
+}
+
+float Wrap01(float x) { return x - std::floor(x); }
+
+// 65536-entry table linear [0, 1] -> 8-bit sRGB (rounded).
+const std::array<uint8_t, 65536>& SrgbTable() {
+  static const std::array<uint8_t, 65536> table = [] {
+    std::array<uint8_t, 65536> t{};
+    for (int i = 0; i < 65536; ++i) {
+      t[i] = static_cast<uint8_t>(std::lround(LinearToSrgb(i / 65535.0f) * 255.0f));
+    }
+    return t;
+  }();
+  return table;
+}
+
+uint8_t EncodeSrgb(float linear, const std::array<uint8_t, 65536>& table) {
+  if (!(linear > 0.0f)) return 0;
+  if (linear >= 1.0f) return 255;
+  return table[static_cast<int>(linear * 65535.0f + 0.5f)];
+}
+
+Eigen::Vector3f ToF(const Eigen::Vector3d& v) { return v.cast<float>(); }
+
+}  // namespace
+
+void SetFlushDenormals() {
+  _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+  _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+}
+
+// ---------------------------------------------------------------------------------------------
+// CameraRays
+
+CameraRays CameraRays::Make(const Camera& camera, int threads) {
+  CameraRays rays;
+  rays.camera = camera;
+  rays.width = camera.width;
+  rays.height = camera.height;
+  const size_t n = static_cast<size_t>(camera.width) * camera.height;
+  rays.bearing.assign(n, Eigen::Vector3f::Zero());
+  rays.valid.assign(n, 0);
+  rays.pixel_angle.assign(n, 0.0f);
+  auto run = [&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& r) {
+      for (int y = r.begin(); y < r.end(); ++y) {
+        for (int x = 0; x < camera.width; ++x) {
+          const std::optional<Eigen::Vector3d> b = camera.Unproject(Eigen::Vector2d(x, y));
+          if (!b || !camera.InFov(*b)) continue;
+          const size_t i = static_cast<size_t>(y) * camera.width + x;
+          rays.bearing[i] = b->normalized().cast<float>();
+          rays.valid[i] = 1;
+        }
+      }
+    });
+  };
+  if (threads > 0) {
+    tbb::task_arena arena(threads);
+    arena.execute(run);
+  } else {
+    run();
+  }
+  // Angular pixel size: mean angle to the right and lower neighbours (left/upper at the borders).
+  float fallback = 0.0f;
+  for (int y = 0; y < camera.height; ++y) {
+    for (int x = 0; x < camera.width; ++x) {
+      const size_t i = static_cast<size_t>(y) * camera.width + x;
+      if (!rays.valid[i]) continue;
+      ++rays.num_valid;
+      float sum = 0.0f;
+      int count = 0;
+      const int nx = x + 1 < camera.width ? x + 1 : x - 1;
+      const int ny = y + 1 < camera.height ? y + 1 : y - 1;
+      for (const size_t j : {static_cast<size_t>(y) * camera.width + nx, static_cast<size_t>(ny) * camera.width + x}) {
+        if (nx < 0 || ny < 0 || !rays.valid[j]) continue;
+        const Eigen::Vector3f& a = rays.bearing[i];
+        const Eigen::Vector3f& b = rays.bearing[j];
+        sum += std::atan2(a.cross(b).norm(), a.dot(b));
+        ++count;
+      }
+      if (count > 0) {
+        rays.pixel_angle[i] = sum / count;
+        fallback = rays.pixel_angle[i];
+      } else {
+        rays.pixel_angle[i] = fallback;
+      }
+    }
+  }
+  return rays;
+}
+
+bool CameraRays::SampleBearing(float u, float v, Eigen::Vector3f* bearing_out) const {
+  const float x0f = std::floor(u), y0f = std::floor(v);
+  const int x0 = static_cast<int>(x0f), y0 = static_cast<int>(y0f);
+  if (x0 >= 0 && y0 >= 0 && x0 + 1 < width && y0 + 1 < height) {
+    const size_t i00 = static_cast<size_t>(y0) * width + x0;
+    const size_t i10 = i00 + 1, i01 = i00 + width, i11 = i01 + 1;
+    if (valid[i00] & valid[i10] & valid[i01] & valid[i11]) {
+      const float ax = u - x0f, ay = v - y0f;
+      const Eigen::Vector3f top = bearing[i00] + ax * (bearing[i10] - bearing[i00]);
+      const Eigen::Vector3f bottom = bearing[i01] + ax * (bearing[i11] - bearing[i01]);
+      *bearing_out = (top + ay * (bottom - top)).normalized();
+      return true;
+    }
+  }
+  const std::optional<Eigen::Vector3d> b = camera.Unproject(Eigen::Vector2d(u, v));
+  if (!b || !camera.InFov(*b)) return false;
+  *bearing_out = b->normalized().cast<float>();
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Tracer
+
+struct Tracer::Impl {
+  const Scene& scene;
+  RTCDevice device = nullptr;
+  RTCScene static_scene = nullptr;
+  RTCScene top = nullptr;
+  std::vector<RTCScene> mesh_scenes;        // per mesh, only for meshes of dynamic objects
+  std::vector<int> static_geom_object;      // static geomID -> object index
+  unsigned static_instance_id = RTC_INVALID_GEOMETRY_ID;
+  std::vector<int> top_instance_object;     // top-level geomID -> object index (-1: static)
+  std::vector<RTCGeometry> dynamic_instances;
+  std::vector<int> dynamic_objects;
+  std::vector<Eigen::Matrix3f> object_rotation;  // world_from_object rotation (static: identity)
+  std::vector<std::vector<float>> mesh_uv_scale;  // per mesh and triangle: sqrt(A_uv / A_object)
+  std::vector<MipTexture> textures;
+
+  Eigen::Vector3f sun_dir, sun_e1, sun_e2;
+  float sun_disc_radius = 0.0f;  // tan(angular diameter / 2)
+  Eigen::Vector3f sky_mean, ground_irradiance;
+
+  explicit Impl(const Scene& s) : scene(s) {}
+
+  ~Impl() {
+    if (top) rtcReleaseScene(top);
+    if (static_scene) rtcReleaseScene(static_scene);
+    for (RTCScene m : mesh_scenes)
+      if (m) rtcReleaseScene(m);
+    if (device) rtcReleaseDevice(device);
+  }
+
+  void CheckDevice(const char* what) const {
+    const RTCError err = rtcGetDeviceError(device);
+    if (err != RTC_ERROR_NONE) throw std::runtime_error(std::string("Embree error ") + std::to_string(err) + " in " + what);
+  }
+
+  RTCGeometry MakeTriangles(const Mesh& mesh, const Rigid3* world_from_object, RTCBuildQuality quality) {
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                                   3 * sizeof(float), mesh.positions.size()));
+    const Eigen::Matrix3f rot = world_from_object ? Eigen::Matrix3f(world_from_object->RotationMatrix().cast<float>())
+                                                  : Eigen::Matrix3f(Eigen::Matrix3f::Identity());
+    const Eigen::Vector3f trans = world_from_object ? ToF(world_from_object->translation) : Eigen::Vector3f::Zero();
+    for (size_t i = 0; i < mesh.positions.size(); ++i) {
+      const Eigen::Vector3f p = rot * mesh.positions[i] + trans;
+      vertices[3 * i + 0] = p.x();
+      vertices[3 * i + 1] = p.y();
+      vertices[3 * i + 2] = p.z();
+    }
+    unsigned* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                        3 * sizeof(unsigned), mesh.triangles.size()));
+    for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+      for (int k = 0; k < 3; ++k) indices[3 * i + k] = static_cast<unsigned>(mesh.triangles[i][k]);
+    }
+    rtcSetGeometryBuildQuality(geom, quality);
+    rtcCommitGeometry(geom);
+    return geom;
+  }
+};
+
+Tracer::Tracer(const Scene& scene) : impl_(std::make_unique<Impl>(scene)) {
+  Impl& d = *impl_;
+  // Validate indices first: bad input must fail with a message naming the culprit.
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    const std::string what = "mesh '" + mesh.name + "'";
+    if (!mesh.uvs.empty() && mesh.uvs.size() != mesh.positions.size())
+      throw std::invalid_argument(what + ": uvs has " + std::to_string(mesh.uvs.size()) + " entries for " +
+                                  std::to_string(mesh.positions.size()) + " positions");
+    if (!mesh.triangle_materials.empty() && mesh.triangle_materials.size() != mesh.triangles.size())
+      throw std::invalid_argument(what + ": triangle_materials size differs from triangles");
+    for (const Eigen::Vector3i& tri : mesh.triangles)
+      for (int k = 0; k < 3; ++k)
+        if (tri[k] < 0 || tri[k] >= static_cast<int>(mesh.positions.size()))
+          throw std::invalid_argument(what + ": triangle vertex index " + std::to_string(tri[k]) + " out of range");
+    auto check_material = [&](int mat) {
+      if (mat < 0 || mat >= static_cast<int>(scene.materials.size()))
+        throw std::invalid_argument(what + ": material index " + std::to_string(mat) + " out of range");
+    };
+    check_material(mesh.material);
+    for (int32_t mat : mesh.triangle_materials) check_material(mat);
+  }
+  for (const Material& mat : scene.materials)
+    if (mat.texture >= static_cast<int>(scene.textures.size()) || mat.texture < -1)
+      throw std::invalid_argument("material '" + mat.name + "': texture index " + std::to_string(mat.texture) +
+                                  " out of range");
+  for (const Object& obj : scene.objects)
+    if (obj.mesh < 0 || obj.mesh >= static_cast<int>(scene.meshes.size()))
+      throw std::invalid_argument("object '" + obj.name + "': mesh index " + std::to_string(obj.mesh) + " out of range");
+
+  d.textures.reserve(scene.textures.size());
+  for (const Texture& tex : scene.textures) d.textures.emplace_back(tex);
+
+  // Per-triangle UV-to-object area ratio (rigid transforms keep areas).
+  d.mesh_uv_scale.resize(scene.meshes.size());
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    if (mesh.uvs.empty()) continue;
+    std::vector<float>& scale = d.mesh_uv_scale[m];
+    scale.resize(mesh.triangles.size());
+    for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+      const Eigen::Vector3i& tri = mesh.triangles[i];
+      const float area = (mesh.positions[tri[1]] - mesh.positions[tri[0]])
+                             .cross(mesh.positions[tri[2]] - mesh.positions[tri[0]])
+                             .norm();
+      const Eigen::Vector2f e1 = mesh.uvs[tri[1]] - mesh.uvs[tri[0]];
+      const Eigen::Vector2f e2 = mesh.uvs[tri[2]] - mesh.uvs[tri[0]];
+      const float uv_area = std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+      scale[i] = area > 0.0f ? std::sqrt(uv_area / area) : 0.0f;
+    }
+  }
+
+  d.device = rtcNewDevice(nullptr);
+  if (!d.device) throw std::runtime_error("cannot create the Embree device");
+
+  const auto start = std::chrono::steady_clock::now();
+  d.static_scene = rtcNewScene(d.device);
+  rtcSetSceneBuildQuality(d.static_scene, RTC_BUILD_QUALITY_HIGH);
+  d.object_rotation.assign(scene.objects.size(), Eigen::Matrix3f::Identity());
+  d.mesh_scenes.assign(scene.meshes.size(), nullptr);
+  for (size_t o = 0; o < scene.objects.size(); ++o) {
+    const Object& obj = scene.objects[o];
+    const Mesh& mesh = scene.meshes[obj.mesh];
+    if (mesh.triangles.empty()) continue;
+    if (obj.IsDynamic()) {
+      if (!d.mesh_scenes[obj.mesh]) {
+        RTCScene ms = rtcNewScene(d.device);
+        rtcSetSceneBuildQuality(ms, RTC_BUILD_QUALITY_HIGH);
+        RTCGeometry g = d.MakeTriangles(mesh, nullptr, RTC_BUILD_QUALITY_HIGH);
+        rtcAttachGeometry(ms, g);
+        rtcReleaseGeometry(g);
+        rtcCommitScene(ms);
+        d.mesh_scenes[obj.mesh] = ms;
+      }
+      d.dynamic_objects.push_back(static_cast<int>(o));
+      continue;
+    }
+    RTCGeometry g = d.MakeTriangles(mesh, &obj.world_from_object, RTC_BUILD_QUALITY_HIGH);
+    const unsigned id = rtcAttachGeometry(d.static_scene, g);
+    rtcReleaseGeometry(g);
+    if (d.static_geom_object.size() <= id) d.static_geom_object.resize(id + 1, -1);
+    d.static_geom_object[id] = static_cast<int>(o);
+    num_static_triangles_ += mesh.triangles.size();
+  }
+  rtcCommitScene(d.static_scene);
+  static_build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  d.CheckDevice("building the static scene");
+
+  d.top = rtcNewScene(d.device);
+  rtcSetSceneFlags(d.top, RTC_SCENE_FLAG_DYNAMIC);
+  rtcSetSceneBuildQuality(d.top, RTC_BUILD_QUALITY_LOW);
+  {
+    RTCGeometry inst = rtcNewGeometry(d.device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(inst, d.static_scene);
+    const float identity[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, identity);
+    rtcCommitGeometry(inst);
+    d.static_instance_id = rtcAttachGeometry(d.top, inst);
+    rtcReleaseGeometry(inst);
+    d.top_instance_object.resize(d.static_instance_id + 1, -1);
+  }
+  for (int o : d.dynamic_objects) {
+    RTCGeometry inst = rtcNewGeometry(d.device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(inst, d.mesh_scenes[scene.objects[o].mesh]);
+    const unsigned id = rtcAttachGeometry(d.top, inst);
+    if (d.top_instance_object.size() <= id) d.top_instance_object.resize(id + 1, -1);
+    d.top_instance_object[id] = o;
+    d.dynamic_instances.push_back(inst);  // the top scene holds a reference; kept for updates
+    rtcReleaseGeometry(inst);
+  }
+
+  // Lighting constants.
+  const Lighting& light = scene.lighting;
+  const Eigen::Vector3d s = light.direction_to_sun.norm() > 0 ? light.direction_to_sun.normalized()
+                                                              : Eigen::Vector3d::UnitZ();
+  d.sun_dir = s.cast<float>();
+  const Eigen::Vector3f helper = std::abs(d.sun_dir.z()) < 0.9f ? Eigen::Vector3f::UnitZ() : Eigen::Vector3f::UnitX();
+  d.sun_e1 = d.sun_dir.cross(helper).normalized();
+  d.sun_e2 = d.sun_dir.cross(d.sun_e1);
+  d.sun_disc_radius = static_cast<float>(std::tan(0.5 * light.sun_angular_diameter_deg * M_PI / 180.0));
+  d.sky_mean = 0.5f * (light.sky_zenith + light.sky_horizon);
+  d.ground_irradiance =
+      light.ground_albedo.cwiseProduct(light.sun_radiance * std::max(0.0f, d.sun_dir.z()) * kInvPi + d.sky_mean);
+
+  SetFrame(0);
+}
+
+Tracer::~Tracer() = default;
+
+void Tracer::SetFrame(int frame) {
+  Impl& d = *impl_;
+  for (size_t k = 0; k < d.dynamic_objects.size(); ++k) {
+    const Object& obj = d.scene.objects[d.dynamic_objects[k]];
+    if (frame < 0 || frame >= static_cast<int>(obj.world_from_object_per_frame.size()))
+      throw std::out_of_range("object '" + obj.name + "': no transform for frame " + std::to_string(frame) + " (has " +
+                              std::to_string(obj.world_from_object_per_frame.size()) + ")");
+    const Rigid3& world_from_object = obj.world_from_object_per_frame[frame];
+    const Eigen::Matrix<double, 3, 4> m = world_from_object.Matrix3x4();
+    float xfm[12];
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 3; ++r) xfm[3 * c + r] = static_cast<float>(m(r, c));
+    rtcSetGeometryTransform(d.dynamic_instances[k], 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+    rtcCommitGeometry(d.dynamic_instances[k]);
+    d.object_rotation[d.dynamic_objects[k]] = world_from_object.RotationMatrix().cast<float>();
+  }
+  rtcCommitScene(d.top);
+  d.CheckDevice("committing the top-level scene");
+}
+
+namespace {
+
+struct alignas(64) TileBuffers {
+  RTCRayHit rayhit[kTilePixels];
+  RTCRay shadow[kTilePixels];
+  int pixel[kTilePixels];        // tile-local pixel index of each ray
+  int shadow_ray[kTilePixels];   // primary ray index of each shadow ray
+  Eigen::Vector3f direct[kTilePixels];   // albedo * E_sun * cos / pi of each shadow ray
+  Eigen::Vector3f sum[kTilePixels];      // linear radiance sums per pixel
+  int count[kTilePixels];
+};
+
+void InitRay(RTCRayHit* rh, const Eigen::Vector3f& origin, const Eigen::Vector3f& dir) {
+  rh->ray.org_x = origin.x();
+  rh->ray.org_y = origin.y();
+  rh->ray.org_z = origin.z();
+  rh->ray.tnear = 0.0f;
+  rh->ray.dir_x = dir.x();
+  rh->ray.dir_y = dir.y();
+  rh->ray.dir_z = dir.z();
+  rh->ray.time = 0.0f;
+  rh->ray.tfar = std::numeric_limits<float>::infinity();
+  rh->ray.mask = 0xffffffffu;
+  rh->ray.id = 0;
+  rh->ray.flags = 0;
+  rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
+}  // namespace
+
+void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const ShadeSettings& settings,
+                    CameraImage* image) const {
+  const Impl& d = *impl_;
+  const Scene& scene = d.scene;
+  const int width = rays.width, height = rays.height;
+  const size_t num_pixels = static_cast<size_t>(width) * height;
+  if (!settings.raw_cast_only) {
+    image->width = width;
+    image->height = height;
+    image->rgb.assign(num_pixels * 3, 0);
+    if (settings.want_depth) image->depth.assign(num_pixels, 0.0f);
+    else image->depth.clear();
+    if (settings.want_mask) image->mask.assign(num_pixels, 0);
+    else image->mask.clear();
+  }
+  const Eigen::Matrix3f world_from_cam_rot = world_from_cam.RotationMatrix().cast<float>();
+  const Eigen::Vector3f origin = ToF(world_from_cam.translation);
+  const int spp = std::max(1, settings.spp);
+  const float inv_sqrt_spp = 1.0f / std::sqrt(static_cast<float>(spp));
+  const Lighting& light = scene.lighting;
+  const auto& srgb = SrgbTable();
+  const float theta_max = static_cast<float>(0.5 * rays.camera.max_fov_deg * M_PI / 180.0);
+
+  const int tiles_x = (width + kTile - 1) / kTile;
+  const int tiles_y = (height + kTile - 1) / kTile;
+
+  auto sky = [&](const Eigen::Vector3f& dir) -> Eigen::Vector3f {
+    if (dir.z() >= 0.0f) return light.sky_horizon + std::sqrt(dir.z()) * (light.sky_zenith - light.sky_horizon);
+    return light.ground_albedo.cwiseProduct(light.sky_horizon);
+  };
+
+  // Trace the primary rays in tb.rayhit[0, n); returns nothing, hits in place.
+  auto render_tile = [&](int tile, TileBuffers& tb) {
+    const int tx0 = (tile % tiles_x) * kTile;
+    const int ty0 = (tile / tiles_x) * kTile;
+    const int tw = std::min(kTile, width - tx0);
+    const int th = std::min(kTile, height - ty0);
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    for (int i = 0; i < kTilePixels; ++i) {
+      tb.sum[i].setZero();
+      tb.count[i] = 0;
+    }
+
+    // Pixel-centre pass for depth and masks (shared with the only sample when spp == 1).
+    const bool centre_pass = settings.want_depth || settings.want_mask;
+    for (int s = (centre_pass && spp > 1) ? -1 : 0; s < spp; ++s) {
+      const bool is_centre = s < 0 || spp == 1;
+      int n = 0;
+      for (int ly = 0; ly < th; ++ly) {
+        for (int lx = 0; lx < tw; ++lx) {
+          const int x = tx0 + lx, y = ty0 + ly;
+          const size_t pi = static_cast<size_t>(y) * width + x;
+          if (!rays.valid[pi]) continue;
+          Eigen::Vector3f bearing;
+          if (is_centre) {
+            bearing = rays.bearing[pi];
+          } else {
+            const uint64_t h = Mix64(pi * 0x632be59bd9b4e019ull + 1);
+            const float jx = Wrap01((s + 0.5f) / spp + UnitFloat(h));
+            const float jy = Wrap01(RadicalInverse2(static_cast<uint32_t>(s)) + UnitFloat(Mix64(h)));
+            if (!rays.SampleBearing(x + jx - 0.5f, y + jy - 0.5f, &bearing)) continue;
+          }
+          InitRay(&tb.rayhit[n], origin, world_from_cam_rot * bearing);
+          tb.pixel[n] = ly * kTile + lx;
+          ++n;
+        }
+      }
+      if (n == 0) continue;
+      rtcIntersect1M(d.top, &context, tb.rayhit, static_cast<unsigned>(n), sizeof(RTCRayHit));
+
+      if (is_centre && !settings.raw_cast_only && centre_pass) {
+        for (int r = 0; r < n; ++r) {
+          const RTCRayHit& rh = tb.rayhit[r];
+          const size_t pi = static_cast<size_t>(ty0 + tb.pixel[r] / kTile) * width + tx0 + tb.pixel[r] % kTile;
+          if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+          if (settings.want_depth) image->depth[pi] = rh.ray.tfar;
+          if (settings.want_mask) {
+            const int inst = static_cast<int>(rh.hit.instID[0]);
+            const int obj = d.top_instance_object[inst] >= 0 ? d.top_instance_object[inst]
+                                                             : d.static_geom_object[rh.hit.geomID];
+            image->mask[pi] = scene.objects[obj].id;
+          }
+        }
+      }
+      if (s < 0) continue;  // the extra centre pass only feeds depth and masks
+
+      // Shade the hits and set up shadow rays.
+      int num_shadow = 0;
+      for (int r = 0; r < n; ++r) {
+        RTCRayHit& rh = tb.rayhit[r];
+        const Eigen::Vector3f dir(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
+        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+          if (!settings.raw_cast_only) {
+            tb.sum[tb.pixel[r]] += sky(dir);
+            ++tb.count[tb.pixel[r]];
+          }
+          continue;
+        }
+        const float t = rh.ray.tfar;
+        const Eigen::Vector3f hit_point = origin + t * dir;
+        if (settings.raw_cast_only) {
+          // Same shadow rays as the full render, without any shading work.
+          if (!settings.shadows) continue;
+          RTCRay& sr = tb.shadow[num_shadow++];
+          sr.org_x = hit_point.x() + 1e-3f * rh.hit.Ng_x;
+          sr.org_y = hit_point.y() + 1e-3f * rh.hit.Ng_y;
+          sr.org_z = hit_point.z() + 1e-3f * rh.hit.Ng_z;
+          sr.dir_x = d.sun_dir.x();
+          sr.dir_y = d.sun_dir.y();
+          sr.dir_z = d.sun_dir.z();
+          sr.tnear = 1e-3f;
+          sr.tfar = std::numeric_limits<float>::infinity();
+          sr.mask = 0xffffffffu;
+          sr.time = 0.0f;
+          sr.id = 0;
+          sr.flags = 0;
+          continue;
+        }
+        const int inst = static_cast<int>(rh.hit.instID[0]);
+        const int obj_index = d.top_instance_object[inst] >= 0 ? d.top_instance_object[inst]
+                                                               : d.static_geom_object[rh.hit.geomID];
+        const Object& obj = scene.objects[obj_index];
+        const Mesh& mesh = scene.meshes[obj.mesh];
+        const unsigned prim = rh.hit.primID;
+        Eigen::Vector3f normal = d.object_rotation[obj_index] * Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+        const float nlen = normal.norm();
+        normal = nlen > 0.0f ? Eigen::Vector3f(normal / nlen) : Eigen::Vector3f(-dir);
+        if (normal.dot(dir) > 0.0f) normal = -normal;
+        const float cos_view = std::max(-normal.dot(dir), 0.1f);
+
+        const int mat_index = mesh.triangle_materials.empty() ? mesh.material : mesh.triangle_materials[prim];
+        const Material& mat = scene.materials[mat_index];
+        Eigen::Vector3f albedo = mat.base_color;
+        if (settings.textures && mat.texture >= 0 && !mesh.uvs.empty()) {
+          const Eigen::Vector3i& tri = mesh.triangles[prim];
+          const float bu = rh.hit.u, bv = rh.hit.v;
+          const Eigen::Vector2f uv = (1.0f - bu - bv) * mesh.uvs[tri[0]] + bu * mesh.uvs[tri[1]] + bv * mesh.uvs[tri[2]];
+          const MipTexture& tex = d.textures[mat.texture];
+          const size_t pi = static_cast<size_t>(ty0 + tb.pixel[r] / kTile) * width + tx0 + tb.pixel[r] % kTile;
+          const float footprint_m = t * rays.pixel_angle[pi] / cos_view * inv_sqrt_spp;
+          const float texels = footprint_m * d.mesh_uv_scale[obj.mesh][prim] * tex.TexelsPerUv();
+          const float lod = texels > 0.0f ? std::log2(texels) + settings.lod_bias : 0.0f;
+          albedo = albedo.cwiseProduct(tex.Sample(uv.x(), uv.y(), lod));
+        }
+        // Ambient: hemisphere mix of sky and ground by the normal's elevation.
+        const float up = 0.5f * (1.0f + normal.z());
+        const Eigen::Vector3f ambient =
+            light.ambient * (d.ground_irradiance + up * (d.sky_mean - d.ground_irradiance));
+        tb.sum[tb.pixel[r]] += albedo.cwiseProduct(ambient);
+        ++tb.count[tb.pixel[r]];
+
+        Eigen::Vector3f to_sun = d.sun_dir;
+        if (settings.soft_shadows && d.sun_disc_radius > 0.0f && spp > 1) {
+          const size_t pi = static_cast<size_t>(ty0 + tb.pixel[r] / kTile) * width + tx0 + tb.pixel[r] % kTile;
+          const uint64_t h = Mix64(pi * 0x9e3779b97f4a7c15ull + 7);
+          const float a = Wrap01(RadicalInverse2(static_cast<uint32_t>(s) * 2654435761u) + UnitFloat(h));
+          const float b = Wrap01((s + 0.5f) / spp + UnitFloat(Mix64(h)));
+          const float radius = d.sun_disc_radius * std::sqrt(a);
+          const float phi = 6.2831853f * b;
+          to_sun = (d.sun_dir + radius * (std::cos(phi) * d.sun_e1 + std::sin(phi) * d.sun_e2)).normalized();
+        }
+        const float cos_sun = normal.dot(to_sun);
+        if (cos_sun <= 0.0f) continue;
+        const Eigen::Vector3f direct = albedo.cwiseProduct(light.sun_radiance) * (cos_sun * kInvPi);
+        if (!settings.shadows) {
+          tb.sum[tb.pixel[r]] += direct;
+          continue;
+        }
+        const float offset = 1e-4f * (1.0f + t);
+        const Eigen::Vector3f shadow_origin = hit_point + offset * normal;
+        RTCRay& sr = tb.shadow[num_shadow];
+        sr.org_x = shadow_origin.x();
+        sr.org_y = shadow_origin.y();
+        sr.org_z = shadow_origin.z();
+        sr.dir_x = to_sun.x();
+        sr.dir_y = to_sun.y();
+        sr.dir_z = to_sun.z();
+        sr.tnear = offset;
+        sr.tfar = std::numeric_limits<float>::infinity();
+        sr.mask = 0xffffffffu;
+        sr.time = 0.0f;
+        sr.id = 0;
+        sr.flags = 0;
+        tb.shadow_ray[num_shadow] = r;
+        tb.direct[num_shadow] = direct;
+        ++num_shadow;
+      }
+      if (num_shadow == 0) continue;
+      rtcOccluded1M(d.top, &context, tb.shadow, static_cast<unsigned>(num_shadow), sizeof(RTCRay));
+      if (settings.raw_cast_only) continue;
+      for (int k = 0; k < num_shadow; ++k) {
+        // Embree sets tfar to -inf for occluded rays.
+        if (tb.shadow[k].tfar >= 0.0f) tb.sum[tb.pixel[tb.shadow_ray[k]]] += tb.direct[k];
+      }
+    }
+    if (settings.raw_cast_only) return;
+
+    // Resolve: box filter, exposure, optional vignetting and noise, sRGB.
+    for (int ly = 0; ly < th; ++ly) {
+      for (int lx = 0; lx < tw; ++lx) {
+        const int local = ly * kTile + lx;
+        if (tb.count[local] == 0) continue;
+        const size_t pi = static_cast<size_t>(ty0 + ly) * width + tx0 + lx;
+        float gain = light.exposure / static_cast<float>(tb.count[local]);
+        if (settings.vignetting > 0.0f) {
+          const Eigen::Vector3f& b = rays.bearing[pi];
+          const float theta = std::atan2(std::hypot(b.x(), b.y()), b.z());
+          const float rel = theta / theta_max;
+          gain *= std::max(0.0f, 1.0f - settings.vignetting * rel * rel);
+        }
+        const Eigen::Vector3f c = tb.sum[local] * gain;
+        for (int k = 0; k < 3; ++k) {
+          uint8_t value = EncodeSrgb(c[k], srgb);
+          if (settings.noise_sigma > 0.0f) {
+            // Box-Muller from two hashed uniforms: deterministic per (seed, pixel, channel).
+            const uint64_t h = Mix64(settings.noise_seed ^ Mix64(pi * 3 + k));
+            const float u1 = std::max(UnitFloat(h), 1e-7f);
+            const float u2 = UnitFloat(Mix64(h));
+            const float g = std::sqrt(-2.0f * std::log(u1)) * std::cos(6.2831853f * u2);
+            value = static_cast<uint8_t>(std::clamp(std::lround(value + settings.noise_sigma * g), 0L, 255L));
+          }
+          image->rgb[pi * 3 + k] = value;
+        }
+      }
+    }
+  };
+
+  const int num_tiles = tiles_x * tiles_y;
+  tbb::parallel_for(tbb::blocked_range<int>(0, num_tiles, 16), [&](const tbb::blocked_range<int>& range) {
+    SetFlushDenormals();
+    thread_local std::unique_ptr<TileBuffers> buffers;
+    if (!buffers) buffers = std::make_unique<TileBuffers>();
+    for (int tile = range.begin(); tile < range.end(); ++tile) render_tile(tile, *buffers);
+  });
+}
+
+}  // namespace rovo

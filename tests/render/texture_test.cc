@@ -1,0 +1,99 @@
+#include "render/texture.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace rovo {
+namespace {
+
+Texture Gradient(int width, int height) {
+  Texture tex;
+  tex.name = "gradient";
+  tex.width = width;
+  tex.height = height;
+  tex.rgb.resize(static_cast<size_t>(width) * height * 3);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      tex.rgb[(y * width + x) * 3 + 0] = static_cast<uint8_t>((x * 37 + y * 11) % 256);
+      tex.rgb[(y * width + x) * 3 + 1] = static_cast<uint8_t>((x * 5 + y * 71) % 256);
+      tex.rgb[(y * width + x) * 3 + 2] = static_cast<uint8_t>(x == y ? 255 : 0);
+    }
+  return tex;
+}
+
+TEST(SrgbTest, RoundTripsAndKnownValues) {
+  EXPECT_NEAR(SrgbToLinear(1.0f), 1.0f, 1e-6f);
+  EXPECT_NEAR(SrgbToLinear(0.5f), 0.21404f, 1e-4f);
+  for (int i = 0; i <= 255; ++i) {
+    const float s = i / 255.0f;
+    EXPECT_NEAR(LinearToSrgb(SrgbToLinear(s)), s, 1e-5f) << i;
+  }
+  EXPECT_EQ(LinearToSrgb(-1.0f), 0.0f);
+  EXPECT_NEAR(LinearToSrgb(2.0f), 1.0f, 1e-6f);
+}
+
+TEST(MipTextureTest, PyramidSizesAndBoxFilterPreservesMean) {
+  const Texture tex = Gradient(16, 8);
+  const MipTexture mip(tex);
+  ASSERT_EQ(mip.NumLevels(), 5);  // 16x8, 8x4, 4x2, 2x1, 1x1
+  EXPECT_EQ(mip.Width(1), 8);
+  EXPECT_EQ(mip.Height(1), 4);
+  EXPECT_EQ(mip.Width(4), 1);
+  EXPECT_EQ(mip.Height(4), 1);
+  EXPECT_FLOAT_EQ(mip.TexelsPerUv(), std::sqrt(128.0f));
+  // Power-of-two sizes: every level has the same mean as level 0.
+  Eigen::Vector3f mean0 = Eigen::Vector3f::Zero();
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 16; ++x) mean0 += mip.Texel(0, x, y);
+  mean0 /= 128.0f;
+  EXPECT_LT((mip.Texel(4, 0, 0) - mean0).norm(), 1e-5f);
+  // One level-1 texel is the mean of its 2x2 parents.
+  const Eigen::Vector3f expected =
+      0.25f * (mip.Texel(0, 2, 4) + mip.Texel(0, 3, 4) + mip.Texel(0, 2, 5) + mip.Texel(0, 3, 5));
+  EXPECT_LT((mip.Texel(1, 1, 2) - expected).norm(), 1e-6f);
+  // Level 0 holds the decoded sRGB values.
+  EXPECT_NEAR(mip.Texel(0, 3, 3).z(), 1.0f, 1e-6f);
+  EXPECT_NEAR(mip.Texel(0, 3, 2).z(), 0.0f, 1e-6f);
+}
+
+TEST(MipTextureTest, BilinearHitsTexelCentresInterpolatesAndWraps) {
+  const MipTexture mip(Gradient(8, 8));
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) {
+      const float u = (x + 0.5f) / 8.0f, v = (y + 0.5f) / 8.0f;
+      EXPECT_LT((mip.SampleLevel(u, v, 0) - mip.Texel(0, x, y)).norm(), 1e-5f);
+      // Repeat wrapping: shifted by whole periods (also negative).
+      EXPECT_LT((mip.SampleLevel(u + 3.0f, v - 2.0f, 0) - mip.Texel(0, x, y)).norm(), 1e-4f);
+    }
+  // Half-way between two texel centres: their mean.
+  const Eigen::Vector3f mid = mip.SampleLevel(2.0f / 8.0f, 0.5f / 8.0f, 0);
+  EXPECT_LT((mid - 0.5f * (mip.Texel(0, 1, 0) + mip.Texel(0, 2, 0))).norm(), 1e-5f);
+  // Across the wrap seam: between the last and the first column.
+  const Eigen::Vector3f seam = mip.SampleLevel(0.0f, 0.5f / 8.0f, 0);
+  EXPECT_LT((seam - 0.5f * (mip.Texel(0, 7, 0) + mip.Texel(0, 0, 0))).norm(), 1e-5f);
+}
+
+TEST(MipTextureTest, TrilinearBlendsLevelsAndClamps) {
+  const MipTexture mip(Gradient(8, 8));
+  const float u = 0.3f, v = 0.6f;
+  const Eigen::Vector3f l1 = mip.SampleLevel(u, v, 1), l2 = mip.SampleLevel(u, v, 2);
+  EXPECT_LT((mip.Sample(u, v, 1.25f) - (0.75f * l1 + 0.25f * l2)).norm(), 1e-5f);
+  EXPECT_LT((mip.Sample(u, v, -3.0f) - mip.SampleLevel(u, v, 0)).norm(), 1e-6f);
+  EXPECT_LT((mip.Sample(u, v, 100.0f) - mip.Texel(3, 0, 0)).norm(), 1e-6f);
+  EXPECT_LT((mip.Sample(u, v, std::nanf("")) - mip.SampleLevel(u, v, 0)).norm(), 1e-6f);
+}
+
+TEST(MipTextureTest, RejectsInconsistentSize) {
+  Texture tex = Gradient(4, 4);
+  tex.rgb.pop_back();
+  try {
+    MipTexture mip(tex);
+    FAIL() << "expected an exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("gradient"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace rovo
