@@ -55,8 +55,10 @@ struct EquidistantModel {
     const T r_xy2 = point_in_cam[0] * point_in_cam[0] + point_in_cam[1] * point_in_cam[1];
     if (r_xy2 == T(0)) {
       if (!(point_in_cam[2] > T(0))) return false;  // the origin or straight behind
-      uv[0] = params[2];
-      uv[1] = params[3];
+      // On the axis r(theta) = theta + O(theta^3) and theta = |(x, y)| / z + ...: the first-order
+      // expansion has the exact value (the centre) and the right derivatives for Jets.
+      uv[0] = params[0] * point_in_cam[0] / point_in_cam[2] + params[2];
+      uv[1] = params[1] * point_in_cam[1] / point_in_cam[2] + params[3];
       return true;
     }
     const T r_xy = sqrt(r_xy2);
@@ -207,6 +209,16 @@ struct OcamModel {
     return rho;
   }
 
+  // d rho / d theta.
+  template <typename T>
+  static T InversePolyDerivative(const T* params, int num_params, const T& theta) {
+    T derivative = T(0);
+    for (int i = num_params - 1; i > kNumFixedParams; --i) {
+      derivative = derivative * theta + T(i - kNumFixedParams) * params[i];
+    }
+    return derivative;
+  }
+
   template <typename T>
   static bool ImgFromCam(const T* params, int num_params, const T* point_in_cam, T* uv) {
     using namespace camera_internal;
@@ -214,8 +226,13 @@ struct OcamModel {
     const T r2 = point_in_cam[0] * point_in_cam[0] + point_in_cam[1] * point_in_cam[1];
     if (r2 == T(0)) {
       if (!(point_in_cam[2] > T(0))) return false;  // the origin or straight behind
-      uv[0] = params[0];
-      uv[1] = params[1];
+      // On the axis rho = rho'(-pi/2) |(x, y)| / z + ... (rho(-pi/2) = 0 for a fitted inverse): the
+      // first-order expansion has the exact value (the centre) and the right derivatives for Jets.
+      const T slope = InversePolyDerivative(params, num_params, T(-M_PI / 2)) / point_in_cam[2];
+      const T x = slope * point_in_cam[0];
+      const T y = slope * point_in_cam[1];
+      uv[0] = params[2] * x + params[3] * y + params[0];
+      uv[1] = params[4] * x + y + params[1];
       return true;
     }
     const T r = sqrt(r2);

@@ -146,8 +146,9 @@ void InverseErrors(const ErrorGrid& grid, const std::vector<double>& b, double* 
 }
 
 // Chebyshev coefficients on s in [-1, 1], s = alpha theta + beta, to monomial coefficients in theta.
+// The polynomial is (1 + s) sum c_k T_k(s), one degree higher than the Chebyshev series.
 std::vector<double> ChebyshevToMonomial(const Eigen::VectorXd& chebyshev, double alpha, double beta) {
-  const int n = static_cast<int>(chebyshev.size());
+  const int n = static_cast<int>(chebyshev.size()) + 1;
   using Poly = std::vector<long double>;
   // Monomial coefficients (in s) of sum c_k T_k(s), T_{k+1} = 2 s T_k - T_{k-1}.
   std::vector<Poly> chebyshev_basis(n, Poly(n, 0.0L));
@@ -158,9 +159,10 @@ std::vector<double> ChebyshevToMonomial(const Eigen::VectorXd& chebyshev, double
     for (int j = 0; j < n; ++j) chebyshev_basis[k][j] -= chebyshev_basis[k - 2][j];
   }
   Poly in_s(n, 0.0L);
-  for (int k = 0; k < n; ++k) {
+  for (int k = 0; k < chebyshev.size(); ++k) {
     for (int j = 0; j < n; ++j) in_s[j] += static_cast<long double>(chebyshev[k]) * chebyshev_basis[k][j];
   }
+  for (int j = n - 1; j >= 1; --j) in_s[j] += in_s[j - 1];  // times (1 + s)
   // Substitute s = alpha theta + beta: sum_k in_s[k] (beta + alpha theta)^k.
   Poly in_theta(n, 0.0L), power(n, 0.0L);
   power[0] = 1.0L;
@@ -222,11 +224,15 @@ OcamInverseFit FitOcamInversePolynomial(const std::vector<double>& params, doubl
   best.max_error_px = std::numeric_limits<double>::infinity();
   best.rms_error_px = std::numeric_limits<double>::infinity();
   for (int degree = 3; degree <= std::max(3, max_degree); ++degree) {
-    Eigen::MatrixXd basis(kFitSamples, degree + 1);
+    // rho(theta) = (1 + s) sum_{k < degree} c_k T_k(s): the factor makes rho vanish on the axis
+    // (s = -1) exactly, so the projection has no hole at the image centre.
+    Eigen::MatrixXd basis(kFitSamples, degree);
     for (int j = 0; j < kFitSamples; ++j) {
-      basis(j, 0) = 1.0;
-      basis(j, 1) = s[j];
-      for (int k = 2; k <= degree; ++k) basis(j, k) = 2.0 * s[j] * basis(j, k - 1) - basis(j, k - 2);
+      Eigen::VectorXd chebyshev_row(degree);
+      chebyshev_row[0] = 1.0;
+      if (degree > 1) chebyshev_row[1] = s[j];
+      for (int k = 2; k < degree; ++k) chebyshev_row[k] = 2.0 * s[j] * chebyshev_row[k - 1] - chebyshev_row[k - 2];
+      basis.row(j) = (1.0 + s[j]) * chebyshev_row.transpose();
     }
     const Eigen::VectorXd chebyshev = basis.colPivHouseholderQr().solve(rho);
     OcamInverseFit fit;

@@ -30,7 +30,7 @@ struct OcamInverseFit {
 // Least-squares fit of rho(theta) to the forward model over theta in [-pi/2, theta_edge + 2 deg]
 // (or up to where the forward model stays monotonic, if that is less), in a Chebyshev basis on the
 // interval mapped to [-1, 1] (solved with Eigen's ColPivHouseholderQR) and converted to monomials
-// in theta. The degree increases from 3 until max_error_px < tolerance_px; returns the first fit
+// in theta. The basis is (theta + pi/2) T_k, so rho(-pi/2) = 0: the axis maps to the centre. The degree increases from 3 until max_error_px < tolerance_px; returns the first fit
 // that meets it, else the one with the smallest max error up to max_degree (check max_error_px).
 // `params`: at least the first 10 values (cx .. a4); any inverse coefficients are ignored.
 // Throws std::invalid_argument when a0 >= 0, the affine is singular, max_fov_deg is not in

@@ -144,6 +144,21 @@ TEST(Camera, JacobianMatchesNumericDifferentiation) {
     }
     EXPECT_LT(worst, 1e-6);
     EXPECT_GT(checked, 500);
+    // On the optical axis (a coordinate singularity of the radial models) the Jacobian is the
+    // limit of its neighbours' and matches central differences.
+    const Eigen::Vector3d on_axis(0, 0, 2);
+    Eigen::Matrix<double, 2, 3> J_axis, J_near;
+    ASSERT_TRUE(camera.Project(on_axis, &J_axis));
+    ASSERT_TRUE(camera.Project(2.0 * Direction(1e-3, 30), &J_near));
+    EXPECT_LT((J_axis - J_near).norm() / J_near.norm(), 1e-4) << J_axis << "\n" << J_near;
+    Eigen::Matrix<double, 2, 3> numeric_axis;
+    for (int axis = 0; axis < 3; ++axis) {
+      Eigen::Vector3d plus = on_axis, minus = on_axis;
+      plus[axis] += 1e-6;
+      minus[axis] -= 1e-6;
+      numeric_axis.col(axis) = (*camera.Project(plus) - *camera.Project(minus)) / 2e-6;
+    }
+    EXPECT_LT((J_axis - numeric_axis).norm() / numeric_axis.norm(), 1e-6) << J_axis << "\n" << numeric_axis;
     // The Jacobian is orthogonal to the viewing ray: moving along it does not move the pixel.
     const Eigen::Vector3d point = 2.0 * Direction(100, 70);
     Eigen::Matrix<double, 2, 3> J;

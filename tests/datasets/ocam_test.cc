@@ -84,6 +84,9 @@ TEST(OcamFit, RealRigPolynomialReachesTheTolerance) {
   }
   EXPECT_LT(worst_px, 0.0101);
   EXPECT_GT(worst_px, 0.0);
+  // The optical axis maps to the centre: rho(-pi/2) = 0 up to rounding.
+  EXPECT_LT(std::abs(OcamModel::InversePoly(with_inverse.data(), static_cast<int>(with_inverse.size()), -M_PI / 2)),
+            1e-9);
 }
 
 // A low degree cap cannot reach 0.01 px: the best fit is returned with its (larger) error.
