@@ -103,9 +103,9 @@ struct Tolerances<double> {
 };
 template <>
 struct Tolerances<float> {
-  // float has 24 bits: pixel coordinates near 1500 resolve to ~1e-4 px; polynomial evaluation and
-  // trigonometry lose a few more bits.
-  static double Pixel(const ModelCase& c) { return c.pixel_tol_double + 0.02; }
+  // float has 24 bits: pixel coordinates near 1500 resolve to ~1e-4 px (measured round trips:
+  // 2.3e-4 px worse than double).
+  static double Pixel(const ModelCase& c) { return c.pixel_tol_double + 0.002; }
   static constexpr double kNorm = 1e-5;
 };
 
