@@ -1,8 +1,12 @@
 #pragma once
 // Renders a dataset (datasets/FORMAT.md) from a scene and a rig. Entry point of `rovo render`.
 
+#include "datasets/rig.h"
+#include "scenes/scene.h"
+
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace rovo {
 
@@ -23,6 +27,8 @@ struct RenderOptions {
   bool masks = false;          // write masks/ (16-bit object ids)
   double scale = 0.0;          // image scale; 0 = 1.0, or the preset's quick scale with --quick
   bool quiet = false;          // no progress output
+  float noise_sigma = 0.0f;    // optional Gaussian sensor noise, std. dev. in 8-bit units (0 = off)
+  float vignetting = 0.0f;     // optional vignetting: gain 1 - v * (theta / theta_max)^2 (0 = off)
 };
 
 struct RenderSummary {
@@ -32,6 +38,54 @@ struct RenderSummary {
   double seconds = 0.0;
 };
 
+// Renders the frames of `options` (see RenderOptions) into options.out_dir. Throws
+// std::invalid_argument / std::runtime_error naming the file or option for bad input, before any
+// output is written. Resumable: frames whose files all exist are skipped (files appear only by
+// atomic rename). groundtruth.tum and dataset.json cover the whole frame range and are identical
+// from every shard. Images are identical for any thread count.
 RenderSummary RenderDataset(const RenderOptions& options);
+
+// Samples per pixel when RenderOptions::spp is 0 (chosen by measurement, see render/README.md).
+inline constexpr int kDefaultSpp = 4;
+// Shards take frames in chunks of this many consecutive frames: frame f belongs to shard
+// (f / kShardChunkFrames) % shard_count.
+inline constexpr int kShardChunkFrames = 8;
+// Perturbed extrinsic sets written to dataset.json (sigma 5 deg, seeds derived from --seed).
+inline constexpr int kNumPerturbedSets = 5;
+
+// The scene of a preset (generated) or a scene folder (loaded); exactly one must be non-empty.
+Scene SceneForOptions(const std::string& preset, bool quick, uint64_t seed, const std::string& scene_dir);
+// `rig` is a preset name, a rig.json/dataset.json path, or "" for the scene's preset ("rovo4" if
+// none); `scale` 0 means 1.
+Rig RigForOptions(const std::string& rig, const Scene& scene, double scale);
+// True when every file of dataset frame `frame` exists under its final name.
+bool FrameComplete(const std::string& out_dir, const Rig& rig, int frame, bool depth, bool masks);
+
+// `rovo scene preview`: a contact sheet with one row per frame and one column per camera.
+struct PreviewOptions {
+  std::string scene_dir;
+  std::string preset;          // alternatively a preset (generated, quick form)
+  uint64_t seed = 0;
+  std::vector<int> frames;     // trajectory frames; empty = first, middle and last
+  std::string rig;
+  double scale = 0.25;         // of the rig's image size
+  int spp = 1;
+  int threads = 0;
+  std::string out_png;         // default <scene_dir>/preview.png
+};
+void RenderScenePreview(const PreviewOptions& options);
+
+// `rovo bench render`: prints a table of render speed, raw ray-cast speed and memory.
+struct RenderBenchOptions {
+  std::string preset = "static_urban";
+  std::string scene_dir;       // instead of the preset
+  uint64_t seed = 0;
+  int frames = 3;
+  double scale = 1.0;
+  int threads = 0;
+  int spp = 0;                 // default-quality spp (0 = kDefaultSpp)
+  std::string write_dir;       // if set, also time full dataset writing into this folder
+};
+void RunRenderBenchmark(const RenderBenchOptions& options);
 
 }  // namespace rovo

@@ -1,0 +1,22 @@
+#pragma once
+// Atomic image writers for the render outputs (OpenImageIO writes a temporary sibling with an
+// explicit format, then it is renamed onto the final name, so a killed process never leaves a
+// partial file under the final name).
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace rovo {
+
+// 8-bit RGB PNG (zlib level 1: the DESIGN.md measurement shows higher levels cost more than tracing).
+void WritePngRgb8(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
+// 16-bit single-channel PNG (object ids).
+void WritePngGray16(const std::string& path, int width, int height, const std::vector<uint16_t>& values);
+// float32 single-channel OpenEXR (zip compression).
+void WriteExrFloat(const std::string& path, int width, int height, const std::vector<float>& values);
+
+// Removes `*.tmp.<pid>.<n>` files in `dir` left by processes that no longer run.
+void RemoveStaleTempFiles(const std::string& dir);
+
+}  // namespace rovo

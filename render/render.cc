@@ -1,0 +1,324 @@
+#include "render/render.h"
+
+#include "datasets/dataset.h"
+#include "datasets/io.h"
+#include "datasets/progress.h"
+#include "render/image_io.h"
+#include "render/tracer.h"
+#include "rovo/version.h"
+#include "scenes/city.h"
+
+#include <tbb/task_arena.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <filesystem>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+namespace rovo {
+namespace {
+namespace fs = std::filesystem;
+
+uint64_t SplitMix(uint64_t x) {
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+bool EndsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// One rendered frame on its way to the writer thread.
+struct FrameJob {
+  int dataset_frame = 0;
+  std::vector<CameraImage> images;
+};
+
+// Encodes and writes frames beside the tracer; at most `capacity` frames wait in memory.
+class FrameWriter {
+ public:
+  FrameWriter(const std::string& out_dir, const Rig& rig, bool depth, bool masks, Progress* progress)
+      : out_dir_(out_dir), rig_(rig), depth_(depth), masks_(masks), progress_(progress),
+        thread_([this] { Run(); }) {}
+  // Joins without rethrowing (the error was or will be reported by Push/Close).
+  ~FrameWriter() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      closing_ = true;
+      ready_.notify_one();
+    }
+    if (thread_.joinable()) thread_.join();
+  }
+
+  // Blocks while the queue is full; rethrows a writer error.
+  void Push(FrameJob job) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    space_.wait(lock, [&] { return queue_.size() < kCapacity || error_; });
+    if (error_) std::rethrow_exception(error_);
+    queue_.push_back(std::move(job));
+    ready_.notify_one();
+  }
+
+  // Waits for all pending frames; rethrows a writer error.
+  void Close() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      closing_ = true;
+      ready_.notify_one();
+    }
+    if (thread_.joinable()) thread_.join();
+    if (error_) {
+      std::exception_ptr e = error_;
+      error_ = nullptr;
+      std::rethrow_exception(e);
+    }
+  }
+
+ private:
+  static constexpr size_t kCapacity = 2;
+
+  void Run() {
+    for (;;) {
+      FrameJob job;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        ready_.wait(lock, [&] { return !queue_.empty() || closing_; });
+        if (queue_.empty()) return;
+        job = std::move(queue_.front());
+        queue_.pop_front();
+        space_.notify_one();
+      }
+      try {
+        Write(job);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        error_ = std::current_exception();
+        queue_.clear();
+        space_.notify_all();
+        return;
+      }
+      if (progress_) progress_->Add(1);
+    }
+  }
+
+  // Images last: depth and masks first, so that the frame's files appear together at the end.
+  void Write(const FrameJob& job) {
+    for (int c = 0; c < rig_.NumCameras(); ++c) {
+      const CameraImage& image = job.images[c];
+      const std::string& name = rig_.cameras[c].name;
+      if (depth_) WriteExrFloat(DepthPath(out_dir_, name, job.dataset_frame), image.width, image.height, image.depth);
+      if (masks_) WritePngGray16(MaskPath(out_dir_, name, job.dataset_frame), image.width, image.height, image.mask);
+    }
+    for (int c = 0; c < rig_.NumCameras(); ++c) {
+      const CameraImage& image = job.images[c];
+      WritePngRgb8(ImagePath(out_dir_, rig_.cameras[c].name, job.dataset_frame), image.width, image.height, image.rgb);
+    }
+  }
+
+  std::string out_dir_;
+  Rig rig_;
+  bool depth_, masks_;
+  Progress* progress_;
+  std::mutex mutex_;
+  std::condition_variable ready_, space_;
+  std::deque<FrameJob> queue_;
+  bool closing_ = false;
+  std::exception_ptr error_;
+  std::thread thread_;
+};
+
+// Checks that an existing dataset.json describes the same rendering; throws naming the field.
+void CheckExistingDataset(const std::string& out_dir, const DatasetInfo& info) {
+  if (!fs::exists(DatasetJsonPath(out_dir))) return;
+  const DatasetInfo old = ReadDatasetInfo(out_dir);
+  const std::string file = DatasetJsonPath(out_dir);
+  auto differ = [&](const std::string& field) {
+    throw std::runtime_error(file + ": field '" + field +
+                             "' differs from this render's settings; the folder holds another dataset (use a new --out)");
+  };
+  if (old.scene_hash != info.scene_hash) differ("scene_hash");
+  if (old.frame_count != info.frame_count) differ("frame_count");
+  if (old.seed != info.seed) differ("seed");
+  if (old.has_depth != info.has_depth) differ("has_depth");
+  if (old.has_masks != info.has_masks) differ("has_masks");
+  if (old.rig.NumCameras() != info.rig.NumCameras()) differ("rig/cameras");
+  for (int c = 0; c < info.rig.NumCameras(); ++c) {
+    const Camera& a = old.rig.cameras[c].camera;
+    const Camera& b = info.rig.cameras[c].camera;
+    if (a.width != b.width || a.height != b.height || a.model != b.model) differ("rig/cameras/" + std::to_string(c));
+  }
+}
+
+}  // namespace
+
+Scene SceneForOptions(const std::string& preset, bool quick, uint64_t seed, const std::string& scene_dir) {
+  if (preset.empty() == scene_dir.empty())
+    throw std::invalid_argument("give exactly one of --preset NAME or --scene DIR");
+  if (!preset.empty()) {
+    FindScenePreset(preset);  // throws listing the valid names
+    return GenerateScene(preset, seed, quick);
+  }
+  if (!fs::is_directory(scene_dir)) throw std::runtime_error(scene_dir + ": scene folder does not exist");
+  return LoadScene(scene_dir);
+}
+
+Rig RigForOptions(const std::string& rig, const Scene& scene, double scale) {
+  if (scale < 0.0 || scale > 4.0) throw std::invalid_argument("--scale " + std::to_string(scale) + ": must be in (0, 4]");
+  Rig result;
+  if (rig.empty()) {
+    result = MakeRigPreset(scene.rig_preset.empty() ? "rovo4" : scene.rig_preset);
+  } else if (EndsWith(rig, ".json")) {
+    if (!fs::exists(rig)) throw std::runtime_error(rig + ": rig file does not exist");
+    result = ReadRigJson(rig);
+  } else {
+    result = MakeRigPreset(rig);
+  }
+  if (scale > 0.0 && scale != 1.0) result = result.Scaled(scale);
+  result.Check("rig");
+  return result;
+}
+
+bool FrameComplete(const std::string& out_dir, const Rig& rig, int frame, bool depth, bool masks) {
+  std::error_code ec;
+  for (const RigCamera& cam : rig.cameras) {
+    if (!fs::exists(ImagePath(out_dir, cam.name, frame), ec)) return false;
+    if (depth && !fs::exists(DepthPath(out_dir, cam.name, frame), ec)) return false;
+    if (masks && !fs::exists(MaskPath(out_dir, cam.name, frame), ec)) return false;
+  }
+  return true;
+}
+
+RenderSummary RenderDataset(const RenderOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  // ---- Validate everything before writing anything.
+  if (options.out_dir.empty()) throw std::invalid_argument("--out: an output folder is required");
+  if (options.shard_count < 1 || options.shard_index < 0 || options.shard_index >= options.shard_count)
+    throw std::invalid_argument("--shard " + std::to_string(options.shard_index) + "/" +
+                                std::to_string(options.shard_count) + ": need 0 <= I < N");
+  if (options.spp < 0 || options.spp > 1024) throw std::invalid_argument("--spp: must be in [1, 1024]");
+  if (options.threads < 0) throw std::invalid_argument("--threads: must be >= 0");
+  if (options.noise_sigma < 0.0f || options.vignetting < 0.0f || options.vignetting > 1.0f)
+    throw std::invalid_argument("--noise must be >= 0 and --vignetting in [0, 1]");
+
+  const Scene scene = SceneForOptions(options.preset, options.quick, options.seed, options.scene_dir);
+  const std::string scene_name = options.preset.empty() ? options.scene_dir : "preset " + options.preset;
+  const int num_traj = static_cast<int>(scene.rig_trajectory.size());
+  if (num_traj == 0) throw std::runtime_error(scene_name + ": trajectory: the scene has no rig poses");
+  for (const Object& obj : scene.objects) {
+    if (obj.IsDynamic() && static_cast<int>(obj.world_from_object_per_frame.size()) != num_traj)
+      throw std::runtime_error(scene_name + ": object '" + obj.name + "': " +
+                               std::to_string(obj.world_from_object_per_frame.size()) +
+                               " motion frames for a trajectory of " + std::to_string(num_traj));
+  }
+  double scale = options.scale;
+  if (scale == 0.0) scale = options.quick && !options.preset.empty() ? FindScenePreset(options.preset).quick_scale : 1.0;
+  const Rig rig = RigForOptions(options.rig, scene, scale);
+
+  const int begin = options.frame_begin;
+  const int end = options.frame_end < 0 ? num_traj : options.frame_end;
+  if (begin < 0 || begin >= end || end > num_traj)
+    throw std::out_of_range("--frames " + std::to_string(begin) + ":" + std::to_string(options.frame_end) +
+                            ": outside the trajectory of " + scene_name + " (frames 0:" + std::to_string(num_traj) + ")");
+  const int count = end - begin;
+
+  DatasetInfo info;
+  info.generator = "rovo render";
+  info.generator_version = ROVO_VERSION;
+  info.seed = options.seed;
+  info.preset = options.preset.empty() ? scene.metadata.preset : options.preset;
+  info.scene_hash = SceneHash(scene);
+  info.frame_rate = scene.frame_rate;
+  info.frame_count = count;
+  info.rig = rig;
+  for (int k = 0; k < kNumPerturbedSets; ++k) {
+    info.perturbed.push_back(PerturbExtrinsics(rig, 5.0, 0.0, SplitMix(options.seed * 1000003ull + 17 + k)));
+  }
+  info.has_depth = options.depth;
+  info.has_masks = options.masks;
+  Trajectory groundtruth(scene.rig_trajectory.begin() + begin, scene.rig_trajectory.begin() + end);
+
+  // The build of the tracer validates the scene's indices (before any output).
+  const int spp = options.spp > 0 ? options.spp : kDefaultSpp;
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+  std::unique_ptr<Tracer> tracer;
+  arena.execute([&] { tracer = std::make_unique<Tracer>(scene); });
+
+  // ---- Output folder and the whole-range files (identical from every shard).
+  EnsureWritableDir(options.out_dir);
+  CheckExistingDataset(options.out_dir, info);
+  WriteTum(GroundTruthPath(options.out_dir), groundtruth);
+  WriteDatasetInfo(options.out_dir, info);
+  for (const RigCamera& cam : rig.cameras) {
+    const std::string dir = fs::path(ImagePath(options.out_dir, cam.name, 0)).parent_path().string();
+    EnsureWritableDir(dir);
+    RemoveStaleTempFiles(dir);
+    if (options.depth) {
+      const std::string ddir = fs::path(DepthPath(options.out_dir, cam.name, 0)).parent_path().string();
+      EnsureWritableDir(ddir);
+      RemoveStaleTempFiles(ddir);
+    }
+    if (options.masks) {
+      const std::string mdir = fs::path(MaskPath(options.out_dir, cam.name, 0)).parent_path().string();
+      EnsureWritableDir(mdir);
+      RemoveStaleTempFiles(mdir);
+    }
+  }
+
+  RenderSummary summary;
+  std::vector<int> todo;
+  for (int f = 0; f < count; ++f) {
+    if ((f / kShardChunkFrames) % options.shard_count != options.shard_index) continue;
+    ++summary.frames_total;
+    if (FrameComplete(options.out_dir, rig, f, options.depth, options.masks)) {
+      ++summary.frames_skipped;
+      continue;
+    }
+    todo.push_back(f);
+  }
+
+  std::vector<CameraRays> rays(rig.NumCameras());
+  arena.execute([&] {
+    for (int c = 0; c < rig.NumCameras(); ++c) rays[c] = CameraRays::Make(rig.cameras[c].camera);
+  });
+
+  ShadeSettings settings;
+  settings.spp = spp;
+  settings.want_depth = options.depth;
+  settings.want_mask = options.masks;
+  settings.noise_sigma = options.noise_sigma;
+  settings.vignetting = options.vignetting;
+
+  Progress progress("render " + options.out_dir, static_cast<int64_t>(todo.size()), "frames", options.quiet);
+  {
+    FrameWriter writer(options.out_dir, rig, options.depth, options.masks, &progress);
+    for (int f : todo) {
+      const int traj_frame = begin + f;
+      const Rigid3& world_from_rig = scene.rig_trajectory[traj_frame].world_from_rig;
+      FrameJob job;
+      job.dataset_frame = f;
+      job.images.resize(rig.NumCameras());
+      arena.execute([&] {
+        tracer->SetFrame(traj_frame);
+        for (int c = 0; c < rig.NumCameras(); ++c) {
+          const Rigid3 world_from_cam = world_from_rig * rig.cameras[c].cam_from_rig.Inverse();
+          settings.noise_seed = SplitMix(options.seed ^ SplitMix(static_cast<uint64_t>(traj_frame) * 16 + c));
+          tracer->Render(rays[c], world_from_cam, settings, &job.images[c]);
+        }
+      });
+      writer.Push(std::move(job));
+      ++summary.frames_rendered;
+    }
+    writer.Close();
+  }
+  progress.Finish();
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+}  // namespace rovo

@@ -1,0 +1,199 @@
+// RenderDataset on a small saved box scene: outputs, resume, shards, threads, bad input.
+#include "render/render.h"
+
+#include "datasets/dataset.h"
+#include "datasets/io.h"
+#include "tests/render/box_scene.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <map>
+
+namespace rovo {
+namespace {
+namespace fs = std::filesystem;
+
+class RenderDatasetTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ = fs::temp_directory_path() /
+            ("rovo_render_test_" + std::to_string(::getpid()) + "_" +
+             ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(root_);
+    fs::create_directories(root_);
+    scene_dir_ = (root_ / "scene").string();
+    SaveScene(testing::MakeBoxScene(kFrames, true), scene_dir_);
+  }
+  void TearDown() override { fs::remove_all(root_); }
+
+  RenderOptions Options(const std::string& out) const {
+    RenderOptions options;
+    options.scene_dir = scene_dir_;
+    options.out_dir = (root_ / out).string();
+    options.rig = "omnimvs4";
+    options.scale = 0.1;  // 80x77 per view
+    options.spp = 2;
+    options.quiet = true;
+    return options;
+  }
+
+  // Relative path -> content of every file under dir.
+  static std::map<std::string, std::string> Files(const std::string& dir) {
+    std::map<std::string, std::string> files;
+    for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+      if (entry.is_regular_file()) files[fs::relative(entry.path(), dir).string()] = ReadFile(entry.path().string());
+    }
+    return files;
+  }
+
+  static constexpr int kFrames = 10;
+  fs::path root_;
+  std::string scene_dir_;
+};
+
+TEST_F(RenderDatasetTest, WritesACompleteReadableDataset) {
+  RenderOptions options = Options("out");
+  options.depth = true;
+  options.masks = true;
+  options.seed = 5;
+  const RenderSummary summary = RenderDataset(options);
+  EXPECT_EQ(summary.frames_total, kFrames);
+  EXPECT_EQ(summary.frames_rendered, kFrames);
+  EXPECT_EQ(summary.frames_skipped, 0);
+  const DatasetInfo info = ReadDatasetInfo(options.out_dir);
+  EXPECT_EQ(info.frame_count, kFrames);
+  EXPECT_EQ(info.seed, 5u);
+  EXPECT_EQ(info.rig.NumCameras(), 4);
+  EXPECT_EQ(info.rig.cameras[0].camera.width, 80);
+  EXPECT_TRUE(info.has_depth);
+  EXPECT_TRUE(info.has_masks);
+  ASSERT_GE(info.perturbed.size(), 5u);
+  for (size_t i = 0; i < info.perturbed.size(); ++i) {
+    EXPECT_DOUBLE_EQ(info.perturbed[i].sigma_rotation_deg, 5.0);
+    for (size_t j = 0; j < i; ++j) EXPECT_NE(info.perturbed[i].seed, info.perturbed[j].seed);
+  }
+  EXPECT_FALSE(info.scene_hash.empty());
+  EXPECT_EQ(ReadTum(GroundTruthPath(options.out_dir)).size(), static_cast<size_t>(kFrames));
+  const std::vector<ValidationIssue> issues = ValidateDataset(options.out_dir);
+  for (const ValidationIssue& issue : issues) ADD_FAILURE() << issue.file << " " << issue.field << ": " << issue.message;
+  for (int f = 0; f < kFrames; ++f) EXPECT_TRUE(FrameComplete(options.out_dir, info.rig, f, true, true));
+  // No temporary files left behind.
+  for (const auto& [path, content] : Files(options.out_dir)) EXPECT_EQ(path.find(".tmp."), std::string::npos) << path;
+}
+
+TEST_F(RenderDatasetTest, ResumeSkipsCompleteFramesAndRedoesMissingOnes) {
+  const RenderOptions options = Options("out");
+  RenderDataset(options);
+  const auto before = Files(options.out_dir);
+  fs::remove(ImagePath(options.out_dir, "cam2", 3));
+  const RenderSummary summary = RenderDataset(options);
+  EXPECT_EQ(summary.frames_rendered, 1);
+  EXPECT_EQ(summary.frames_skipped, kFrames - 1);
+  EXPECT_EQ(Files(options.out_dir), before);
+}
+
+TEST_F(RenderDatasetTest, ShardsUnionEqualsFullRunAndWholeRangeFilesMatch) {
+  RenderOptions full = Options("full");
+  full.frame_begin = 1;
+  full.frame_end = 10;  // 9 frames: chunks of 8 -> shard 0 gets 8, shard 1 gets 1
+  RenderDataset(full);
+  RenderOptions shard = full;
+  shard.out_dir = (root_ / "sharded").string();
+  shard.shard_count = 2;
+  shard.shard_index = 1;
+  const RenderSummary s1 = RenderDataset(shard);
+  EXPECT_EQ(s1.frames_rendered, 1);
+  // dataset.json and groundtruth.tum already describe the whole range after one shard.
+  EXPECT_EQ(ReadFile(DatasetJsonPath(shard.out_dir)), ReadFile(DatasetJsonPath(full.out_dir)));
+  EXPECT_EQ(ReadFile(GroundTruthPath(shard.out_dir)), ReadFile(GroundTruthPath(full.out_dir)));
+  shard.shard_index = 0;
+  const RenderSummary s0 = RenderDataset(shard);
+  EXPECT_EQ(s0.frames_rendered, 8);
+  EXPECT_EQ(Files(shard.out_dir), Files(full.out_dir));
+}
+
+TEST_F(RenderDatasetTest, ImagesAreByteIdenticalForOneAndTwoThreads) {
+  RenderOptions one = Options("one");
+  one.threads = 1;
+  one.frame_end = 3;
+  one.masks = true;
+  RenderOptions two = one;
+  two.out_dir = (root_ / "two").string();
+  two.threads = 2;
+  RenderDataset(one);
+  RenderDataset(two);
+  EXPECT_EQ(Files(one.out_dir), Files(two.out_dir));
+}
+
+// Each bad input fails with a message naming the file or option and writes nothing.
+void ExpectFailsNaming(const RenderOptions& options, const std::string& needle) {
+  try {
+    RenderDataset(options);
+    ADD_FAILURE() << "expected an error naming " << needle;
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(options.out_dir)) << "output written despite the error";
+}
+
+TEST_F(RenderDatasetTest, BadInputFailsCleanly) {
+  RenderOptions missing = Options("out_missing");
+  missing.scene_dir = (root_ / "no_such_scene").string();
+  ExpectFailsNaming(missing, "no_such_scene");
+
+  RenderOptions range = Options("out_range");
+  range.frame_begin = 5;
+  range.frame_end = kFrames + 1;
+  ExpectFailsNaming(range, "--frames");
+
+  RenderOptions rig = Options("out_rig");
+  rig.rig = (root_ / "no_rig.json").string();
+  ExpectFailsNaming(rig, "no_rig.json");
+
+  RenderOptions shard = Options("out_shard");
+  shard.shard_index = 2;
+  shard.shard_count = 2;
+  ExpectFailsNaming(shard, "--shard");
+
+  // Unwritable output: a folder below a regular file.
+  WriteFileAtomic((root_ / "plain_file").string(), "x");
+  RenderOptions unwritable = Options("plain_file/out");
+  try {
+    RenderDataset(unwritable);
+    ADD_FAILURE() << "expected an error";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("plain_file"), std::string::npos) << e.what();
+  }
+
+  // Malformed scene.json.
+  const std::string json_path = (fs::path(scene_dir_) / "scene.json").string();
+  const std::string good_json = ReadFile(json_path);
+  WriteFileAtomic(json_path, good_json.substr(0, good_json.size() / 2));
+  ExpectFailsNaming(Options("out_json"), "scene.json");
+  WriteFileAtomic(json_path, good_json);
+
+  // Missing texture file.
+  fs::path texture;
+  for (const auto& entry : fs::recursive_directory_iterator(scene_dir_))
+    if (entry.path().extension() == ".png") texture = entry.path();
+  ASSERT_FALSE(texture.empty());
+  fs::remove(texture);
+  ExpectFailsNaming(Options("out_texture"), texture.filename().string());
+}
+
+TEST_F(RenderDatasetTest, RefusesToMixWithAnotherDataset) {
+  RenderOptions options = Options("out");
+  options.frame_end = 2;
+  RenderDataset(options);
+  options.seed = 123;  // a different seed changes the perturbed extrinsics: another dataset
+  try {
+    RenderDataset(options);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("dataset.json"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace rovo
