@@ -1,0 +1,333 @@
+#include "eval/metrics.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+namespace rovo {
+
+UmeyamaResult AlignUmeyama(const std::vector<Eigen::Vector3d>& src, const std::vector<Eigen::Vector3d>& dst,
+                           bool with_scale) {
+  if (src.size() != dst.size()) {
+    throw std::invalid_argument("AlignUmeyama: point sets differ in size (" + std::to_string(src.size()) + " vs " +
+                                std::to_string(dst.size()) + ")");
+  }
+  const size_t n = src.size();
+  if (n < 3) {
+    throw std::invalid_argument("AlignUmeyama: need at least 3 corresponding points, got " + std::to_string(n));
+  }
+  Eigen::Vector3d mean_src = Eigen::Vector3d::Zero(), mean_dst = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < n; ++i) {
+    mean_src += src[i];
+    mean_dst += dst[i];
+  }
+  mean_src /= static_cast<double>(n);
+  mean_dst /= static_cast<double>(n);
+
+  Eigen::Matrix3d sigma = Eigen::Matrix3d::Zero();      // (1/n) sum y x^T
+  Eigen::Matrix3d cov_src = Eigen::Matrix3d::Zero();    // (1/n) sum x x^T
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d x = src[i] - mean_src;
+    const Eigen::Vector3d y = dst[i] - mean_dst;
+    sigma += y * x.transpose();
+    cov_src += x * x.transpose();
+  }
+  sigma /= static_cast<double>(n);
+  cov_src /= static_cast<double>(n);
+
+  // Degeneracy: the spread of src must span at least a plane. Eigenvalues ascending.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov_src);
+  const Eigen::Vector3d lambda = eig.eigenvalues();
+  const double largest = lambda(2);
+  if (!(largest > 0.0) || lambda(1) <= 1e-12 * largest) {
+    std::ostringstream msg;
+    msg << "AlignUmeyama: degenerate input, the " << n << " source points are "
+        << (largest > 0.0 ? "collinear" : "all at one position")
+        << " (spread eigenvalues " << lambda.transpose()
+        << "); the rotation about their line is undetermined, so the trajectory cannot be aligned";
+    throw std::invalid_argument(msg.str());
+  }
+
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(sigma, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::Matrix3d& u = svd.matrixU();
+  const Eigen::Matrix3d& v = svd.matrixV();
+  Eigen::Vector3d s(1.0, 1.0, 1.0);
+  if (u.determinant() * v.determinant() < 0.0) s(2) = -1.0;  // reflection -> nearest rotation
+
+  UmeyamaResult result;
+  result.rotation = u * s.asDiagonal() * v.transpose();
+  if (with_scale) {
+    const double var_src = cov_src.trace();
+    result.scale = svd.singularValues().dot(s) / var_src;
+  }
+  result.translation = mean_dst - result.scale * result.rotation * mean_src;
+  return result;
+}
+
+Association AssociateByTimestamp(const Trajectory& gt, const Trajectory& estimate, double tolerance_s) {
+  Association out;
+  // For each gt frame the nearest estimate within tolerance (each estimate matches at most its
+  // nearest gt frame).
+  std::map<int, std::pair<int, double>> best;  // gt index -> (estimate index, |dt|)
+  std::vector<bool> used(estimate.size(), false);
+  for (size_t j = 0; j < estimate.size(); ++j) {
+    const double t = estimate[j].timestamp;
+    const auto it = std::lower_bound(gt.begin(), gt.end(), t,
+                                     [](const StampedPose& p, double value) { return p.timestamp < value; });
+    int nearest = -1;
+    double nearest_dt = 0.0;
+    for (auto c : {it, it == gt.begin() ? gt.end() : it - 1}) {
+      if (c == gt.end()) continue;
+      const double dt = std::abs(c->timestamp - t);
+      if (nearest < 0 || dt < nearest_dt) {
+        nearest = static_cast<int>(c - gt.begin());
+        nearest_dt = dt;
+      }
+    }
+    if (nearest < 0 || nearest_dt > tolerance_s) continue;
+    const auto found = best.find(nearest);
+    if (found == best.end() || nearest_dt < found->second.second) best[nearest] = {static_cast<int>(j), nearest_dt};
+  }
+  for (const auto& [gt_index, match] : best) {
+    out.pairs.emplace_back(gt_index, match.first);
+    used[match.first] = true;
+  }
+  for (size_t i = 0, k = 0; i < gt.size(); ++i) {
+    if (k < out.pairs.size() && out.pairs[k].first == static_cast<int>(i)) {
+      ++k;
+    } else {
+      out.gt_without_estimate.push_back(static_cast<int>(i));
+    }
+  }
+  for (size_t j = 0; j < estimate.size(); ++j) {
+    if (!used[j]) out.estimate_without_gt.push_back(static_cast<int>(j));
+  }
+  return out;
+}
+
+double TranslationRmse(const Trajectory& gt, const Trajectory& estimate, const Association& association,
+                       const Rigid3& gt_from_est) {
+  if (association.pairs.empty()) throw std::invalid_argument("TranslationRmse: no associated frames");
+  double sum = 0.0;
+  for (const auto& [i, j] : association.pairs) {
+    const Eigen::Vector3d aligned = gt_from_est * estimate[j].world_from_rig.translation;
+    sum += (gt[i].world_from_rig.translation - aligned).squaredNorm();
+  }
+  return std::sqrt(sum / static_cast<double>(association.pairs.size()));
+}
+
+Rigid3 AlignSe3(const Trajectory& gt, const Trajectory& estimate, const Association& association) {
+  std::vector<Eigen::Vector3d> src, dst;
+  for (const auto& [i, j] : association.pairs) {
+    src.push_back(estimate[j].world_from_rig.translation);
+    dst.push_back(gt[i].world_from_rig.translation);
+  }
+  return AlignUmeyama(src, dst, /*with_scale=*/false).DstFromSrc();
+}
+
+Rigid3 AlignOrigin(const Trajectory& gt, const Trajectory& estimate, const Association& association) {
+  if (association.pairs.empty()) throw std::invalid_argument("AlignOrigin: no associated frames");
+  const auto [i, j] = association.pairs.front();
+  return gt[i].world_from_rig * estimate[j].world_from_rig.Inverse();
+}
+
+DriftResult RelativeDrift(const Trajectory& gt, const Trajectory& estimate, const Association& association,
+                          const std::vector<double>& fractions, int step) {
+  DriftResult result;
+  const size_t n = association.pairs.size();
+  if (n < 2) return result;
+  std::vector<double> distance(n, 0.0);  // gt path distance from the first associated frame
+  for (size_t k = 1; k < n; ++k) {
+    distance[k] = distance[k - 1] + (gt[association.pairs[k].first].world_from_rig.translation -
+                                     gt[association.pairs[k - 1].first].world_from_rig.translation)
+                                        .norm();
+  }
+  const double total = distance.back();
+  if (!(total > 0.0)) return result;
+  for (double f : fractions) result.segment_lengths_m.push_back(f * total);
+
+  double sum_translation = 0.0, sum_rotation = 0.0;
+  for (size_t k = 0; k < n; k += static_cast<size_t>(std::max(step, 1))) {
+    for (double length : result.segment_lengths_m) {
+      const auto it = std::lower_bound(distance.begin() + static_cast<long>(k), distance.end(), distance[k] + length);
+      if (it == distance.end()) continue;
+      const size_t m = static_cast<size_t>(it - distance.begin());
+      const auto [gi, ei] = association.pairs[k];
+      const auto [gj, ej] = association.pairs[m];
+      const Rigid3 gt_motion = gt[gi].world_from_rig.Inverse() * gt[gj].world_from_rig;
+      const Rigid3 est_motion = estimate[ei].world_from_rig.Inverse() * estimate[ej].world_from_rig;
+      const Rigid3 error = gt_motion.Inverse() * est_motion;
+      sum_translation += error.translation.norm() / length;
+      sum_rotation += RotationAngleDeg(error.rotation) / length;
+      ++result.num_segments;
+    }
+  }
+  if (result.num_segments > 0) {
+    result.translation_pct = 100.0 * sum_translation / result.num_segments;
+    result.rotation_deg_per_100m = 100.0 * sum_rotation / result.num_segments;
+  }
+  return result;
+}
+
+std::vector<ExtrinsicError> ExtrinsicErrors(const std::vector<ExtrinsicsRecord>& extrinsics,
+                                            const std::vector<Rigid3>& gt_cam_from_rig) {
+  std::vector<ExtrinsicError> errors;
+  if (gt_cam_from_rig.empty()) return errors;
+  // Group records by frame (records of one frame are contiguous or not; do not assume).
+  std::map<int, std::map<int, const ExtrinsicsRecord*>> by_frame;
+  for (const ExtrinsicsRecord& r : extrinsics) {
+    if (r.camera < 0 || r.camera >= static_cast<int>(gt_cam_from_rig.size())) {
+      throw std::invalid_argument("extrinsics: frame " + std::to_string(r.frame) + " names camera " +
+                                  std::to_string(r.camera) + " but the rig has " +
+                                  std::to_string(gt_cam_from_rig.size()) + " cameras");
+    }
+    by_frame[r.frame][r.camera] = &r;
+  }
+  const Rigid3 gt_rig_from_cam0 = gt_cam_from_rig[0].Inverse();
+  for (const auto& [frame, cameras] : by_frame) {
+    const auto cam0 = cameras.find(0);
+    if (cam0 == cameras.end()) {
+      throw std::invalid_argument("extrinsics: frame " + std::to_string(frame) +
+                                  " has no camera 0 (the reference of relative extrinsics)");
+    }
+    const Rigid3 est_rig_from_cam0 = cam0->second->cam_from_rig.Inverse();
+    for (const auto& [camera, record] : cameras) {
+      if (camera == 0) continue;
+      const Rigid3 est = record->cam_from_rig * est_rig_from_cam0;  // cam_i_from_cam0
+      const Rigid3 gt = gt_cam_from_rig[camera] * gt_rig_from_cam0;
+      ExtrinsicError e;
+      e.frame = frame;
+      e.timestamp = record->timestamp;
+      e.camera = camera;
+      e.rotation_error_deg = RotationDistanceDeg(gt.rotation, est.rotation);
+      e.translation_error_m = (est.translation - gt.translation).norm();
+      e.rpy_est_deg = RollPitchYawDegFromQuaternion(est.rotation);
+      e.rpy_gt_deg = RollPitchYawDegFromQuaternion(gt.rotation);
+      errors.push_back(e);
+    }
+  }
+  return errors;
+}
+
+namespace {
+
+double MedianInterval(const Trajectory& trajectory) {
+  std::vector<double> dt;
+  for (size_t i = 1; i < trajectory.size(); ++i) dt.push_back(trajectory[i].timestamp - trajectory[i - 1].timestamp);
+  if (dt.empty()) return 0.0;
+  std::nth_element(dt.begin(), dt.begin() + static_cast<long>(dt.size() / 2), dt.end());
+  return dt[dt.size() / 2];
+}
+
+double GtPathLength(const Trajectory& gt) {
+  double length = 0.0;
+  for (size_t i = 1; i < gt.size(); ++i) {
+    length += (gt[i].world_from_rig.translation - gt[i - 1].world_from_rig.translation).norm();
+  }
+  return length;
+}
+
+}  // namespace
+
+RunEvaluation EvaluateRun(const Trajectory& gt, const std::vector<Rigid3>& gt_cam_from_rig, const RunData& run,
+                          const std::string& label, const EvalOptions& options) {
+  RunEvaluation out;
+  RunMetrics& m = out.metrics;
+  m.label = label;
+  m.mode = run.info.value("mode", std::string());
+  if (run.info.contains("noise_set") && run.info["noise_set"].is_number_integer()) {
+    m.noise_set = run.info["noise_set"].get<int>();
+  }
+  m.gt_frames = static_cast<int>(gt.size());
+  m.estimated_frames = static_cast<int>(run.trajectory.size());
+  m.path_length_m = GtPathLength(gt);
+
+  double tolerance = options.time_tolerance_s;
+  if (tolerance <= 0.0) {
+    const double interval = MedianInterval(gt);
+    tolerance = interval > 0.0 ? 0.25 * interval : 1e-3;
+  }
+  const Association association = AssociateByTimestamp(gt, run.trajectory, tolerance);
+  m.associated_frames = static_cast<int>(association.pairs.size());
+  m.missing_frames = static_cast<int>(association.gt_without_estimate.size());
+
+  if (!association.pairs.empty()) {
+    const Rigid3 origin = AlignOrigin(gt, run.trajectory, association);
+    m.rmse_origin_m = TranslationRmse(gt, run.trajectory, association, origin);
+    out.gt_from_est = origin;
+    try {
+      out.gt_from_est = AlignSe3(gt, run.trajectory, association);
+      m.rmse_se3_m = TranslationRmse(gt, run.trajectory, association, out.gt_from_est);
+      if (m.path_length_m > 0.0) m.relative_rmse_pct = 100.0 * *m.rmse_se3_m / m.path_length_m;
+    } catch (const std::invalid_argument& e) {
+      m.alignment_note = std::string("SE(3) alignment impossible: ") + e.what() + "; error along path uses origin alignment";
+    }
+    for (const auto& [i, j] : association.pairs) {
+      FrameError fe;
+      fe.gt_index = i;
+      fe.estimate_index = j;
+      fe.timestamp = gt[i].timestamp;
+      fe.gt_position = gt[i].world_from_rig.translation;
+      fe.aligned_position = out.gt_from_est * run.trajectory[j].world_from_rig.translation;
+      fe.error_m = (fe.gt_position - fe.aligned_position).norm();
+      out.frame_errors.push_back(fe);
+    }
+    m.drift = RelativeDrift(gt, run.trajectory, association);
+  } else {
+    m.alignment_note = "no estimated pose matches a ground-truth timestamp";
+  }
+
+  int ok = 0;
+  double inlier_sum = 0.0, reproj_sum = 0.0, time_sum = 0.0;
+  for (const FrameRecord& f : run.frames) {
+    time_sum += f.time_ms;
+    if (f.status == "lost") ++m.lost_frames;
+    if (f.status != "ok") continue;
+    ++ok;
+    inlier_sum += f.inlier_ratio;
+    reproj_sum += f.mean_reproj_error_deg;
+  }
+  if (ok > 0) {
+    m.mean_inlier_ratio = inlier_sum / ok;
+    m.mean_reproj_error_deg = reproj_sum / ok;
+  }
+  if (!run.frames.empty()) m.mean_time_ms = time_sum / static_cast<double>(run.frames.size());
+
+  out.extrinsic_errors = ExtrinsicErrors(run.extrinsics, gt_cam_from_rig);
+  const int num_cameras = static_cast<int>(gt_cam_from_rig.size());
+  if (num_cameras > 1) {
+    const size_t k = static_cast<size_t>(num_cameras - 1);
+    m.final_ext_rotation_deg.assign(k, 0.0);
+    m.final_ext_translation_m.assign(k, 0.0);
+    m.mean_ext_rotation_deg.assign(k, 0.0);
+    m.mean_ext_translation_m.assign(k, 0.0);
+    std::vector<int> count(k, 0), last_frame(k, -1);
+    for (const ExtrinsicError& e : out.extrinsic_errors) {
+      const size_t c = static_cast<size_t>(e.camera - 1);
+      m.mean_ext_rotation_deg[c] += e.rotation_error_deg;
+      m.mean_ext_translation_m[c] += e.translation_error_m;
+      ++count[c];
+      if (e.frame >= last_frame[c]) {
+        last_frame[c] = e.frame;
+        m.final_ext_rotation_deg[c] = e.rotation_error_deg;
+        m.final_ext_translation_m[c] = e.translation_error_m;
+      }
+    }
+    for (size_t c = 0; c < k; ++c) {
+      if (count[c] > 0) {
+        m.mean_ext_rotation_deg[c] /= count[c];
+        m.mean_ext_translation_m[c] /= count[c];
+      }
+      m.max_final_ext_rotation_deg = std::max(m.max_final_ext_rotation_deg, m.final_ext_rotation_deg[c]);
+      m.max_final_ext_translation_m = std::max(m.max_final_ext_translation_m, m.final_ext_translation_m[c]);
+    }
+  }
+  return out;
+}
+
+}  // namespace rovo

@@ -1,0 +1,270 @@
+#include "eval/report.h"
+
+#include "datasets/dataset.h"
+#include "datasets/io.h"
+#include "eval/plots.h"
+#include "rovo/version.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+
+namespace rovo {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string Fmt(const char* format, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), format, value);
+  return buffer;
+}
+
+std::string FmtOpt(const char* format, const std::optional<double>& value) {
+  return value ? Fmt(format, *value) : std::string("n/a");
+}
+
+nlohmann::json OptToJson(const std::optional<double>& value) {
+  return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
+}
+
+std::string Csv(std::initializer_list<std::string> fields) {
+  std::string line;
+  bool first = true;
+  for (const std::string& f : fields) {
+    if (!first) line += ',';
+    line += f;
+    first = false;
+  }
+  return line + "\n";
+}
+
+std::string Num(double value) { return Fmt("%.10g", value); }
+
+}  // namespace
+
+nlohmann::json MetricsToJson(const RunMetrics& m) {
+  nlohmann::json j;
+  j["label"] = m.label;
+  j["mode"] = m.mode;
+  j["noise_set"] = m.noise_set;
+  j["gt_frames"] = m.gt_frames;
+  j["estimated_frames"] = m.estimated_frames;
+  j["associated_frames"] = m.associated_frames;
+  j["missing_frames"] = m.missing_frames;
+  j["lost_frames"] = m.lost_frames;
+  j["path_length_m"] = m.path_length_m;
+  j["rmse_se3_m"] = OptToJson(m.rmse_se3_m);
+  j["rmse_origin_m"] = OptToJson(m.rmse_origin_m);
+  j["relative_rmse_pct"] = OptToJson(m.relative_rmse_pct);
+  j["drift_translation_pct"] = m.drift.translation_pct;
+  j["drift_rotation_deg_per_100m"] = m.drift.rotation_deg_per_100m;
+  j["drift_segments"] = m.drift.num_segments;
+  j["drift_segment_lengths_m"] = m.drift.segment_lengths_m;
+  j["mean_inlier_ratio"] = m.mean_inlier_ratio;
+  j["mean_reproj_error_deg"] = m.mean_reproj_error_deg;
+  j["mean_time_ms"] = m.mean_time_ms;
+  j["final_ext_rotation_deg"] = m.final_ext_rotation_deg;
+  j["final_ext_translation_m"] = m.final_ext_translation_m;
+  j["mean_ext_rotation_deg"] = m.mean_ext_rotation_deg;
+  j["mean_ext_translation_m"] = m.mean_ext_translation_m;
+  j["max_final_ext_rotation_deg"] = m.max_final_ext_rotation_deg;
+  j["max_final_ext_translation_m"] = m.max_final_ext_translation_m;
+  j["alignment_note"] = m.alignment_note;
+  return j;
+}
+
+RunMetrics MetricsFromJson(const nlohmann::json& j, const std::string& what) {
+  RunMetrics m;
+  auto field = [&](const char* key) -> const nlohmann::json& {
+    if (!j.is_object() || !j.contains(key)) throw std::runtime_error(what + ": missing field \"" + key + "\"");
+    return j.at(key);
+  };
+  auto opt = [&](const char* key) -> std::optional<double> {
+    const nlohmann::json& v = field(key);
+    if (v.is_null()) return std::nullopt;
+    if (!v.is_number()) throw std::runtime_error(what + ": field \"" + key + "\" must be a number or null");
+    return v.get<double>();
+  };
+  try {
+    m.label = field("label").get<std::string>();
+    m.mode = field("mode").get<std::string>();
+    m.noise_set = field("noise_set").get<int>();
+    m.gt_frames = field("gt_frames").get<int>();
+    m.estimated_frames = field("estimated_frames").get<int>();
+    m.associated_frames = field("associated_frames").get<int>();
+    m.missing_frames = field("missing_frames").get<int>();
+    m.lost_frames = field("lost_frames").get<int>();
+    m.path_length_m = field("path_length_m").get<double>();
+    m.rmse_se3_m = opt("rmse_se3_m");
+    m.rmse_origin_m = opt("rmse_origin_m");
+    m.relative_rmse_pct = opt("relative_rmse_pct");
+    m.drift.translation_pct = field("drift_translation_pct").get<double>();
+    m.drift.rotation_deg_per_100m = field("drift_rotation_deg_per_100m").get<double>();
+    m.drift.num_segments = field("drift_segments").get<int>();
+    m.drift.segment_lengths_m = field("drift_segment_lengths_m").get<std::vector<double>>();
+    m.mean_inlier_ratio = field("mean_inlier_ratio").get<double>();
+    m.mean_reproj_error_deg = field("mean_reproj_error_deg").get<double>();
+    m.mean_time_ms = field("mean_time_ms").get<double>();
+    m.final_ext_rotation_deg = field("final_ext_rotation_deg").get<std::vector<double>>();
+    m.final_ext_translation_m = field("final_ext_translation_m").get<std::vector<double>>();
+    m.mean_ext_rotation_deg = field("mean_ext_rotation_deg").get<std::vector<double>>();
+    m.mean_ext_translation_m = field("mean_ext_translation_m").get<std::vector<double>>();
+    m.max_final_ext_rotation_deg = field("max_final_ext_rotation_deg").get<double>();
+    m.max_final_ext_translation_m = field("max_final_ext_translation_m").get<double>();
+    m.alignment_note = field("alignment_note").get<std::string>();
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(what + ": bad metrics object: " + e.what());
+  }
+  return m;
+}
+
+std::string MetricsLegendMarkdown() {
+  return "Metrics: **RMSE SE(3)** = translation RMSE [m] after least-squares SE(3) (Umeyama, no scale) alignment of "
+         "the estimated to the ground-truth positions (primary); **rel.** = RMSE SE(3) / ground-truth path length "
+         "[%]; **RMSE origin** = translation RMSE [m] with the first pose aligned only; **drift** = KITTI-style "
+         "relative error averaged over segments of 10..80% of the path length (translation % and deg/100 m); "
+         "**inliers** = mean inlier ratio of the multi-view P3P RANSAC over frames with status ok [%]; "
+         "**reproj** = mean angular reprojection error of inliers after refinement over frames with status ok "
+         "[deg]; **ext rot / ext trans** = largest error over cameras i >= 1 of cam_i_from_cam0 at the last frame "
+         "[deg / m]; **ms/frame** = mean wall time per frame. Frames = associated / ground-truth frames.\n";
+}
+
+std::string RunTableMarkdown(const std::vector<RunMetrics>& runs) {
+  std::string md =
+      "| run | mode | noise set | frames | RMSE SE(3) [m] | rel. [%] | RMSE origin [m] | drift [%] | drift "
+      "[deg/100m] | inliers [%] | reproj [deg] | ext rot [deg] | ext trans [m] | ms/frame |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const RunMetrics& m : runs) {
+    md += "| " + m.label + " | " + m.mode + " | " + (m.noise_set >= 0 ? std::to_string(m.noise_set) : "-") + " | " +
+          std::to_string(m.associated_frames) + "/" + std::to_string(m.gt_frames) + " | " +
+          FmtOpt("%.4f", m.rmse_se3_m) + " | " + FmtOpt("%.4f", m.relative_rmse_pct) + " | " +
+          FmtOpt("%.4f", m.rmse_origin_m) + " | " + Fmt("%.3f", m.drift.translation_pct) + " | " +
+          Fmt("%.3f", m.drift.rotation_deg_per_100m) + " | " + Fmt("%.1f", 100.0 * m.mean_inlier_ratio) + " | " +
+          Fmt("%.3f", m.mean_reproj_error_deg) + " | " + Fmt("%.3f", m.max_final_ext_rotation_deg) + " | " +
+          Fmt("%.4f", m.max_final_ext_translation_m) + " | " + Fmt("%.1f", m.mean_time_ms) + " |\n";
+  }
+  return md;
+}
+
+std::vector<RunEvaluation> EvaluateAndReport(const std::string& dataset_dir, const std::vector<std::string>& run_dirs,
+                                             const std::string& out_dir, const EvalReportOptions& options) {
+  if (run_dirs.empty()) throw std::invalid_argument("rovo eval: no run folders given");
+  const DatasetInfo info = ReadDatasetInfo(dataset_dir);
+  const Trajectory gt = ReadTum(GroundTruthPath(dataset_dir));
+  if (gt.empty()) throw std::runtime_error(GroundTruthPath(dataset_dir) + ": no poses");
+  const std::vector<Rigid3> gt_cam_from_rig = info.rig.Extrinsics();
+  EnsureWritableDir(out_dir);
+
+  std::vector<RunEvaluation> evaluations;
+  std::map<std::string, int> label_count;
+  nlohmann::json runs_json = nlohmann::json::array();
+  std::string summary =
+      Csv({"label", "mode", "noise_set", "run_seed", "gt_frames", "associated_frames", "missing_frames",
+           "lost_frames", "path_length_m", "rmse_se3_m", "relative_rmse_pct", "rmse_origin_m",
+           "drift_translation_pct", "drift_rotation_deg_per_100m", "mean_inlier_ratio", "mean_reproj_error_deg",
+           "max_final_ext_rotation_deg", "max_final_ext_translation_m", "mean_time_ms"});
+  for (const std::string& run_dir : run_dirs) {
+    const RunData run = ReadRun(run_dir);
+    std::string label = fs::path(run_dir).lexically_normal().filename().string();
+    if (label.empty() || label == ".") label = fs::path(run_dir).lexically_normal().parent_path().filename().string();
+    if (label.empty()) label = "run";
+    const int seen = label_count[label]++;
+    if (seen > 0) label += "_" + std::to_string(seen + 1);
+
+    RunEvaluation evaluation = EvaluateRun(gt, gt_cam_from_rig, run, label, options.eval);
+    const RunMetrics& m = evaluation.metrics;
+    const std::string run_out = (fs::path(out_dir) / label).string();
+    EnsureWritableDir(run_out);
+
+    std::string errors = Csv({"gt_index", "timestamp", "gt_x", "gt_y", "gt_z", "est_x", "est_y", "est_z", "error_m"});
+    for (const FrameError& e : evaluation.frame_errors) {
+      errors += Csv({std::to_string(e.gt_index), Num(e.timestamp), Num(e.gt_position.x()), Num(e.gt_position.y()),
+                     Num(e.gt_position.z()), Num(e.aligned_position.x()), Num(e.aligned_position.y()),
+                     Num(e.aligned_position.z()), Num(e.error_m)});
+    }
+    WriteFileAtomic((fs::path(run_out) / "errors.csv").string(), errors);
+    WriteFramesCsv((fs::path(run_out) / "frames.csv").string(), run.frames);
+    std::string ext = Csv({"frame", "timestamp", "camera", "rotation_error_deg", "translation_error_m", "roll_est_deg",
+                           "pitch_est_deg", "yaw_est_deg", "roll_gt_deg", "pitch_gt_deg", "yaw_gt_deg"});
+    for (const ExtrinsicError& e : evaluation.extrinsic_errors) {
+      ext += Csv({std::to_string(e.frame), Num(e.timestamp), std::to_string(e.camera), Num(e.rotation_error_deg),
+                  Num(e.translation_error_m), Num(e.rpy_est_deg.x()), Num(e.rpy_est_deg.y()), Num(e.rpy_est_deg.z()),
+                  Num(e.rpy_gt_deg.x()), Num(e.rpy_gt_deg.y()), Num(e.rpy_gt_deg.z())});
+    }
+    WriteFileAtomic((fs::path(run_out) / "extrinsic_errors.csv").string(), ext);
+
+    if (options.kitti) {
+      // Line k of both files is the k-th associated frame; the estimate is mapped into the gt world.
+      Trajectory est_aligned, gt_associated;
+      for (const FrameError& e : evaluation.frame_errors) {
+        gt_associated.push_back(gt[static_cast<size_t>(e.gt_index)]);
+        const StampedPose& est = run.trajectory[static_cast<size_t>(e.estimate_index)];
+        est_aligned.push_back({est.timestamp, evaluation.gt_from_est * est.world_from_rig});
+      }
+      WriteKitti((fs::path(run_out) / "kitti_estimate.txt").string(), est_aligned);
+      WriteKitti((fs::path(run_out) / "kitti_groundtruth.txt").string(), gt_associated);
+    }
+
+    nlohmann::json rj = MetricsToJson(m);
+    rj["run_dir"] = fs::absolute(run_dir).lexically_normal().string();
+    rj["run_seed"] = run.info.value("seed", nlohmann::json(nullptr));
+    rj["gt_from_est"] = {{"qx", evaluation.gt_from_est.rotation.x()}, {"qy", evaluation.gt_from_est.rotation.y()},
+                         {"qz", evaluation.gt_from_est.rotation.z()}, {"qw", evaluation.gt_from_est.rotation.w()},
+                         {"tx", evaluation.gt_from_est.translation.x()}, {"ty", evaluation.gt_from_est.translation.y()},
+                         {"tz", evaluation.gt_from_est.translation.z()}};
+    runs_json.push_back(rj);
+    summary += Csv({m.label, m.mode, std::to_string(m.noise_set), rj["run_seed"].dump(), std::to_string(m.gt_frames),
+                    std::to_string(m.associated_frames), std::to_string(m.missing_frames),
+                    std::to_string(m.lost_frames), Num(m.path_length_m), m.rmse_se3_m ? Num(*m.rmse_se3_m) : "",
+                    m.relative_rmse_pct ? Num(*m.relative_rmse_pct) : "", m.rmse_origin_m ? Num(*m.rmse_origin_m) : "",
+                    Num(m.drift.translation_pct), Num(m.drift.rotation_deg_per_100m), Num(m.mean_inlier_ratio),
+                    Num(m.mean_reproj_error_deg), Num(m.max_final_ext_rotation_deg),
+                    Num(m.max_final_ext_translation_m), Num(m.mean_time_ms)});
+    if (!options.quiet && m.missing_frames > 0) {
+      std::fprintf(stderr, "rovo eval: %s: %d of %d ground-truth frames have no estimate\n", label.c_str(),
+                   m.missing_frames, m.gt_frames);
+    }
+    if (!options.quiet && !m.alignment_note.empty()) {
+      std::fprintf(stderr, "rovo eval: %s: %s\n", label.c_str(), m.alignment_note.c_str());
+    }
+    evaluations.push_back(std::move(evaluation));
+  }
+
+  std::string gt_csv = Csv({"timestamp", "x", "y", "z"});
+  for (const StampedPose& p : gt) {
+    gt_csv += Csv({Num(p.timestamp), Num(p.world_from_rig.translation.x()), Num(p.world_from_rig.translation.y()),
+                   Num(p.world_from_rig.translation.z())});
+  }
+  WriteFileAtomic((fs::path(out_dir) / "groundtruth.csv").string(), gt_csv);
+  WriteFileAtomic((fs::path(out_dir) / "summary.csv").string(), summary);
+
+  std::vector<RunMetrics> metrics;
+  for (const RunEvaluation& e : evaluations) metrics.push_back(e.metrics);
+  const std::string title = "rovo eval: " + (info.preset.empty() ? dataset_dir : info.preset);
+  const std::string table = RunTableMarkdown(metrics);
+  WriteFileAtomic((fs::path(out_dir) / "table.md").string(),
+                  "# " + title + "\n\nDataset: `" + dataset_dir + "` (seed " + std::to_string(info.seed) + ")\n\n" +
+                      table + "\n" + MetricsLegendMarkdown());
+
+  nlohmann::json report;
+  report["generator"] = "rovo eval";
+  report["generator_version"] = ROVO_VERSION;
+  report["dataset"] = fs::absolute(dataset_dir).lexically_normal().string();
+  report["dataset_seed"] = info.seed;
+  report["preset"] = info.preset;
+  report["gt_path_length_m"] = evaluations.front().metrics.path_length_m;
+  report["metrics"] = MetricsLegendMarkdown();
+  report["runs"] = runs_json;
+  WriteJsonFileAtomic((fs::path(out_dir) / "metrics.json").string(), report);
+
+  if (options.plots) {
+    const std::vector<std::string> pngs = RunReportPlots(out_dir, options.quiet);
+    WriteHtmlReport((fs::path(out_dir) / "report.html").string(), title, table + "\n" + MetricsLegendMarkdown(),
+                    pngs);
+  }
+  return evaluations;
+}
+
+}  // namespace rovo

@@ -1,0 +1,44 @@
+#pragma once
+// `rovo eval`: scores runs against a dataset's ground truth and writes a report folder:
+//   <out>/metrics.json            dataset, seeds, metric definitions, one object per run
+//   <out>/summary.csv             one row per run (same numbers as the table)
+//   <out>/table.md                Markdown table (states which metrics)
+//   <out>/groundtruth.csv         full gt path: timestamp,x,y,z (world)
+//   <out>/<label>/errors.csv      per associated frame: gt and aligned estimated position, error
+//   <out>/<label>/frames.csv      the run's per-frame records (inlier ratio, reprojection error)
+//   <out>/<label>/extrinsic_errors.csv  per frame and camera i >= 1: errors and roll/pitch/yaw of
+//                                       cam_i_from_cam0, estimated and ground truth
+//   with --kitti: <out>/<label>/kitti_estimate.txt (aligned) and kitti_groundtruth.txt, line by line
+//   associated.
+
+#include "eval/metrics.h"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
+
+namespace rovo {
+
+struct EvalReportOptions {
+  bool kitti = false;
+  bool plots = true;     // run eval/plots/plot_report.py and write report.html
+  bool quiet = false;
+  EvalOptions eval;
+};
+
+nlohmann::json MetricsToJson(const RunMetrics& metrics);
+// Inverse of MetricsToJson; throws std::runtime_error naming `what` and the field.
+RunMetrics MetricsFromJson(const nlohmann::json& json, const std::string& what);
+
+// Definitions of the reported metrics, printed under every table.
+std::string MetricsLegendMarkdown();
+// One row per run.
+std::string RunTableMarkdown(const std::vector<RunMetrics>& runs);
+
+// Reads the dataset and runs, scores each run, writes the report folder. Run labels are the run
+// folders' names (made unique with a suffix). Returns the evaluations in input order.
+std::vector<RunEvaluation> EvaluateAndReport(const std::string& dataset_dir, const std::vector<std::string>& run_dirs,
+                                             const std::string& out_dir, const EvalReportOptions& options);
+
+}  // namespace rovo
