@@ -19,6 +19,7 @@ struct ScenePreset {
   std::string rig_preset = "rovo4";
   int quick_frames = 0;        // --quick form
   double quick_scale = 0.5;    // image scale for the --quick form
+  double frame_rate = 10.0;    // Hz
 };
 
 // All presets, in Table I order.

@@ -1,10 +1,91 @@
-// `rovo` subcommands of scenes/.
+// `rovo scene generate` and `rovo scene list`.
 #include "datasets/cli_groups.h"
+#include "datasets/trajectory.h"
+#include "scenes/city.h"
+#include "scenes/scene.h"
 
 #include <CLI/CLI.hpp>
 
-namespace rovo {
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <string>
 
-void AddSceneCommands(CliGroups& groups) {}
+namespace rovo {
+namespace {
+
+struct GenerateOptions {
+  std::string preset;
+  uint64_t seed = 1;
+  bool quick = false;
+  std::string out_dir;
+};
+
+size_t SceneBytes(const Scene& scene, size_t* texture_bytes) {
+  size_t tex = 0, geo = 0;
+  for (const Texture& t : scene.textures) tex += t.rgb.size();
+  for (const Mesh& m : scene.meshes) {
+    geo += m.positions.size() * 12 + m.uvs.size() * 8 + m.triangles.size() * 12 + m.triangle_materials.size() * 4;
+  }
+  for (const Object& o : scene.objects) geo += o.world_from_object_per_frame.size() * sizeof(Rigid3);
+  *texture_bytes = tex;
+  return tex + geo;
+}
+
+void RunGenerate(const GenerateOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Scene scene = GenerateScene(o.preset, o.seed, o.quick);
+  const auto t1 = std::chrono::steady_clock::now();
+  SaveScene(scene, o.out_dir);
+  const auto t2 = std::chrono::steady_clock::now();
+  size_t triangles = 0, instanced = 0, dynamic = 0;
+  for (const Mesh& m : scene.meshes) triangles += m.triangles.size();
+  for (const Object& ob : scene.objects) {
+    instanced += scene.meshes[ob.mesh].triangles.size();
+    dynamic += ob.IsDynamic() ? 1 : 0;
+  }
+  size_t texture_bytes = 0;
+  const size_t bytes = SceneBytes(scene, &texture_bytes);
+  const ScenePreset& p = FindScenePreset(o.preset);
+  std::printf("scene        %s\n", o.out_dir.c_str());
+  std::printf("preset       %s%s, seed %llu, lighting %s, rig %s\n", p.name.c_str(), o.quick ? " (quick)" : "",
+              static_cast<unsigned long long>(o.seed), scene.lighting.preset.c_str(), scene.rig_preset.c_str());
+  std::printf("hash         %s\n", SceneHash(scene).c_str());
+  std::printf("meshes       %zu (%zu triangles; %zu placed in the world)\n", scene.meshes.size(), triangles, instanced);
+  std::printf("objects      %zu (%zu moving)\n", scene.objects.size(), dynamic);
+  std::printf("textures     %zu (%.1f MB)\n", scene.textures.size(), texture_bytes / 1048576.0);
+  std::printf("materials    %zu\n", scene.materials.size());
+  std::printf("memory       %.1f MB\n", bytes / 1048576.0);
+  std::printf("path         %.1f m in %zu frames at %.0f Hz (preset: %.0f m, %d frames)\n", PathLength(scene.rig_trajectory),
+              scene.rig_trajectory.size(), scene.frame_rate, o.quick ? p.path_length_m * (p.quick_frames - 1) / (p.frames - 1) : p.path_length_m,
+              o.quick ? p.quick_frames : p.frames);
+  std::printf("time         %.2f s generate, %.2f s save\n", std::chrono::duration<double>(t1 - t0).count(),
+              std::chrono::duration<double>(t2 - t1).count());
+}
+
+void RunList() {
+  std::printf("%-16s %7s %9s %7s %8s %7s %-9s  %s\n", "preset", "frames", "length_m", "quick", "scale", "traffic", "lighting", "description");
+  for (const ScenePreset& p : ScenePresets()) {
+    std::printf("%-16s %7d %9.0f %7d %8.2f %7s %-9s  %s\n", p.name.c_str(), p.frames, p.path_length_m, p.quick_frames,
+                p.quick_scale, p.traffic ? "yes" : "no", p.lighting.c_str(), p.description.c_str());
+  }
+}
+
+}  // namespace
+
+void AddSceneCommands(CliGroups& groups) {
+  auto opts = std::make_shared<GenerateOptions>();
+  CLI::App* gen = groups.scene->add_subcommand(
+      "generate", "Generate a procedural city (streets, facades, traffic, lighting, rig drive) and save it as a scene folder");
+  gen->add_option("--preset", opts->preset, "Scene preset (see `rovo scene list`)")->required();
+  gen->add_option("--seed", opts->seed, "Random seed; the same preset, seed and form give the same scene byte for byte")
+      ->capture_default_str();
+  gen->add_flag("--quick", opts->quick, "The preset's short form (CI-sized: a few dozen frames)");
+  gen->add_option("--out", opts->out_dir, "Output scene folder (scenes/FORMAT.md)")->required();
+  gen->callback([opts] { RunGenerate(*opts); });
+
+  CLI::App* list = groups.scene->add_subcommand("list", "List the scene presets (the paper's Table I sequences)");
+  list->callback([] { RunList(); });
+}
 
 }  // namespace rovo

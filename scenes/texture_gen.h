@@ -1,0 +1,43 @@
+#pragma once
+// Procedural textures for the city (all seamlessly tileable, generated in memory, 8-bit sRGB).
+// Each generator is deterministic in its seed. Texel densities are chosen for visual odometry:
+// about 1.25 cm per texel on facades and about 1 cm on roads and sidewalks, with corners
+// (window frames, brick joints, slab joints, markings, cracks) that ORB/KLT can track.
+
+#include "scenes/scene.h"
+
+#include <cstdint>
+
+namespace rovo {
+
+// Physical sizes the generators assume (metres covered by one texture tile).
+inline constexpr double kFacadeTileMetres = 12.8;     // 1024 px wide, 4 floors of 3.2 m tall
+inline constexpr double kFloorHeightMetres = 3.2;
+inline constexpr double kStorefrontHeightMetres = 4.0;  // 1024 x 320 px: 12.8 m x 4 m
+inline constexpr double kSidewalkTileMetres = 8.0;
+inline constexpr double kGroundTileMetres = 12.0;
+inline constexpr double kRoofTileMetres = 8.0;
+
+// Upper-floor facade: 1024 x 1024 px for 12.8 m x 12.8 m (4 floors of 3.2 m; texture row 0 is the
+// top of a floor), windows centred in FacadeBays(seed, index) equal columns. The wall colour is
+// near neutral so the material tint sets the building colour.
+Texture MakeFacadeTexture(uint64_t seed, int index);
+int FacadeBays(uint64_t seed, int index);
+// Ground-floor shops: 1024 x 320 px for 12.8 m x 4 m (shop windows, doors, signs, plinth).
+Texture MakeStorefrontTexture(uint64_t seed, int index);
+// Road segment: square tile `road_width_m` across (v, curb to curb) and along (u). Asphalt noise,
+// cracks, patches, dashed centre line (2 dashes per tile), edge lines `parking_lane_m` from the curbs
+// when > 0, gutters.
+Texture MakeRoadTexture(uint64_t seed, int index, double road_width_m, double parking_lane_m);
+// Intersection square of the road width: asphalt with zebra crossings along its four edges.
+Texture MakeIntersectionTexture(uint64_t seed, double road_width_m);
+Texture MakeSidewalkTexture(uint64_t seed);   // 0.5 m slabs, kSidewalkTileMetres per tile
+Texture MakeConcreteTexture(uint64_t seed);   // curbs, roofs (kRoofTileMetres per tile)
+Texture MakeGroundTexture(uint64_t seed);     // grass/dirt beyond the city
+Texture MakeCarSideTexture(uint64_t seed);    // 512 x 128: doors, handles, sills (4.4 m x 1.1 m)
+Texture MakeCarEndTexture(uint64_t seed);     // 256 x 128: grille, lights, plate
+Texture MakeCarGlassTexture(uint64_t seed);   // 256 x 64: dark glass with pillars
+Texture MakeBarkTexture(uint64_t seed);
+Texture MakeFoliageTexture(uint64_t seed);
+
+}  // namespace rovo
