@@ -1,11 +1,17 @@
 // `rovo` subcommands of eval/: eval, suite, demo, gate.
 #include "datasets/cli_groups.h"
+#include "datasets/io.h"
+#include "eval/gate.h"
 #include "eval/report.h"
+#include "eval/suite.h"
+#include "scenes/city.h"
 
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <filesystem>
 #include <memory>
+#include <sstream>
 
 namespace rovo {
 
@@ -50,8 +56,139 @@ void AddEvalCommand(CLI::App& root) {
   });
 }
 
+std::vector<std::string> SplitCommaList(const std::string& list) {
+  std::vector<std::string> out;
+  std::stringstream in(list);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    if (!item.empty()) out.push_back(item);
+  }
+  return out;
+}
+
+void PrintSuite(const std::vector<PresetSummary>& summaries, const SuiteOptions& options) {
+  std::printf("%s\n", SuiteTableMarkdown(summaries, options.quick).c_str());
+  std::printf("Suite: %s (suite.json, table.md%s)\n", options.out_dir.c_str(), options.plots ? ", report.html" : "");
+}
+
+void AddSuiteCommand(CLI::App& root) {
+  auto options = std::make_shared<SuiteOptions>();
+  auto presets = std::make_shared<std::string>();
+  auto no_plots = std::make_shared<bool>(false);
+  std::string preset_names;
+  for (const ScenePreset& p : ScenePresets()) preset_names += (preset_names.empty() ? "" : ",") + p.name;
+  CLI::App* cmd = root.add_subcommand(
+      "suite",
+      "The paper's Table I suites: renders missing datasets, runs VO with ground-truth extrinsics (GTExt) once and "
+      "with each of K perturbed extrinsic sets fixed (NoisyExt) and calibrated online (OnlineExt), evaluates, and "
+      "writes suite.json, table.md (mean +- std over noise sets, the paper's figures beside ours) and report.html. "
+      "Resumes: complete runs and datasets are not redone.");
+  cmd->add_option("--presets", *presets, "Comma-separated presets (default: all: " + preset_names + ")");
+  cmd->add_flag("--quick", options->quick, "Use the presets' quick forms (fewer frames, smaller images)");
+  cmd->add_option("--seeds", options->noise_sets, "Number K of extrinsic noise sets (noise_set 0..K-1)")
+      ->default_val(1)
+      ->check(CLI::Range(1, 1000));
+  cmd->add_option("--jobs", options->jobs, "VO runs in parallel; each gets cores/jobs threads")
+      ->default_val(1)
+      ->check(CLI::Range(1, 256));
+  cmd->add_option("--threads", options->threads, "Cores to use (0 = all)")->default_val(0);
+  cmd->add_option("--data", options->data_dir, "Dataset cache folder (default: OUT/data)");
+  cmd->add_option("--scene-seed", options->scene_seed, "Scene and render seed")->default_val(0);
+  cmd->add_option("--vo-seed", options->vo_seed, "RANSAC seed of every run")->default_val(0);
+  cmd->add_flag("--no-plots", *no_plots, "Skip plots and report.html");
+  cmd->add_option("--out", options->out_dir, "Suite output folder")->required();
+  cmd->callback([options, presets, no_plots] {
+    options->presets = SplitCommaList(*presets);
+    options->plots = !*no_plots;
+    PrintSuite(RunSuite(*options), *options);
+  });
+}
+
+void AddDemoCommand(CLI::App& root) {
+  auto out = std::make_shared<std::string>("rovo-demo");
+  auto no_plots = std::make_shared<bool>(false);
+  CLI::App* cmd = root.add_subcommand(
+      "demo",
+      "End-to-end demo: renders the small default dataset (cloudy_urban, quick), runs GTExt, NoisyExt and OnlineExt "
+      "(one noise set), prints the Table I row and writes the report (a few minutes on 2 cores).");
+  cmd->add_option("--out", *out, "Output folder")->default_val("rovo-demo");
+  cmd->add_flag("--no-plots", *no_plots, "Skip plots and report.html");
+  cmd->callback([out, no_plots] {
+    SuiteOptions options;
+    options.presets = {"cloudy_urban"};
+    options.quick = true;
+    options.noise_sets = 1;
+    options.out_dir = *out;
+    options.plots = !*no_plots;
+    PrintSuite(RunSuite(options), options);
+    if (options.plots) {
+      std::printf("Open %s\n", (std::filesystem::absolute(*out) / "report.html").lexically_normal().c_str());
+    }
+  });
+}
+
+struct GateArgs {
+  std::string gates = "ci/gates.json";
+  std::string suite;
+  bool run = false;
+  std::string data;
+  int jobs = 1;
+};
+
+void AddGateCommand(CLI::App& root) {
+  auto args = std::make_shared<GateArgs>();
+  CLI::App* cmd = root.add_subcommand(
+      "gate",
+      "CI accuracy gate: checks a suite's suite.json against the thresholds of a gates file; prints the table and "
+      "exits with status 1 when any metric crosses its threshold. With --run, first runs (or resumes) the suite the "
+      "gates file describes into --suite.");
+  cmd->add_option("--gates", args->gates, "Gates file (JSON)")->default_val("ci/gates.json");
+  cmd->add_option("--suite", args->suite, "Suite folder (holds suite.json)")->required();
+  cmd->add_flag("--run", args->run, "Run the suite described in the gates file first (resumes)");
+  cmd->add_option("--data", args->data, "With --run: dataset cache folder (default: SUITE/data)");
+  cmd->add_option("--jobs", args->jobs, "With --run: VO runs in parallel")->default_val(1)->check(CLI::Range(1, 256));
+  cmd->callback([args] {
+    const nlohmann::json gates = ReadJsonFile(args->gates);
+    if (args->run) {
+      if (!gates.contains("suite") || !gates["suite"].is_object()) {
+        throw std::runtime_error(args->gates + ": missing object field \"suite\" (needed by --run)");
+      }
+      const nlohmann::json& s = gates["suite"];
+      SuiteOptions options;
+      try {
+        options.presets = s.at("presets").get<std::vector<std::string>>();
+        options.quick = s.value("quick", true);
+        options.noise_sets = s.value("noise_sets", 1);
+        options.scene_seed = s.value("scene_seed", uint64_t{0});
+        options.vo_seed = s.value("vo_seed", uint64_t{0});
+      } catch (const nlohmann::json::exception& e) {
+        throw std::runtime_error(args->gates + ": field \"suite\": " + e.what());
+      }
+      options.out_dir = args->suite;
+      options.data_dir = args->data;
+      options.jobs = args->jobs;
+      options.plots = false;
+      RunSuite(options);
+    }
+    const std::string suite_path = (std::filesystem::path(args->suite) / "suite.json").string();
+    const std::vector<GateCheck> checks = CheckGates(gates, args->gates, ReadJsonFile(suite_path));
+    std::printf("%s\n", GateTableMarkdown(checks).c_str());
+    if (!AllGatesPass(checks)) {
+      std::fprintf(stderr, "rovo gate: FAILED: a metric crossed its threshold (%s vs %s)\n", suite_path.c_str(),
+                   args->gates.c_str());
+      throw CLI::RuntimeError(1);
+    }
+    std::printf("rovo gate: all %zu gates pass\n", checks.size());
+  });
+}
+
 }  // namespace
 
-void AddEvalCommands(CliGroups& groups) { AddEvalCommand(*groups.root); }
+void AddEvalCommands(CliGroups& groups) {
+  AddEvalCommand(*groups.root);
+  AddSuiteCommand(*groups.root);
+  AddDemoCommand(*groups.root);
+  AddGateCommand(*groups.root);
+}
 
 }  // namespace rovo

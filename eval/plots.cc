@@ -247,7 +247,10 @@ void WriteHtmlReport(const std::string& path, const std::string& title, const st
     html += "<p><i>No plots (python3 with matplotlib was not available or failed).</i></p>\n";
   }
   for (const std::string& png : pngs) {
-    const std::string name = fs::path(png).filename().string();
+    // Caption "<report folder>/<file>": plots live in <report>/plots/.
+    const fs::path png_path(png);
+    const std::string name = png_path.parent_path().parent_path().filename().string() + "/" +
+                             png_path.filename().string();
     html += "<figure><img alt=\"" + HtmlEscape(name) + "\" src=\"data:image/png;base64," + Base64Encode(ReadFile(png)) +
             "\"><figcaption>" + HtmlEscape(name) + "</figcaption></figure>\n";
   }

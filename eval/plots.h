@@ -26,7 +26,7 @@ std::string Base64Encode(const std::string& bytes);
 std::string MarkdownToHtml(const std::string& markdown);
 
 // One self-contained HTML page: title, the Markdown body, and each PNG embedded as a data URI with
-// its file name as caption. Written atomically.
+// "<report folder>/<file name>" as caption. Written atomically.
 void WriteHtmlReport(const std::string& path, const std::string& title, const std::string& markdown,
                      const std::vector<std::string>& pngs);
 

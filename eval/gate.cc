@@ -1,0 +1,76 @@
+#include "eval/gate.h"
+
+#include "eval/suite.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <stdexcept>
+
+namespace rovo {
+
+namespace {
+
+std::string Fmt(double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.4g", value);
+  return buffer;
+}
+
+}  // namespace
+
+std::vector<GateCheck> CheckGates(const nlohmann::json& gates, const std::string& gates_what,
+                                  const nlohmann::json& suite) {
+  if (!gates.is_object() || !gates.contains("gates") || !gates["gates"].is_array()) {
+    throw std::runtime_error(gates_what + ": missing array field \"gates\"");
+  }
+  const std::vector<std::string>& names = AggregatedMetricNames();
+  std::vector<GateCheck> checks;
+  int index = 0;
+  for (const nlohmann::json& g : gates["gates"]) {
+    const std::string where = gates_what + ": gates[" + std::to_string(index++) + "]";
+    auto text = [&](const char* key) {
+      if (!g.contains(key) || !g[key].is_string()) throw std::runtime_error(where + ": missing string field \"" + key + "\"");
+      return g[key].get<std::string>();
+    };
+    GateCheck c;
+    c.preset = text("preset");
+    c.mode = text("mode");
+    c.metric = text("metric");
+    if (c.mode != "gt" && c.mode != "noisy" && c.mode != "online") {
+      throw std::runtime_error(where + ": field \"mode\" must be gt, noisy or online");
+    }
+    if (std::find(names.begin(), names.end(), c.metric) == names.end()) {
+      throw std::runtime_error(where + ": field \"metric\": unknown metric \"" + c.metric + "\"");
+    }
+    const bool has_max = g.contains("max"), has_min = g.contains("min");
+    if (has_max == has_min) throw std::runtime_error(where + ": exactly one of \"max\" and \"min\" is required");
+    const nlohmann::json& bound = has_max ? g["max"] : g["min"];
+    if (!bound.is_number()) throw std::runtime_error(where + ": field \"" + (has_max ? "max" : "min") + "\" must be a number");
+    c.is_max = has_max;
+    c.bound = bound.get<double>();
+    c.note = g.value("note", std::string());
+    const nlohmann::json::json_pointer pointer("/presets/" + c.preset + "/modes/" + c.mode + "/" + c.metric);
+    if (suite.contains(pointer)) {
+      const nlohmann::json& stat = suite[pointer];
+      if (stat.contains("n") && stat["n"].get<int>() > 0 && stat["mean"].is_number()) c.value = stat["mean"].get<double>();
+    }
+    c.pass = c.value && (c.is_max ? *c.value <= c.bound : *c.value >= c.bound);
+    checks.push_back(c);
+  }
+  return checks;
+}
+
+bool AllGatesPass(const std::vector<GateCheck>& checks) {
+  return std::all_of(checks.begin(), checks.end(), [](const GateCheck& c) { return c.pass; });
+}
+
+std::string GateTableMarkdown(const std::vector<GateCheck>& checks) {
+  std::string md = "| preset | mode | metric | value (mean) | bound | result |\n|---|---|---|---|---|---|\n";
+  for (const GateCheck& c : checks) {
+    md += "| " + c.preset + " | " + c.mode + " | " + c.metric + " | " + (c.value ? Fmt(*c.value) : "missing") + " | " +
+          (c.is_max ? "<= " : ">= ") + Fmt(c.bound) + " | " + (c.pass ? "pass" : "**FAIL**") + " |\n";
+  }
+  return md;
+}
+
+}  // namespace rovo

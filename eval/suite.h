@@ -1,0 +1,90 @@
+#pragma once
+// The paper's comparison suites (Table I): for each preset, render the dataset if missing, run VO
+// with ground-truth extrinsics (GTExt) once and with each of K perturbed extrinsic sets held fixed
+// (NoisyExt) and calibrated online (OnlineExt), evaluate, aggregate mean +- std over the noise sets.
+//
+// Layout of --out:
+//   <out>/runs/<preset>/{gt, noisy_<k>, online_<k>}/   run folders (datasets/run.h)
+//   <out>/reports/<preset>/                            `rovo eval` report of all runs of the preset
+//   <out>/suite.json                                   aggregated metrics per preset and mode
+//   <out>/table.md, <out>/report.html                  Table I layout with the paper's figures
+// Datasets go to <data>/<preset>[_quick]_s<seed>/ (default <data> = <out>/data).
+// Resume: a run folder whose run.json is complete is not run again; a dataset whose frames all
+// exist is not rendered again.
+
+#include "eval/metrics.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rovo {
+
+struct SuiteOptions {
+  std::vector<std::string> presets;  // empty = all presets (ScenePresets order)
+  bool quick = false;                // the presets' quick forms
+  int noise_sets = 1;                // K: NoisyExt/OnlineExt runs per preset (noise_set 0..K-1)
+  int jobs = 1;                      // VO runs in parallel; each gets cores / jobs threads
+  int threads = 0;                   // cores to use; 0 = all
+  std::string data_dir;              // "" = <out>/data
+  std::string out_dir;
+  uint64_t scene_seed = 0;           // scene / render seed
+  uint64_t vo_seed = 0;              // RANSAC seed of every run
+  bool plots = true;
+  bool quiet = false;
+};
+
+// Mean and sample standard deviation (n - 1; 0 for n = 1) of one metric over the noise sets.
+struct Stat {
+  double mean = 0.0;
+  double std = 0.0;
+  int n = 0;
+};
+Stat ComputeStat(const std::vector<double>& values);
+
+// Aggregated metrics of one mode of one preset. Metric names as in MetricsToJson.
+struct ModeSummary {
+  std::string mode;  // gt | noisy | online
+  std::vector<RunMetrics> runs;
+  std::vector<std::pair<std::string, Stat>> stats;  // name -> stat, names in kAggregatedMetrics order
+  std::optional<Stat> Find(const std::string& name) const;
+};
+
+struct PresetSummary {
+  std::string preset;
+  std::string dataset_dir;
+  int frames = 0;
+  double path_length_m = 0.0;
+  std::vector<ModeSummary> modes;  // gt, noisy, online (those that ran)
+  const ModeSummary* Find(const std::string& mode) const;
+};
+
+// Names of the aggregated metrics (keys of suite.json "presets.<p>.<mode>").
+const std::vector<std::string>& AggregatedMetricNames();
+// Value of an aggregated metric for one run (nullopt when undefined, e.g. RMSE of a failed run).
+std::optional<double> MetricValue(const RunMetrics& metrics, const std::string& name);
+
+// Groups per-run metrics by mode and aggregates them.
+std::vector<ModeSummary> SummariseModes(const std::vector<RunMetrics>& runs);
+
+// The paper's Table I row for a preset, if it has one (path length in metres, RMSEs in metres,
+// inlier ratios in %, reprojection errors in degrees).
+struct PaperRow {
+  std::string sequence;
+  double length_m, rmse_noisy, rmse_online, rmse_gt, inlier_online, inlier_gt, reproj_online, reproj_gt;
+};
+std::optional<PaperRow> PaperRowForPreset(const std::string& preset);
+
+// Table I layout: per preset, RMSE SE(3) of NoisyExt / OnlineExt / GTExt (mean +- std over noise
+// sets) with our relative error and the paper's (RMSE / path length), inlier ratio and
+// reprojection error Online/GT beside the paper's, final extrinsic error of OnlineExt.
+std::string SuiteTableMarkdown(const std::vector<PresetSummary>& presets, bool quick);
+
+nlohmann::json SuiteToJson(const std::vector<PresetSummary>& presets, const SuiteOptions& options);
+
+std::vector<PresetSummary> RunSuite(const SuiteOptions& options);
+
+}  // namespace rovo
