@@ -6,6 +6,8 @@
 #include "datasets/camera.h"
 #include "datasets/rigid3.h"
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -34,6 +36,32 @@ struct Rig {
 // "rovo4_real" (the paper lab's calibrated rig, imported from OmniMVS config.yaml).
 std::vector<std::string> RigPresetNames();
 Rig MakeRigPreset(const std::string& name);  // throws std::invalid_argument for an unknown name
+
+// Mounting helpers (rig frame REP-103: x forward, y left, z up; camera frame OpenCV).
+// CamFromRigFromMount: a camera whose optical axis (+z) points at yaw (about rig +z, 0 = forward,
+// +90 = left) and pitch (up positive), image x horizontal (right of the axis), image y completing
+// the right-handed frame (down for pitch 0), centre at position_in_rig.
+Rigid3 CamFromRigFromMount(double yaw_deg, double pitch_deg, const Eigen::Vector3d& position_in_rig);
+// Camera centre in the rig frame: rig_from_cam's translation = -R^T t.
+Eigen::Vector3d CameraPositionInRig(const Rigid3& cam_from_rig);
+// Optical axis (+z of the camera) in the rig frame, and its yaw atan2(y, x) / pitch in degrees.
+Eigen::Vector3d CameraAxisInRig(const Rigid3& cam_from_rig);
+double CameraYawDeg(const Rigid3& cam_from_rig);
+double CameraPitchDeg(const Rigid3& cam_from_rig);
+
+// Rig JSON (datasets/FORMAT.md), the same camera objects as dataset.json's /rig:
+//   {"cameras": [{"name", "model", "width", "height", "params", "max_fov_deg",
+//                 "cam_from_rig": {"rotation_xyzw": [x, y, z, w], "translation": [x, y, z]}}]}
+// A rig.json file adds "schema_version" and "source" at the top level.
+inline constexpr int kRigSchemaVersion = 1;
+nlohmann::json Rigid3ToJson(const Rigid3& b_from_a);
+nlohmann::json RigToJson(const Rig& rig);
+// Parses and checks a rig object; throws std::runtime_error "<file>: <json pointer>: <problem>".
+Rig RigFromJson(const nlohmann::json& json, const std::string& file, const std::string& pointer = "");
+// Reads a rig.json, or the /rig of a dataset.json. Throws naming the file and field.
+Rig ReadRigJson(const std::string& path);
+// Atomic write; `source` records where the rig came from (e.g. "preset rovo4").
+void WriteRigJson(const std::string& path, const Rig& rig, const std::string& source);
 
 // One perturbed set of extrinsics (the NoisyExt / OnlineExt starting point).
 struct PerturbedExtrinsics {
