@@ -8,8 +8,9 @@
 //   template <typename T> static bool CamFromImg(const T* params, int num_params,
 //                                                const T uv[2], T bearing_in_cam[3]);
 // ImgFromCam accepts any non-zero point (also z <= 0: a 220-degree lens sees behind its image
-// plane); CamFromImg returns a unit bearing. Neither divides by z. The field-of-view limit is not a
-// model parameter: `Camera` (camera.h) applies it.
+// plane); CamFromImg returns a unit bearing. Neither divides by z (except on the optical axis
+// itself, where z > 0, to give Jets the right derivatives). The field-of-view limit is not a model
+// parameter: `Camera` (camera.h) applies it.
 //
 // Pixel convention (all models, all of rovo): continuous coordinates, u along columns (right), v
 // along rows (down), the centre of the top-left pixel at (0, 0), as in OpenCV.
