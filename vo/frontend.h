@@ -8,11 +8,15 @@
 // continues in the next keeps its id. The back-end keys landmarks by track_id.
 
 #include "datasets/rig.h"
+#include "vo/hybrid_projection.h"
+#include "vo/interview_matching.h"
+#include "vo/tracking.h"
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
 #include <cstdint>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -33,6 +37,51 @@ struct FrontendFrame {
   std::vector<std::pair<uint64_t, uint64_t>> merged_ids;
   // Wall time per stage in milliseconds: warp, detect, track, match.
   double ms_warp = 0, ms_detect = 0, ms_track = 0, ms_match = 0;
+};
+
+struct FrontendOptions {
+  int target_features_per_view = 600;   // KLT tracks + new detections per view
+  float min_feature_distance_px = 12;   // between features of one view (warped pixels)
+  int fast_threshold = 12;              // FAST-9 threshold of the detector
+  float max_forward_backward_px = 1.0f; // KLT forward-backward round-trip error
+  HybridProjectionOptions projection;   // warp geometry (focal, extents, rebuild threshold)
+  InterviewMatchOptions matching;       // inter-view filters
+  bool match_between_views = true;      // inter-view matching on/off (ablation)
+};
+
+// The front-end: per frame, warps each fisheye image with its camera's hybrid projection, tracks
+// (KLT) and re-detects features per view, attaches ORB descriptors, matches neighbouring views in
+// their overlaps and unifies track ids (identity rules above). Views run in parallel (TBB).
+//
+// Extrinsics: the rig passed in is the current (possibly noisy) calibration. SetExtrinsics updates
+// the epipolar/y filters at once; a camera's warp maps are rebuilt only when its hybrid layout moves
+// by more than options.projection.rebuild_threshold_deg (hybrid_projection.h), and its tracked
+// features are then carried over through their bearings.
+class Frontend {
+ public:
+  Frontend(const Rig& rig, const FrontendOptions& options = {});
+  ~Frontend();
+
+  // One image per camera, 8-bit gray or BGR, each of its camera's size. Throws std::invalid_argument
+  // on a wrong count, size or type.
+  FrontendFrame Process(const std::vector<cv::Mat>& fisheye_images);
+  void SetExtrinsics(const std::vector<Rigid3>& cam_from_rig);
+
+  const HybridProjection& projection(int camera) const;
+  int NumCameras() const;
+  // Warped gray image of a camera at the last Process call (for drawing and studies).
+  const cv::Mat& warped_image(int camera) const;
+  // The tracker state of a camera (points with descriptors after the last Process call).
+  const ViewTracker& tracker(int camera) const;
+  // Inter-view matches accepted at the last Process call: (camera a, camera b, index in a, index in b).
+  struct ViewMatch {
+    int camera_a, camera_b, index_a, index_b;
+  };
+  const std::vector<ViewMatch>& last_matches() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace rovo

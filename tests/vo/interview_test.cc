@@ -1,0 +1,212 @@
+#include "vo/interview_matching.h"
+
+#include "datasets/rig.h"
+#include "vo/hybrid_projection.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <random>
+
+namespace rovo {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+TEST(InterviewFilters, EpipolarAngle) {
+  const Eigen::Vector3d ca(0, 0, 0), cb(1, 0, 0);
+  const Eigen::Vector3d point(3, 5, 1);
+  const Eigen::Vector3d da = (point - ca).normalized(), db = (point - cb).normalized();
+  EXPECT_NEAR(EpipolarAngle(ca, da, cb, db), 0.0, 1e-12);
+  // Tilting b's ray by 1 deg out of the epipolar plane gives ~1 deg.
+  const Eigen::Vector3d plane_normal = (cb - ca).cross(da).normalized();
+  const Eigen::Vector3d tilted = Eigen::AngleAxisd(1.0 * kDeg, db.cross(plane_normal).normalized()) * db;
+  EXPECT_NEAR(EpipolarAngle(ca, da, cb, tilted) / kDeg, 1.0, 0.05);
+  // A ray along the baseline defines no plane.
+  EXPECT_NEAR(EpipolarAngle(ca, Eigen::Vector3d::UnitX(), cb, db), 0.5 * M_PI, 1e-12);
+}
+
+TEST(InterviewFilters, PositiveDisparity) {
+  const Eigen::Vector3d ca(0, 0, 0), cb(1, 0, 0);
+  const Eigen::Vector3d point(0.3, 4, 0.5);
+  const Eigen::Vector3d da = (point - ca).normalized(), db = (point - cb).normalized();
+  const auto lambdas = ClosestRayParameters(ca, da, cb, db);
+  ASSERT_TRUE(lambdas.has_value());
+  EXPECT_NEAR(lambdas->x(), (point - ca).norm(), 1e-9);
+  EXPECT_NEAR(lambdas->y(), (point - cb).norm(), 1e-9);
+  EXPECT_TRUE(PositiveDisparity(ca, da, cb, db));
+  // Same rays, swapped cameras: they diverge (negative disparity).
+  EXPECT_FALSE(PositiveDisparity(cb, da, ca, db));
+  // Point behind camera b.
+  EXPECT_FALSE(PositiveDisparity(ca, da, cb, -db));
+  // Parallel rays: no intersection.
+  EXPECT_FALSE(ClosestRayParameters(ca, da, cb, da).has_value());
+  EXPECT_FALSE(PositiveDisparity(ca, da, cb, da));
+}
+
+TEST(InterviewFilters, RectifiedYAndAngles) {
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ(), m = Eigen::Vector3d::UnitX();
+  EXPECT_NEAR(*RectifiedY(Eigen::Vector3d(2, 5, -1).normalized(), up, m), 0.5, 1e-12);
+  EXPECT_FALSE(RectifiedY(Eigen::Vector3d(-1, 0, 0), up, m).has_value());
+  EXPECT_NEAR(AngleDifferenceDeg(350, 10), 20, 1e-12);
+  EXPECT_NEAR(AngleDifferenceDeg(10, 190), 180, 1e-12);
+  EXPECT_NEAR(AngleDifferenceDeg(725, 0), 5, 1e-12);
+}
+
+TEST(InterviewFilters, Zncc) {
+  cv::Mat a(64, 64, CV_8UC1);
+  cv::RNG rng(5);
+  rng.fill(a, cv::RNG::UNIFORM, 0, 200);
+  cv::Mat b;
+  a.convertTo(b, CV_8UC1, 0.5, 40);  // gain and offset change
+  EXPECT_NEAR(*Zncc(a, {30, 30}, b, {30, 30}, 11), 1.0, 0.02);
+  EXPECT_LT(*Zncc(a, {30, 30}, a, {20, 40}, 11), 0.5);
+  EXPECT_FALSE(Zncc(a, {2, 30}, b, {30, 30}, 11).has_value());  // patch leaves the image
+  const cv::Mat flat(64, 64, CV_8UC1, cv::Scalar(90));
+  EXPECT_FALSE(Zncc(flat, {30, 30}, a, {30, 30}, 11).has_value());
+}
+
+// Synthetic overlap of two omnimvs4 neighbours: true points with (noisy) shared descriptors, plus
+// distractors that copy a true point's descriptor at a wrong place. All filters but ZNCC (no
+// images): every accepted match is right, and most true pairs are found.
+class SyntheticPair : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    rig_ = MakeRigPreset("omnimvs4");
+    layouts_ = ComputeHybridLayouts(rig_);
+    a_ = 0;
+    b_ = layouts_[0].right_neighbour;
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+    std::uniform_int_distribution<int> byte(0, 255);
+    const Eigen::Vector3d m = layouts_[a_].right_normal_in_rig;
+    const Eigen::Vector3d tangent = m.cross(Eigen::Vector3d::UnitZ());
+    cv::RNG cv_rng(3);
+    while (truth_.size() < 200) {
+      const Eigen::Vector3d point = (4.0 + 20.0 * std::abs(uniform(rng))) * m + 12.0 * uniform(rng) * tangent +
+                                    3.0 * uniform(rng) * Eigen::Vector3d::UnitZ();
+      const Eigen::Vector3d in_a = rig_.cameras[a_].cam_from_rig * point;
+      const Eigen::Vector3d in_b = rig_.cameras[b_].cam_from_rig * point;
+      if (!rig_.cameras[a_].camera.InFov(in_a) || !rig_.cameras[b_].camera.InFov(in_b)) continue;
+      cv::Mat descriptor(1, 32, CV_8UC1);
+      for (int k = 0; k < 32; ++k) descriptor.at<uint8_t>(0, k) = static_cast<uint8_t>(byte(rng));
+      const float angle = static_cast<float>(360.0 * std::abs(uniform(rng)));
+      AddFeature(&points_a_, &bearings_a_, a_, in_a, Flip(descriptor, 8, cv_rng), angle);
+      AddFeature(&points_b_, &bearings_b_, b_, in_b, Flip(descriptor, 8, cv_rng), angle + 5.0f);
+      truth_.push_back({static_cast<int>(points_a_.size()) - 1, static_cast<int>(points_b_.size()) - 1});
+      // Distractor in b: same descriptor and orientation, a different direction.
+      const Eigen::Vector3d wrong = rig_.cameras[b_].cam_from_rig * (point + 2.0 * tangent + 1.5 * Eigen::Vector3d::UnitZ());
+      if (rig_.cameras[b_].camera.InFov(wrong)) {
+        AddFeature(&points_b_, &bearings_b_, b_, wrong, Flip(descriptor, 4, cv_rng), angle);
+      }
+    }
+  }
+
+  static cv::Mat Flip(const cv::Mat& descriptor, int bits, cv::RNG& rng) {
+    cv::Mat out = descriptor.clone();
+    for (int k = 0; k < bits; ++k) {
+      const int bit = rng.uniform(0, 256);
+      out.at<uint8_t>(0, bit / 8) ^= static_cast<uint8_t>(1u << (bit % 8));
+    }
+    return out;
+  }
+
+  void AddFeature(std::vector<TrackedPoint>* points, std::vector<Eigen::Vector3d>* bearings, int camera,
+                  const Eigen::Vector3d& point_in_cam, const cv::Mat& descriptor, float angle) {
+    TrackedPoint p;
+    p.track_id = points->size() + 1;
+    p.has_descriptor = true;
+    p.descriptor = descriptor;
+    p.angle_deg = std::fmod(angle, 360.0f);
+    points->push_back(p);
+    bearings->push_back(rig_.cameras[camera].cam_from_rig.RotationMatrix().transpose() * point_in_cam.normalized());
+  }
+
+  std::vector<InterviewMatch> Match(const InterviewMatchOptions& options, double noise_deg = 0.0) {
+    MatchView va, vb;
+    va.points = &points_a_;
+    vb.points = &points_b_;
+    va.bearings_in_rig = bearings_a_;
+    vb.bearings_in_rig = bearings_b_;
+    std::mt19937_64 rng(5);
+    std::normal_distribution<double> normal(0.0, noise_deg * kDeg);
+    for (auto* bearings : {&va.bearings_in_rig, &vb.bearings_in_rig}) {
+      for (Eigen::Vector3d& d : *bearings) {
+        d = (Eigen::AngleAxisd(normal(rng), Eigen::Vector3d::UnitZ()) *
+             Eigen::AngleAxisd(normal(rng), d.unitOrthogonal()) * d).normalized();
+      }
+    }
+    va.centre_in_rig = rig_.cameras[a_].cam_from_rig.Inverse().translation;
+    vb.centre_in_rig = rig_.cameras[b_].cam_from_rig.Inverse().translation;
+    PairGeometry pair;
+    pair.up_in_rig = layouts_[a_].up_in_rig;
+    pair.plane_normal_in_rig = layouts_[a_].right_normal_in_rig;
+    pair.focal_px = 200.0;
+    return MatchViews(pair, va, vb, options);
+  }
+
+  int CountCorrect(const std::vector<InterviewMatch>& matches) const {
+    int correct = 0;
+    for (const InterviewMatch& m : matches) {
+      for (const auto& [ia, ib] : truth_) correct += (m.index_a == ia && m.index_b == ib);
+    }
+    return correct;
+  }
+
+  Rig rig_;
+  std::vector<HybridLayout> layouts_;
+  int a_ = 0, b_ = 0;
+  std::vector<TrackedPoint> points_a_, points_b_;
+  std::vector<Eigen::Vector3d> bearings_a_, bearings_b_;
+  std::vector<std::pair<int, int>> truth_;
+};
+
+TEST_F(SyntheticPair, AllFiltersGivePreciseMatches) {
+  InterviewMatchOptions options;
+  options.use_zncc = false;
+  const auto matches = Match(options, 0.05);
+  EXPECT_EQ(CountCorrect(matches), static_cast<int>(matches.size()));
+  EXPECT_GT(matches.size(), 0.8 * truth_.size());
+}
+
+TEST_F(SyntheticPair, DescriptorsAloneAreFooledByDistractors) {
+  InterviewMatchOptions options;
+  options.use_zncc = false;
+  options.use_y_distance = false;
+  options.max_epipolar_angle_deg = 180.0;
+  options.max_ratio = 1.0;
+  options.use_positive_disparity = false;
+  const auto matches = Match(options);
+  // Without geometry the closer distractor descriptors win most of the time.
+  EXPECT_LT(CountCorrect(matches), 0.5 * matches.size());
+  // The epipolar filter alone restores most of the precision, positive disparity the rest.
+  options.max_epipolar_angle_deg = 0.5;
+  const auto epipolar = Match(options);
+  EXPECT_GE(CountCorrect(epipolar), 0.8 * epipolar.size());
+  options.use_positive_disparity = true;
+  const auto both = Match(options);
+  EXPECT_EQ(CountCorrect(both), static_cast<int>(both.size()));
+  EXPECT_GT(both.size(), 0.8 * truth_.size());
+}
+
+TEST_F(SyntheticPair, OrientationAndDescriptorThresholdsReject) {
+  InterviewMatchOptions options;
+  options.use_zncc = false;
+  options.max_orientation_diff_deg = 2.0;  // true pairs differ by 5 deg
+  EXPECT_EQ(CountCorrect(Match(options)), 0);
+  options.max_orientation_diff_deg = 30.0;
+  options.max_descriptor_distance = 5;  // true pairs differ by up to 16 bits
+  EXPECT_LT(CountCorrect(Match(options)), 0.2 * truth_.size());
+}
+
+TEST_F(SyntheticPair, RotatedExtrinsicsFailTheEpipolarAndYFilters) {
+  // Rotate camera b by 3 deg: matching with the wrong extrinsics rejects the true pairs.
+  for (Eigen::Vector3d& d : bearings_b_) d = Eigen::AngleAxisd(3.0 * kDeg, Eigen::Vector3d::UnitX()) * d;
+  InterviewMatchOptions options;
+  options.use_zncc = false;
+  EXPECT_LT(Match(options).size(), 0.1 * truth_.size());
+}
+
+}  // namespace
+}  // namespace rovo

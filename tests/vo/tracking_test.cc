@@ -1,0 +1,168 @@
+#include "vo/tracking.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <map>
+#include <random>
+#include <set>
+
+namespace rovo {
+namespace {
+
+// Smooth random texture (blurred noise plus random rectangles) with strong corners.
+cv::Mat TexturedImage(int width, int height, uint64_t seed) {
+  cv::Mat image(height, width, CV_8UC1);
+  cv::RNG rng(seed);
+  rng.fill(image, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 2.0);
+  cv::normalize(image, image, 0, 255, cv::NORM_MINMAX);
+  for (int k = 0; k < 400; ++k) {
+    const int x = rng.uniform(0, width), y = rng.uniform(0, height);
+    cv::rectangle(image, cv::Rect(x, y, rng.uniform(8, 40), rng.uniform(8, 40)), cv::Scalar(rng.uniform(0, 255)),
+                  cv::FILLED);
+  }
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 0.8);
+  return image;
+}
+
+cv::Mat Shifted(const cv::Mat& image, double dx, double dy) {
+  cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, dx, 0, 1, dy);
+  cv::Mat out;
+  cv::warpAffine(image, out, m, image.size(), cv::INTER_CUBIC, cv::BORDER_REFLECT);
+  return out;
+}
+
+uint64_t Counter() {
+  static uint64_t next = 0;
+  return ++next;
+}
+
+TEST(Tracking, DetectsUniformlyUpToTheTarget) {
+  TrackerOptions options;
+  options.target_features = 300;
+  options.min_feature_distance_px = 15.0f;
+  ViewTracker tracker(options);
+  const cv::Mat image = TexturedImage(640, 480, 1);
+  cv::Mat mask(480, 640, CV_8UC1, cv::Scalar(255));
+  mask(cv::Rect(320, 0, 320, 480)).setTo(0);  // right half invalid
+  tracker.Track(image, mask);
+  tracker.DetectAndDescribe(Counter);
+  const auto& points = tracker.points();
+  ASSERT_GE(static_cast<int>(points.size()), 250);
+  ASSERT_LE(static_cast<int>(points.size()), 300);
+  std::set<uint64_t> ids;
+  for (size_t i = 0; i < points.size(); ++i) {
+    ids.insert(points[i].track_id);
+    EXPECT_LT(points[i].px.x, 320 - options.border_px);  // inside the eroded mask
+    EXPECT_TRUE(points[i].has_descriptor);
+    EXPECT_EQ(points[i].descriptor.cols, 32);
+    EXPECT_EQ(points[i].age, 0);
+    for (size_t j = i + 1; j < points.size(); ++j) {
+      EXPECT_GE(cv::norm(points[i].px - points[j].px), options.min_feature_distance_px - 1e-3);
+    }
+  }
+  EXPECT_EQ(ids.size(), points.size());
+  // Uniform coverage: every quadrant of the valid half holds features.
+  int quadrant[4] = {0, 0, 0, 0};
+  for (const TrackedPoint& p : points) quadrant[(p.px.x >= 160) + 2 * (p.px.y >= 240)]++;
+  for (int q : quadrant) EXPECT_GT(q, 30);
+}
+
+TEST(Tracking, KltFollowsAShiftAndKeepsIds) {
+  ViewTracker tracker;
+  const cv::Mat image = TexturedImage(640, 480, 2);
+  const cv::Mat mask(480, 640, CV_8UC1, cv::Scalar(255));
+  tracker.Track(image, mask);
+  tracker.DetectAndDescribe(Counter);
+  std::map<uint64_t, cv::Point2f> before;
+  for (const TrackedPoint& p : tracker.points()) before[p.track_id] = p.px;
+  const double dx = 3.3, dy = -1.7;
+  const int kept = tracker.Track(Shifted(image, dx, dy), mask);
+  EXPECT_GT(kept, 0.85 * before.size());
+  double sum_error = 0;
+  for (const TrackedPoint& p : tracker.points()) {
+    ASSERT_TRUE(before.count(p.track_id));
+    EXPECT_EQ(p.age, 1);
+    const cv::Point2f error = p.px - before[p.track_id] - cv::Point2f(dx, dy);
+    EXPECT_LT(cv::norm(error), 0.25);
+    sum_error += cv::norm(error);
+  }
+  EXPECT_LT(sum_error / kept, 0.1);
+  // Re-detection fills up to the target again with fresh ids.
+  tracker.DetectAndDescribe(Counter);
+  EXPECT_GT(static_cast<int>(tracker.points().size()), kept);
+  int fresh = 0;
+  for (const TrackedPoint& p : tracker.points()) fresh += before.count(p.track_id) == 0;
+  EXPECT_EQ(fresh, static_cast<int>(tracker.points().size()) - kept);
+}
+
+TEST(Tracking, ForwardBackwardCheckDropsChangedRegions) {
+  ViewTracker tracker;
+  const cv::Mat image = TexturedImage(640, 480, 3);
+  const cv::Mat mask(480, 640, CV_8UC1, cv::Scalar(255));
+  tracker.Track(image, mask);
+  tracker.DetectAndDescribe(Counter);
+  int left_before = 0;
+  for (const TrackedPoint& p : tracker.points()) left_before += p.px.x < 280;
+  // The right half becomes an unrelated texture: those tracks must go, the left ones stay.
+  cv::Mat next = image.clone();
+  TexturedImage(640, 480, 99)(cv::Rect(320, 0, 320, 480)).copyTo(next(cv::Rect(320, 0, 320, 480)));
+  tracker.Track(next, mask);
+  int left_after = 0, right_after = 0;
+  for (const TrackedPoint& p : tracker.points()) {
+    if (p.px.x < 280) ++left_after;
+    if (p.px.x > 360) ++right_after;
+  }
+  EXPECT_GT(left_after, 0.9 * left_before);
+  EXPECT_LT(right_after, 0.1 * left_before);
+}
+
+TEST(Tracking, DescriptorsAreStableUnderSmallShiftAndOrientationFollowsRotation) {
+  ViewTracker tracker;
+  const cv::Mat image = TexturedImage(640, 480, 4);
+  const cv::Mat mask(480, 640, CV_8UC1, cv::Scalar(255));
+  tracker.Track(image, mask);
+  tracker.DetectAndDescribe(Counter);
+  std::map<uint64_t, cv::Mat> descriptors;
+  for (const TrackedPoint& p : tracker.points()) descriptors[p.track_id] = p.descriptor.clone();
+  tracker.Track(Shifted(image, 0.4, 0.3), mask);
+  tracker.DetectAndDescribe(Counter);
+  double sum = 0;
+  int count = 0;
+  for (const TrackedPoint& p : tracker.points()) {
+    if (!descriptors.count(p.track_id) || !p.has_descriptor) continue;
+    sum += HammingDistance(descriptors[p.track_id], p.descriptor);
+    ++count;
+  }
+  ASSERT_GT(count, 100);
+  EXPECT_LT(sum / count, 30.0);  // random descriptors would be ~128 apart
+
+  // Rotating the image by 30 deg about a point rotates its ORB orientation by 30 deg.
+  const cv::Point2f centre(320, 240);
+  cv::Mat rotated;
+  cv::warpAffine(image, rotated, cv::getRotationMatrix2D(centre, 30.0, 1.0), image.size(), cv::INTER_CUBIC);
+  const float a = IntensityCentroidAngleDeg(image, centre);
+  const float b = IntensityCentroidAngleDeg(rotated, centre);
+  double diff = std::fmod(a - b + 720.0, 360.0);  // OpenCV rotates counter-clockwise on screen
+  EXPECT_NEAR(diff, 30.0, 3.0);
+}
+
+TEST(Tracking, HammingDistanceCountsBits) {
+  cv::Mat a = cv::Mat::zeros(1, 32, CV_8UC1), b = a.clone();
+  b.at<uint8_t>(0, 0) = 0xFF;
+  b.at<uint8_t>(0, 31) = 0x01;
+  EXPECT_EQ(HammingDistance(a, b), 9);
+  EXPECT_EQ(HammingDistance(a, a), 0);
+}
+
+TEST(Tracking, RejectsNonGrayImages) {
+  ViewTracker tracker;
+  const cv::Mat color(100, 100, CV_8UC3);
+  const cv::Mat mask(100, 100, CV_8UC1, cv::Scalar(255));
+  EXPECT_THROW(tracker.Track(color, mask), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace rovo

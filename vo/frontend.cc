@@ -1,0 +1,244 @@
+#include "vo/frontend.h"
+
+#include <opencv2/imgproc.hpp>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+namespace rovo {
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+cv::Mat ToGray(const cv::Mat& image, int camera) {
+  if (image.depth() != CV_8U) {
+    throw std::invalid_argument("Frontend: image of camera " + std::to_string(camera) + " is not 8-bit");
+  }
+  if (image.channels() == 1) return image;
+  cv::Mat gray;
+  if (image.channels() == 3) {
+    cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
+  } else if (image.channels() == 4) {
+    cv::cvtColor(image, gray, cv::COLOR_BGRA2GRAY);
+  } else {
+    throw std::invalid_argument("Frontend: image of camera " + std::to_string(camera) + " has " +
+                                std::to_string(image.channels()) + " channels");
+  }
+  return gray;
+}
+
+}  // namespace
+
+struct Frontend::Impl {
+  Rig rig;
+  FrontendOptions options;
+  std::vector<HybridLayout> layouts;          // for the current extrinsics
+  std::vector<HybridProjection> projections;  // maps (rebuilt only past the threshold)
+  std::vector<ViewTracker> trackers;
+  std::vector<cv::Mat> warped, fisheye_gray;
+  std::vector<std::pair<int, int>> pairs;     // (camera, its right neighbour), each overlap once
+  std::vector<ViewMatch> last_matches;
+  uint64_t last_id = 0;
+
+  void UpdatePairs() {
+    pairs.clear();
+    std::set<std::pair<int, int>> seen;
+    for (int i = 0; i < rig.NumCameras(); ++i) {
+      const int j = layouts[i].right_neighbour;
+      if (j == i || !seen.insert({std::min(i, j), std::max(i, j)}).second) continue;
+      pairs.emplace_back(i, j);
+    }
+  }
+};
+
+Frontend::Frontend(const Rig& rig, const FrontendOptions& options) : impl_(std::make_unique<Impl>()) {
+  Impl& s = *impl_;
+  s.rig = rig;
+  s.options = options;
+  s.layouts = ComputeHybridLayouts(rig);
+  s.projections.resize(rig.NumCameras());
+  tbb::parallel_for(0, rig.NumCameras(), [&](int i) {
+    s.projections[i] = HybridProjection(rig.cameras[i].camera, rig.cameras[i].cam_from_rig, s.layouts[i], options.projection);
+  });
+  TrackerOptions tracker_options;
+  tracker_options.target_features = options.target_features_per_view;
+  tracker_options.min_feature_distance_px = options.min_feature_distance_px;
+  tracker_options.fast_threshold = options.fast_threshold;
+  tracker_options.max_forward_backward_px = options.max_forward_backward_px;
+  s.trackers.assign(rig.NumCameras(), ViewTracker(tracker_options));
+  s.warped.resize(rig.NumCameras());
+  s.fisheye_gray.resize(rig.NumCameras());
+  s.UpdatePairs();
+}
+
+Frontend::~Frontend() = default;
+
+int Frontend::NumCameras() const { return impl_->rig.NumCameras(); }
+const HybridProjection& Frontend::projection(int camera) const { return impl_->projections.at(camera); }
+const cv::Mat& Frontend::warped_image(int camera) const { return impl_->warped.at(camera); }
+const ViewTracker& Frontend::tracker(int camera) const { return impl_->trackers.at(camera); }
+const std::vector<Frontend::ViewMatch>& Frontend::last_matches() const { return impl_->last_matches; }
+
+void Frontend::SetExtrinsics(const std::vector<Rigid3>& cam_from_rig) {
+  Impl& s = *impl_;
+  if (static_cast<int>(cam_from_rig.size()) != s.rig.NumCameras()) {
+    throw std::invalid_argument("Frontend::SetExtrinsics: " + std::to_string(cam_from_rig.size()) +
+                                " extrinsics for " + std::to_string(s.rig.NumCameras()) + " cameras");
+  }
+  s.rig = s.rig.WithExtrinsics(cam_from_rig);
+  s.layouts = ComputeHybridLayouts(s.rig);
+  s.UpdatePairs();
+  tbb::parallel_for(0, s.rig.NumCameras(), [&](int i) {
+    const HybridProjection& old = s.projections[i];
+    if (HybridLayoutChangeDeg(old.layout(), old.cam_from_rig(), s.layouts[i], cam_from_rig[i]) <=
+        s.options.projection.rebuild_threshold_deg) {
+      return;
+    }
+    HybridProjection rebuilt(s.rig.cameras[i].camera, cam_from_rig[i], s.layouts[i], s.options.projection);
+    // Carry tracked features over through their bearings, and re-warp the last image so that KLT
+    // continues between images of the same warp.
+    std::vector<TrackedPoint> carried;
+    for (const TrackedPoint& p : s.trackers[i].points()) {
+      const auto bearing = old.BearingFromWarped(Eigen::Vector2d(p.px.x, p.px.y));
+      if (!bearing) continue;
+      const auto px = rebuilt.WarpedFromBearing(*bearing);
+      if (!px || !rebuilt.InWarpedImage(*px)) continue;
+      TrackedPoint q = p;
+      q.px = cv::Point2f(static_cast<float>(px->x()), static_cast<float>(px->y()));
+      carried.push_back(std::move(q));
+    }
+    s.projections[i] = std::move(rebuilt);
+    if (!s.fisheye_gray[i].empty()) {
+      s.projections[i].Warp(s.fisheye_gray[i], &s.warped[i]);
+      s.trackers[i].ResetImage(s.warped[i], s.projections[i].valid_mask(), std::move(carried));
+    } else {
+      s.trackers[i].Clear();
+    }
+  });
+}
+
+FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
+  Impl& s = *impl_;
+  const int n = s.rig.NumCameras();
+  if (static_cast<int>(fisheye_images.size()) != n) {
+    throw std::invalid_argument("Frontend::Process: " + std::to_string(fisheye_images.size()) + " images for " +
+                                std::to_string(n) + " cameras");
+  }
+  for (int i = 0; i < n; ++i) {
+    const Camera& camera = s.rig.cameras[i].camera;
+    if (fisheye_images[i].cols != camera.width || fisheye_images[i].rows != camera.height) {
+      throw std::invalid_argument("Frontend::Process: image of camera " + std::to_string(i) + " is " +
+                                  std::to_string(fisheye_images[i].cols) + "x" + std::to_string(fisheye_images[i].rows) +
+                                  ", expected " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
+    }
+  }
+  FrontendFrame frame;
+
+  auto start = std::chrono::steady_clock::now();
+  tbb::parallel_for(0, n, [&](int i) {
+    s.fisheye_gray[i] = ToGray(fisheye_images[i], i);
+    cv::Mat warped;
+    s.projections[i].Warp(s.fisheye_gray[i], &warped);
+    s.warped[i] = warped;
+  });
+  frame.ms_warp = MsSince(start);
+
+  start = std::chrono::steady_clock::now();
+  tbb::parallel_for(0, n, [&](int i) { s.trackers[i].Track(s.warped[i], s.projections[i].valid_mask()); });
+  frame.ms_track = MsSince(start);
+
+  // New points get id 0 in parallel, then ids in camera order (deterministic).
+  start = std::chrono::steady_clock::now();
+  tbb::parallel_for(0, n, [&](int i) { s.trackers[i].DetectAndDescribe([] { return uint64_t{0}; }); });
+  for (int i = 0; i < n; ++i) {
+    for (TrackedPoint& p : s.trackers[i].points()) {
+      if (p.track_id == 0) p.track_id = ++s.last_id;
+    }
+  }
+  frame.ms_detect = MsSince(start);
+
+  start = std::chrono::steady_clock::now();
+  s.last_matches.clear();
+  if (s.options.match_between_views && !s.pairs.empty()) {
+    std::vector<MatchView> views(n);
+    tbb::parallel_for(0, n, [&](int i) {
+      const Eigen::Matrix3d rig_from_cam = s.rig.cameras[i].cam_from_rig.RotationMatrix().transpose();
+      views[i].points = &s.trackers[i].points();
+      views[i].centre_in_rig = s.rig.cameras[i].cam_from_rig.Inverse().translation;
+      views[i].image = &s.warped[i];
+      views[i].bearings_in_rig.reserve(s.trackers[i].points().size());
+      for (const TrackedPoint& p : s.trackers[i].points()) {
+        const auto bearing = s.projections[i].BearingFromWarped(Eigen::Vector2d(p.px.x, p.px.y));
+        views[i].bearings_in_rig.push_back(bearing ? Eigen::Vector3d(rig_from_cam * *bearing) : Eigen::Vector3d::Zero());
+      }
+    });
+    std::vector<std::vector<InterviewMatch>> pair_matches(s.pairs.size());
+    tbb::parallel_for(0, static_cast<int>(s.pairs.size()), [&](int k) {
+      const auto [a, b] = s.pairs[k];
+      PairGeometry geometry;
+      geometry.up_in_rig = s.layouts[a].up_in_rig;
+      geometry.plane_normal_in_rig = s.layouts[a].right_normal_in_rig;
+      geometry.focal_px = 0.5 * (s.projections[a].focal_px() + s.projections[b].focal_px());
+      pair_matches[k] = MatchViews(geometry, views[a], views[b], s.options.matching);
+    });
+
+    // Unify ids sequentially: `from` = the younger (larger) id, `into` = the older one. A merge that
+    // would put one id twice into a view is refused.
+    std::vector<std::unordered_map<uint64_t, int>> index_of(n);
+    for (int i = 0; i < n; ++i) {
+      const auto& points = s.trackers[i].points();
+      for (int k = 0; k < static_cast<int>(points.size()); ++k) index_of[i][points[k].track_id] = k;
+    }
+    for (size_t k = 0; k < s.pairs.size(); ++k) {
+      const auto [a, b] = s.pairs[k];
+      for (const InterviewMatch& m : pair_matches[k]) {
+        auto& pa = s.trackers[a].points()[m.index_a];
+        auto& pb = s.trackers[b].points()[m.index_b];
+        if (pa.track_id != pb.track_id) {
+          const uint64_t into = std::min(pa.track_id, pb.track_id);
+          const uint64_t from = std::max(pa.track_id, pb.track_id);
+          bool conflict = false;
+          for (int i = 0; i < n && !conflict; ++i) conflict = index_of[i].count(from) && index_of[i].count(into);
+          if (conflict) continue;
+          for (int i = 0; i < n; ++i) {
+            const auto it = index_of[i].find(from);
+            if (it == index_of[i].end()) continue;
+            const int index = it->second;
+            s.trackers[i].points()[index].track_id = into;
+            index_of[i].erase(it);
+            index_of[i][into] = index;
+          }
+          frame.merged_ids.emplace_back(from, into);
+        }
+        s.last_matches.push_back({a, b, m.index_a, m.index_b});
+      }
+    }
+  }
+  frame.ms_match = MsSince(start);
+
+  frame.features_per_camera.resize(n);
+  for (int i = 0; i < n; ++i) {
+    auto& out = frame.features_per_camera[i];
+    for (const TrackedPoint& p : s.trackers[i].points()) {
+      const auto bearing = s.projections[i].BearingFromWarped(Eigen::Vector2d(p.px.x, p.px.y));
+      if (!bearing) continue;
+      Feature f;
+      f.track_id = p.track_id;
+      f.camera = i;
+      f.warped_px = Eigen::Vector2f(p.px.x, p.px.y);
+      f.bearing_in_cam = *bearing;
+      f.age = p.age;
+      out.push_back(f);
+    }
+  }
+  return frame;
+}
+
+}  // namespace rovo

@@ -1,0 +1,170 @@
+#include "vo/interview_matching.h"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace rovo {
+
+double EpipolarAngle(const Eigen::Vector3d& centre_a, const Eigen::Vector3d& bearing_a, const Eigen::Vector3d& centre_b,
+                     const Eigen::Vector3d& bearing_b) {
+  const Eigen::Vector3d baseline = centre_b - centre_a;
+  const Eigen::Vector3d na = baseline.cross(bearing_a);
+  const Eigen::Vector3d nb = baseline.cross(bearing_b);
+  const double na_norm = na.norm(), nb_norm = nb.norm();
+  if (na_norm < 1e-12 || nb_norm < 1e-12) return 0.5 * M_PI;
+  const double angle_b = std::asin(std::min(1.0, std::abs(na.dot(bearing_b)) / (na_norm * bearing_b.norm())));
+  const double angle_a = std::asin(std::min(1.0, std::abs(nb.dot(bearing_a)) / (nb_norm * bearing_a.norm())));
+  return std::max(angle_a, angle_b);
+}
+
+std::optional<Eigen::Vector2d> ClosestRayParameters(const Eigen::Vector3d& centre_a, const Eigen::Vector3d& bearing_a,
+                                                    const Eigen::Vector3d& centre_b, const Eigen::Vector3d& bearing_b) {
+  // la - c lb = p, c la - lb = q with c = d_a . d_b, p = w . d_a, q = w . d_b, w = c_b - c_a.
+  const Eigen::Vector3d w = centre_b - centre_a;
+  const double c = bearing_a.dot(bearing_b);
+  const double denominator = 1.0 - c * c;
+  if (denominator < 1e-12) return std::nullopt;
+  const double p = w.dot(bearing_a), q = w.dot(bearing_b);
+  return Eigen::Vector2d((p - c * q) / denominator, (c * p - q) / denominator);
+}
+
+bool PositiveDisparity(const Eigen::Vector3d& centre_a, const Eigen::Vector3d& bearing_a, const Eigen::Vector3d& centre_b,
+                       const Eigen::Vector3d& bearing_b) {
+  const auto lambdas = ClosestRayParameters(centre_a, bearing_a, centre_b, bearing_b);
+  return lambdas && lambdas->x() > 0 && lambdas->y() > 0;
+}
+
+std::optional<double> RectifiedY(const Eigen::Vector3d& bearing, const Eigen::Vector3d& up, const Eigen::Vector3d& m) {
+  const double along = bearing.dot(m);
+  if (along <= 1e-9) return std::nullopt;
+  return -bearing.dot(up) / along;
+}
+
+std::optional<double> Zncc(const cv::Mat& image_a, cv::Point2f a, const cv::Mat& image_b, cv::Point2f b, int patch_px) {
+  const float half = 0.5f * patch_px + 1.0f;
+  const auto inside = [half](const cv::Mat& image, cv::Point2f p) {
+    return p.x >= half && p.y >= half && p.x < image.cols - half && p.y < image.rows - half;
+  };
+  if (!inside(image_a, a) || !inside(image_b, b)) return std::nullopt;
+  cv::Mat pa, pb;
+  cv::getRectSubPix(image_a, cv::Size(patch_px, patch_px), a, pa, CV_32F);
+  cv::getRectSubPix(image_b, cv::Size(patch_px, patch_px), b, pb, CV_32F);
+  const int n = patch_px * patch_px;
+  double sa = 0, sb = 0;
+  const float* va = pa.ptr<float>();
+  const float* vb = pb.ptr<float>();
+  for (int i = 0; i < n; ++i) sa += va[i], sb += vb[i];
+  const double ma = sa / n, mb = sb / n;
+  double ab = 0, aa = 0, bb = 0;
+  for (int i = 0; i < n; ++i) {
+    const double da = va[i] - ma, db = vb[i] - mb;
+    ab += da * db;
+    aa += da * da;
+    bb += db * db;
+  }
+  if (aa < 1e-6 * n || bb < 1e-6 * n) return std::nullopt;
+  return ab / std::sqrt(aa * bb);
+}
+
+double AngleDifferenceDeg(double a_deg, double b_deg) {
+  double d = std::fmod(std::abs(a_deg - b_deg), 360.0);
+  return d > 180.0 ? 360.0 - d : d;
+}
+
+namespace {
+
+struct Candidate {
+  int other = -1;
+  int distance = std::numeric_limits<int>::max();
+};
+
+// Best and second-best admissible candidate per feature (by descriptor distance).
+struct Best {
+  Candidate first, second;
+  void Offer(int other, int distance) {
+    if (distance < first.distance) {
+      second = first;
+      first = {other, distance};
+    } else if (distance < second.distance) {
+      second = {other, distance};
+    }
+  }
+};
+
+}  // namespace
+
+std::vector<InterviewMatch> MatchViews(const PairGeometry& pair, const MatchView& a, const MatchView& b,
+                                       const InterviewMatchOptions& options) {
+  const std::vector<TrackedPoint>& pa = *a.points;
+  const std::vector<TrackedPoint>& pb = *b.points;
+  const int na = static_cast<int>(pa.size()), nb = static_cast<int>(pb.size());
+  // Rectified y per feature (NaN when the feature faces away from the shared plane).
+  const auto rectified = [&](const MatchView& view, int n) {
+    std::vector<double> ys(n, std::numeric_limits<double>::quiet_NaN());
+    for (int i = 0; i < n; ++i) {
+      if (const auto y = RectifiedY(view.bearings_in_rig[i], pair.up_in_rig, pair.plane_normal_in_rig)) ys[i] = *y;
+    }
+    return ys;
+  };
+  const std::vector<double> ya = rectified(a, na), yb = rectified(b, nb);
+  const double max_dy = options.max_y_distance_px / pair.focal_px;
+  const double max_epipolar = options.max_epipolar_angle_deg * M_PI / 180.0;
+  // Order b by rectified y so each a scans only the band |y_a - y_b| <= max_dy.
+  std::vector<int> b_order;
+  for (int j = 0; j < nb; ++j) {
+    if (pb[j].has_descriptor && (!options.use_y_distance || !std::isnan(yb[j]))) b_order.push_back(j);
+  }
+  if (options.use_y_distance) {
+    std::sort(b_order.begin(), b_order.end(), [&](int x, int y) { return yb[x] < yb[y]; });
+  }
+  std::vector<double> b_sorted_y;
+  for (int j : b_order) b_sorted_y.push_back(options.use_y_distance ? yb[j] : 0.0);
+
+  std::vector<Best> best_a(na), best_b(nb);
+  for (int i = 0; i < na; ++i) {
+    if (!pa[i].has_descriptor) continue;
+    size_t begin = 0, end = b_order.size();
+    if (options.use_y_distance) {
+      if (std::isnan(ya[i])) continue;
+      begin = std::lower_bound(b_sorted_y.begin(), b_sorted_y.end(), ya[i] - max_dy) - b_sorted_y.begin();
+      end = std::upper_bound(b_sorted_y.begin(), b_sorted_y.end(), ya[i] + max_dy) - b_sorted_y.begin();
+    }
+    for (size_t k = begin; k < end; ++k) {
+      const int j = b_order[k];
+      if (AngleDifferenceDeg(pa[i].angle_deg, pb[j].angle_deg) > options.max_orientation_diff_deg) continue;
+      const int distance = HammingDistance(pa[i].descriptor, pb[j].descriptor);
+      if (distance > options.max_descriptor_distance) continue;
+      if (EpipolarAngle(a.centre_in_rig, a.bearings_in_rig[i], b.centre_in_rig, b.bearings_in_rig[j]) > max_epipolar) {
+        continue;
+      }
+      if (options.use_positive_disparity &&
+          !PositiveDisparity(a.centre_in_rig, a.bearings_in_rig[i], b.centre_in_rig, b.bearings_in_rig[j])) continue;
+      best_a[i].Offer(j, distance);
+      best_b[j].Offer(i, distance);
+    }
+  }
+
+  const auto passes_ratio = [&](const Best& best) {
+    if (options.max_ratio >= 1.0 || best.second.other < 0) return true;
+    return best.first.distance <= options.max_ratio * best.second.distance;
+  };
+  std::vector<InterviewMatch> matches;
+  for (int i = 0; i < na; ++i) {
+    const int j = best_a[i].first.other;
+    if (j < 0 || !passes_ratio(best_a[i])) continue;
+    if (options.use_mutual && (best_b[j].first.other != i || !passes_ratio(best_b[j]))) continue;
+    InterviewMatch match{i, j, best_a[i].first.distance, 0.0};
+    if (options.use_zncc) {
+      const auto score = Zncc(*a.image, pa[i].px, *b.image, pb[j].px, options.zncc_patch_px);
+      if (!score || *score < options.min_zncc) continue;
+      match.zncc = *score;
+    }
+    matches.push_back(match);
+  }
+  return matches;
+}
+
+}  // namespace rovo

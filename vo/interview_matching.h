@@ -1,0 +1,93 @@
+#pragma once
+// Inter-view feature matching between neighbouring views in their overlap (ROVO paper IV-B).
+//
+// For a pair of views (a, b) sharing the projection-plane normal m (both cameras' planes over this
+// overlap are parallel to the baseline, hybrid_projection.h), a candidate pair of features passes
+// when, with d_a, d_b the bearings rotated into the rig frame, c_a, c_b the camera centres, up the
+// rig-plane normal and f the warped focal length:
+//   1. y-distance:   f |y(d_a) - y(d_b)| <= max_y_distance_px, y(d) = -(d . up) / (d . m)
+//                    (the rectified-like warped y; needs d . m > 0 for both),
+//   2. descriptor:   Hamming(desc_a, desc_b) <= max_descriptor_distance,
+//   3. orientation:  |angle_a - angle_b| (mod 360) <= max_orientation_diff_deg,
+//   4. epipolar:     max(angle of d_b to the plane span(c_b - c_a, d_a), same for d_a) <= max_epipolar_angle_deg,
+//   5. positive disparity: the rays c_a + la d_a and c_b + lb d_b converge with la > 0 and lb > 0
+//                    (closest points; parallel rays fail),
+// then the two nearest admissible candidates by descriptor distance (kNN, k = 2) are kept per feature
+// in both directions, and the nearest one is accepted when
+//   ratio:           best <= max_ratio * second best (when there is a second),
+//   6. left-right:   a's best is b and b's best is a (mutual),
+//   7. ZNCC:         zero-normalised cross-correlation of the square patches around both points in
+//                    the warped images >= min_zncc.
+
+#include "datasets/rigid3.h"
+#include "vo/tracking.h"
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include <optional>
+#include <vector>
+
+namespace rovo {
+
+struct InterviewMatchOptions {
+  double max_y_distance_px = 6.0;
+  int max_descriptor_distance = 64;
+  double max_orientation_diff_deg = 30.0;
+  double max_epipolar_angle_deg = 0.5;
+  double min_zncc = 0.7;
+  int zncc_patch_px = 11;       // odd side of the ZNCC patch
+  double max_ratio = 0.9;       // best / second-best descriptor distance (1 = off)
+  bool use_zncc = true;         // ablation switches (the projection study turns filters off)
+  bool use_y_distance = true;
+  bool use_mutual = true;
+  bool use_positive_disparity = true;
+};
+
+// One view's features for matching.
+struct MatchView {
+  const std::vector<TrackedPoint>* points = nullptr;
+  std::vector<Eigen::Vector3d> bearings_in_rig;  // rotation only (rig_from_cam rotation * bearing_in_cam)
+  Eigen::Vector3d centre_in_rig = Eigen::Vector3d::Zero();
+  const cv::Mat* image = nullptr;  // 8-bit gray image the points live in (for ZNCC)
+};
+
+struct PairGeometry {
+  Eigen::Vector3d up_in_rig = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d plane_normal_in_rig = Eigen::Vector3d::UnitX();  // shared plane normal m
+  double focal_px = 400.0;
+};
+
+struct InterviewMatch {
+  int index_a = -1, index_b = -1;
+  int descriptor_distance = 0;
+  double zncc = 0.0;
+};
+
+// Angle (radians) of `bearing_b` to the epipolar plane through the baseline and `bearing_a`, and
+// vice versa; returns the larger. All in one frame. Returns pi/2 when a bearing is parallel to the
+// baseline (no plane).
+double EpipolarAngle(const Eigen::Vector3d& centre_a, const Eigen::Vector3d& bearing_a, const Eigen::Vector3d& centre_b,
+                     const Eigen::Vector3d& bearing_b);
+
+// Ray parameters (la, lb) of the closest points of c_a + la d_a and c_b + lb d_b (unit bearings);
+// nullopt for (nearly) parallel rays.
+std::optional<Eigen::Vector2d> ClosestRayParameters(const Eigen::Vector3d& centre_a, const Eigen::Vector3d& bearing_a,
+                                                    const Eigen::Vector3d& centre_b, const Eigen::Vector3d& bearing_b);
+bool PositiveDisparity(const Eigen::Vector3d& centre_a, const Eigen::Vector3d& bearing_a, const Eigen::Vector3d& centre_b,
+                       const Eigen::Vector3d& bearing_b);
+
+// Rectified-like y of a direction for a plane normal m: -(d . up) / (d . m); nullopt when d . m <= 0.
+std::optional<double> RectifiedY(const Eigen::Vector3d& bearing, const Eigen::Vector3d& up, const Eigen::Vector3d& m);
+
+// ZNCC of the patch_px x patch_px patches (bilinear) around a and b; nullopt when a patch leaves its
+// image or is flat.
+std::optional<double> Zncc(const cv::Mat& image_a, cv::Point2f a, const cv::Mat& image_b, cv::Point2f b, int patch_px);
+
+// Smallest difference of two angles in degrees, in [0, 180].
+double AngleDifferenceDeg(double a_deg, double b_deg);
+
+std::vector<InterviewMatch> MatchViews(const PairGeometry& pair, const MatchView& a, const MatchView& b,
+                                       const InterviewMatchOptions& options);
+
+}  // namespace rovo

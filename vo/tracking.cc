@@ -1,0 +1,209 @@
+#include "vo/tracking.h"
+
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace rovo {
+namespace {
+
+constexpr int kOrbPatchRadius = 15;
+
+// Square-grid occupancy for the minimum-distance rule: cell side = min distance / sqrt(2), so one
+// point per cell and a check of the 5x5 cell neighbourhood is exact.
+class OccupancyGrid {
+ public:
+  OccupancyGrid(int width, int height, float min_distance)
+      : min_distance2_(min_distance * min_distance),
+        cell_(std::max(1.0f, min_distance / std::sqrt(2.0f))),
+        cols_(static_cast<int>(width / cell_) + 1),
+        rows_(static_cast<int>(height / cell_) + 1),
+        cells_(static_cast<size_t>(cols_) * rows_, cv::Point2f(-1e9f, -1e9f)) {}
+
+  bool Free(cv::Point2f p) const {
+    const int cx = static_cast<int>(p.x / cell_), cy = static_cast<int>(p.y / cell_);
+    for (int y = std::max(0, cy - 2); y <= std::min(rows_ - 1, cy + 2); ++y) {
+      for (int x = std::max(0, cx - 2); x <= std::min(cols_ - 1, cx + 2); ++x) {
+        const cv::Point2f q = cells_[static_cast<size_t>(y) * cols_ + x];
+        const cv::Point2f d = p - q;
+        if (d.dot(d) < min_distance2_) return false;
+      }
+    }
+    return true;
+  }
+  void Add(cv::Point2f p) {
+    const int cx = std::clamp(static_cast<int>(p.x / cell_), 0, cols_ - 1);
+    const int cy = std::clamp(static_cast<int>(p.y / cell_), 0, rows_ - 1);
+    cells_[static_cast<size_t>(cy) * cols_ + cx] = p;
+  }
+
+ private:
+  float min_distance2_, cell_;
+  int cols_, rows_;
+  std::vector<cv::Point2f> cells_;
+};
+
+bool MaskAt(const cv::Mat& mask, cv::Point2f p) {
+  const int x = static_cast<int>(std::lround(p.x)), y = static_cast<int>(std::lround(p.y));
+  return x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<uint8_t>(y, x) != 0;
+}
+
+// The validity mask eroded by `border` pixels, also away from the image edges (ORB patch + blur).
+cv::Mat DetectionMask(const cv::Mat& mask, int border) {
+  cv::Mat eroded;
+  const int k = 2 * border + 1;
+  cv::erode(mask, eroded, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)));
+  if (eroded.rows > 2 * border && eroded.cols > 2 * border) {
+    eroded.rowRange(0, border).setTo(0);
+    eroded.rowRange(eroded.rows - border, eroded.rows).setTo(0);
+    eroded.colRange(0, border).setTo(0);
+    eroded.colRange(eroded.cols - border, eroded.cols).setTo(0);
+  } else {
+    eroded.setTo(0);
+  }
+  return eroded;
+}
+
+}  // namespace
+
+float IntensityCentroidAngleDeg(const cv::Mat& image, cv::Point2f px) {
+  const int cx = static_cast<int>(std::lround(px.x)), cy = static_cast<int>(std::lround(px.y));
+  double m01 = 0, m10 = 0;
+  for (int dy = -kOrbPatchRadius; dy <= kOrbPatchRadius; ++dy) {
+    const int y = cy + dy;
+    if (y < 0 || y >= image.rows) continue;
+    const uint8_t* row = image.ptr<uint8_t>(y);
+    const int half = static_cast<int>(std::sqrt(double(kOrbPatchRadius * kOrbPatchRadius - dy * dy)));
+    for (int dx = -half; dx <= half; ++dx) {
+      const int x = cx + dx;
+      if (x < 0 || x >= image.cols) continue;
+      m10 += dx * row[x];
+      m01 += dy * row[x];
+    }
+  }
+  float angle = static_cast<float>(std::atan2(m01, m10) * 180.0 / M_PI);
+  if (angle < 0) angle += 360.0f;
+  return angle;
+}
+
+int HammingDistance(const cv::Mat& a, const cv::Mat& b) { return static_cast<int>(cv::norm(a, b, cv::NORM_HAMMING)); }
+
+ViewTracker::ViewTracker(const TrackerOptions& options) : options_(options) {}
+
+void ViewTracker::Clear() {
+  image_.release();
+  pyramid_.clear();
+  points_.clear();
+  descriptors_.release();
+}
+
+void ViewTracker::ResetImage(const cv::Mat& image, const cv::Mat& mask, std::vector<TrackedPoint> points) {
+  image_ = image;
+  detect_mask_ = DetectionMask(mask, options_.border_px);
+  pyramid_.clear();
+  cv::buildOpticalFlowPyramid(image_, pyramid_, cv::Size(options_.klt_window_px, options_.klt_window_px),
+                              options_.klt_levels);
+  points_.clear();
+  for (TrackedPoint& p : points) {
+    if (MaskAt(detect_mask_, p.px)) points_.push_back(std::move(p));
+  }
+}
+
+int ViewTracker::Track(const cv::Mat& image, const cv::Mat& mask) {
+  if (image.type() != CV_8UC1) throw std::invalid_argument("ViewTracker: image must be 8-bit gray");
+  if (mask.size() != image.size()) throw std::invalid_argument("ViewTracker: mask size differs from the image");
+  const cv::Size window(options_.klt_window_px, options_.klt_window_px);
+  std::vector<cv::Mat> pyramid;
+  cv::buildOpticalFlowPyramid(image, pyramid, window, options_.klt_levels);
+  if (detect_mask_.size() != mask.size() || detect_mask_.empty()) {
+    detect_mask_ = DetectionMask(mask, options_.border_px);
+  }
+  std::vector<TrackedPoint> kept;
+  if (!points_.empty() && !pyramid_.empty()) {
+    std::vector<cv::Point2f> previous, forward, backward;
+    previous.reserve(points_.size());
+    for (const TrackedPoint& p : points_) previous.push_back(p.px);
+    std::vector<uint8_t> status_fw, status_bw;
+    std::vector<float> error;
+    const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
+    cv::calcOpticalFlowPyrLK(pyramid_, pyramid, previous, forward, status_fw, error, window, options_.klt_levels,
+                             criteria);
+    backward = previous;
+    cv::calcOpticalFlowPyrLK(pyramid, pyramid_, forward, backward, status_bw, error, window, options_.klt_levels,
+                             criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
+    const float max_fb2 = options_.max_forward_backward_px * options_.max_forward_backward_px;
+    for (size_t i = 0; i < points_.size(); ++i) {
+      if (!status_fw[i] || !status_bw[i]) continue;
+      const cv::Point2f d = backward[i] - previous[i];
+      if (d.dot(d) > max_fb2) continue;
+      if (!MaskAt(detect_mask_, forward[i])) continue;
+      TrackedPoint p = points_[i];
+      p.px = forward[i];
+      ++p.age;
+      p.has_descriptor = false;
+      kept.push_back(std::move(p));
+    }
+    // Enforce the minimum distance among tracks too (converging tracks): older tracks win.
+    std::stable_sort(kept.begin(), kept.end(),
+                     [](const TrackedPoint& a, const TrackedPoint& b) { return a.age > b.age; });
+    OccupancyGrid grid(image.cols, image.rows, options_.min_feature_distance_px);
+    std::vector<TrackedPoint> spaced;
+    spaced.reserve(kept.size());
+    for (TrackedPoint& p : kept) {
+      if (!grid.Free(p.px)) continue;
+      grid.Add(p.px);
+      spaced.push_back(std::move(p));
+    }
+    kept = std::move(spaced);
+  }
+  points_ = std::move(kept);
+  image_ = image;
+  pyramid_ = std::move(pyramid);
+  return static_cast<int>(points_.size());
+}
+
+void ViewTracker::DetectAndDescribe(const std::function<uint64_t()>& next_id) {
+  if (image_.empty()) return;
+  if (static_cast<int>(points_.size()) < options_.target_features) {
+    std::vector<cv::KeyPoint> corners;
+    cv::FAST(image_, corners, options_.fast_threshold, true, cv::FastFeatureDetector::TYPE_9_16);
+    std::sort(corners.begin(), corners.end(),
+              [](const cv::KeyPoint& a, const cv::KeyPoint& b) { return a.response > b.response; });
+    OccupancyGrid grid(image_.cols, image_.rows, options_.min_feature_distance_px);
+    for (const TrackedPoint& p : points_) grid.Add(p.px);
+    for (const cv::KeyPoint& kp : corners) {
+      if (static_cast<int>(points_.size()) >= options_.target_features) break;
+      if (!MaskAt(detect_mask_, kp.pt) || !grid.Free(kp.pt)) continue;
+      grid.Add(kp.pt);
+      TrackedPoint p;
+      p.track_id = next_id();
+      p.px = kp.pt;
+      points_.push_back(std::move(p));
+    }
+  }
+
+  // Orientation and descriptors for all points.
+  std::vector<cv::KeyPoint> keypoints;
+  keypoints.reserve(points_.size());
+  for (size_t i = 0; i < points_.size(); ++i) {
+    points_[i].angle_deg = IntensityCentroidAngleDeg(image_, points_[i].px);
+    points_[i].has_descriptor = false;
+    cv::KeyPoint kp(points_[i].px, 31.0f, points_[i].angle_deg, 0.0f, 0, static_cast<int>(i));
+    keypoints.push_back(kp);
+  }
+  static thread_local cv::Ptr<cv::ORB> orb = cv::ORB::create(500, 1.2f, 1, 19, 0, 2, cv::ORB::HARRIS_SCORE, 31);
+  descriptors_.release();
+  if (!keypoints.empty()) orb->compute(image_, keypoints, descriptors_);
+  for (size_t k = 0; k < keypoints.size(); ++k) {
+    const int i = keypoints[k].class_id;
+    if (i < 0 || i >= static_cast<int>(points_.size())) continue;
+    points_[i].has_descriptor = true;
+    points_[i].descriptor = descriptors_.row(static_cast<int>(k));
+  }
+}
+
+}  // namespace rovo

@@ -1,0 +1,72 @@
+#pragma once
+// Intra-view feature processing (ROVO paper IV-B): FAST corners (ORB's detector) picked strongest
+// first under a minimum-distance constraint so they cover the image uniformly; pyramidal KLT
+// (cv::calcOpticalFlowPyrLK) from the previous frame with a forward-backward check; re-detection to
+// keep a target count; ORB descriptors (oriented BRIEF, orientation by the intensity centroid of a
+// radius-15 disc) recomputed on every point every frame so that inter-view matching can use them.
+//
+// Works on any 8-bit gray image with a validity mask: the hybrid-warped views, or (for the
+// projection study) the raw fisheye images.
+
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace rovo {
+
+struct TrackerOptions {
+  int target_features = 600;         // per view; re-detect when fewer are tracked
+  float min_feature_distance_px = 12.0f;  // between any two features (detections and tracks)
+  int fast_threshold = 12;           // FAST-9 intensity threshold
+  int klt_window_px = 21;            // KLT window side
+  int klt_levels = 3;                // pyramid levels above the base
+  float max_forward_backward_px = 1.0f;  // forward-backward KLT round-trip error
+  int border_px = 20;                // features keep this distance from invalid pixels and image edges (ORB patch)
+};
+
+struct TrackedPoint {
+  uint64_t track_id = 0;
+  cv::Point2f px;
+  int age = 0;          // frames tracked in this view (0 = detected this frame)
+  float angle_deg = 0;  // ORB orientation (intensity centroid), degrees in [0, 360)
+  bool has_descriptor = false;
+  cv::Mat descriptor;   // 1x32 CV_8U (ORB), a view into ViewTracker's descriptor matrix
+};
+
+class ViewTracker {
+ public:
+  explicit ViewTracker(const TrackerOptions& options = {});
+
+  // Tracks the previous points into `image` (8-bit gray) and drops the lost ones. `mask` (CV_8U,
+  // 255 = valid) is the image's validity area. Returns the number of points kept. The first call
+  // only stores the image.
+  int Track(const cv::Mat& image, const cv::Mat& mask);
+  // Detects new points (ids from `next_id`) until target_features, then computes orientation and
+  // descriptors for all points. Call after Track on the same image.
+  void DetectAndDescribe(const std::function<uint64_t()>& next_id);
+
+  std::vector<TrackedPoint>& points() { return points_; }
+  const std::vector<TrackedPoint>& points() const { return points_; }
+  const cv::Mat& image() const { return image_; }
+  // Replaces the stored image (and the points), e.g. after the warp maps were rebuilt.
+  void ResetImage(const cv::Mat& image, const cv::Mat& mask, std::vector<TrackedPoint> points);
+  void Clear();
+
+ private:
+  TrackerOptions options_;
+  cv::Mat image_, detect_mask_;
+  std::vector<cv::Mat> pyramid_;
+  std::vector<TrackedPoint> points_;
+  cv::Mat descriptors_;
+};
+
+// ORB orientation of the patch around `px` (intensity centroid over a radius-15 disc), degrees in
+// [0, 360). The patch must lie inside the image.
+float IntensityCentroidAngleDeg(const cv::Mat& image, cv::Point2f px);
+
+// Hamming distance of two 1x32 CV_8U ORB descriptors.
+int HammingDistance(const cv::Mat& a, const cv::Mat& b);
+
+}  // namespace rovo
