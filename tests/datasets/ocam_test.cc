@@ -235,6 +235,66 @@ TEST(OcamCalibReader, AffineMappingMatchesOcamCalib) {
   EXPECT_GT(checked, 800);
 }
 
+// OCamCalib's world2cam (its C reference semantics): ray in its frame -> pixel (row, col).
+Eigen::Vector2d OcamCalibWorld2Cam(const Eigen::Vector3d& ray, const std::vector<double>& invpol, double xc, double yc,
+                                   double c, double d, double e) {
+  const double norm = std::sqrt(ray.x() * ray.x() + ray.y() * ray.y());
+  const double theta = std::atan(ray.z() / norm);
+  double rho = invpol[0], t_i = 1;
+  for (size_t i = 1; i < invpol.size(); ++i) {
+    t_i *= theta;
+    rho += t_i * invpol[i];
+  }
+  const double x = ray.x() / norm * rho, y = ray.y() / norm * rho;
+  return Eigen::Vector2d(x * c + y * d + xc, x * e + y + yc);
+}
+
+// With a non-identity affine and an accurate inverse in the file, the camera's Project equals
+// OCamCalib's world2cam with the file's own coefficients (checks the inverse's mapping b' = c b).
+TEST(OcamCalibReader, ProjectMatchesOcamCalibWorld2Cam) {
+  const double c = 1.05, d = 0.02, e = -0.03, xc = 500.25, yc = 640.75;
+  const std::vector<double> poly = {-300.0, 0.0, 0.0012, -1.0e-6, 1.5e-9};
+  // The documented mapping, written out here, to fit an inverse and express it in OCamCalib's units.
+  std::vector<double> rovo_params = {yc, xc, 1 / c, e / c, d / c};
+  for (int i = 0; i < 5; ++i) rovo_params.push_back(poly[i] * std::pow(c, 1 - i));
+  const OcamInverseFit fit = FitOcamInversePolynomial(rovo_params, 200.0, 0.001);
+  ASSERT_LT(fit.max_error_px, 0.001);
+  std::vector<double> invpol;
+  for (double b : fit.inverse_poly) invpol.push_back(b / c);
+  std::string text = "5";
+  char number[128];
+  for (double a : poly) {
+    std::snprintf(number, sizeof(number), " %.17g", a);
+    text += number;
+  }
+  text += "\n" + std::to_string(invpol.size());
+  for (double b : invpol) {
+    std::snprintf(number, sizeof(number), " %.17g", b);
+    text += number;
+  }
+  std::snprintf(number, sizeof(number), "\n%.17g %.17g\n", xc, yc);
+  text += number;
+  std::snprintf(number, sizeof(number), "%.17g %.17g %.17g\n1000 1280\n", c, d, e);
+  text += number;
+  double file_error = 1;
+  const Camera camera = ReadOcamCalibTxt(WriteTemp("world2cam.txt", text), 200.0, &file_error);
+  EXPECT_LT(file_error, 0.001);  // kept, not refitted
+  int checked = 0;
+  for (double angle = 0.5; angle <= 100; angle += 4.5) {
+    for (double azimuth = 3; azimuth < 360; azimuth += 17) {
+      const Eigen::Vector3d rovo_ray(std::sin(angle * kDeg) * std::cos(azimuth * kDeg),
+                                     std::sin(angle * kDeg) * std::sin(azimuth * kDeg), std::cos(angle * kDeg));
+      const Eigen::Vector3d ocam_ray(rovo_ray.y(), rovo_ray.x(), -rovo_ray.z());
+      const Eigen::Vector2d row_col = OcamCalibWorld2Cam(ocam_ray, invpol, xc, yc, c, d, e);
+      const auto uv = camera.Project(rovo_ray);
+      ASSERT_TRUE(uv.has_value());
+      EXPECT_LT((*uv - Eigen::Vector2d(row_col.y(), row_col.x())).norm(), 1e-8) << angle << " " << azimuth;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 400);
+}
+
 // An accurate inverse polynomial in the file is kept (scaled by c, the sensor normalisation).
 TEST(OcamCalibReader, AccurateInverseInTheFileIsKept) {
   // Fit an inverse in OCamCalib's own units: with c = 1, d = e = 0 the mapping is a relabelling.
