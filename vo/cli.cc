@@ -1,10 +1,117 @@
-// `rovo` subcommands of vo/.
+// `rovo` subcommands of vo/: `rovo vo` (run the pipeline on a dataset) and `rovo bench vo`.
 #include "datasets/cli_groups.h"
+#include "vo/pipeline.h"
+
+#if __has_include("vo/projection_study.h")
+#include "vo/projection_study.h"
+#define ROVO_HAVE_PROJECTION_STUDY 1
+#endif
 
 #include <CLI/CLI.hpp>
 
-namespace rovo {
+#include <cstdio>
+#include <memory>
+#include <stdexcept>
+#include <string>
 
-void AddVoCommands(CliGroups& groups) {}
+namespace rovo {
+namespace {
+
+// "A:B" (B exclusive; either side may be empty) -> [begin, end), end = -1 for "to the end".
+void ParseFrameRange(const std::string& text, int* begin, int* end) {
+  if (text.empty()) return;
+  const size_t colon = text.find(':');
+  if (colon == std::string::npos) throw std::invalid_argument("--frames: expected A:B, got '" + text + "'");
+  try {
+    const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
+    *begin = a.empty() ? 0 : std::stoi(a);
+    *end = b.empty() ? -1 : std::stoi(b);
+  } catch (const std::exception&) {
+    throw std::invalid_argument("--frames: expected integers A:B, got '" + text + "'");
+  }
+}
+
+struct VoArgs {
+  VoOptions options;
+  std::string extrinsics = "gt";
+  std::string frames;
+};
+
+void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
+  cmd->add_option("dataset", args->options.dataset_dir, "Dataset folder (datasets/FORMAT.md)")->required();
+  cmd->add_option("--extrinsics", args->extrinsics,
+                  "Extrinsics: gt (GTExt), noisy (NoisyExt: a perturbed set, fixed) or online (OnlineExt: a perturbed "
+                  "set, calibrated online in the local BA)")
+      ->check(CLI::IsMember({"gt", "noisy", "online"}))
+      ->capture_default_str();
+  cmd->add_option("--noise-set", args->options.noise_set, "Index of the perturbed extrinsic set in dataset.json")
+      ->capture_default_str();
+  cmd->add_option("--seed", args->options.seed, "RANSAC seed (recorded in run.json)")->capture_default_str();
+  cmd->add_option("--frames", args->frames, "Frame range A:B (B exclusive; default: all frames)");
+  cmd->add_option("--threads", args->options.threads, "Worker threads of the front-end (0: all cores)")
+      ->capture_default_str();
+  cmd->add_option("--sampling", args->options.sampling, "RANSAC view sampling: pps (paper) or uniform (ablation)")
+      ->check(CLI::IsMember({"pps", "uniform"}))
+      ->capture_default_str();
+  cmd->add_option("--ransac", args->options.ransac,
+                  "RANSAC scoring: multiview (paper: all views) or single-view (ablation: one view)")
+      ->check(CLI::IsMember({"multiview", "single-view"}))
+      ->capture_default_str();
+  cmd->add_flag("--quiet", args->options.quiet, "No progress output");
+}
+
+void Finalise(VoArgs* args) {
+  args->options.mode = ExtrinsicsModeFromName(args->extrinsics);
+  ParseFrameRange(args->frames, &args->options.frame_begin, &args->options.frame_end);
+}
+
+}  // namespace
+
+void AddVoCommands(CliGroups& groups) {
+  auto args = std::make_shared<VoArgs>();
+  CLI::App* cmd = groups.root->add_subcommand(
+      "vo",
+      "Run the ROVO visual odometry on a dataset and write a run folder (trajectory.tum, frames.csv, "
+      "extrinsics.csv, run.json). Starts at the ground-truth first pose; metric scale from inter-view "
+      "triangulation.");
+  AddVoRunOptions(cmd, args.get());
+  cmd->add_option("--out", args->options.out_dir, "Run folder to write")->required();
+  cmd->callback([args] {
+    Finalise(args.get());
+    const VoSummary s = RunVo(args->options);
+    std::printf("%d frames (%d ok, %d init, %d lost) in %.1f s (%.1f frames/s); mean inlier ratio %.1f%%, mean "
+                "reprojection error %.3f deg -> %s\n",
+                s.frames, s.frames_ok, s.frames_init, s.frames_lost, s.seconds, s.frames / std::max(s.seconds, 1e-9),
+                100.0 * s.mean_inlier_ratio, s.mean_reproj_error_deg, args->options.out_dir.c_str());
+  });
+
+  auto bench_args = std::make_shared<VoArgs>();
+  CLI::App* bench = groups.bench->add_subcommand(
+      "vo", "Time the whole pipeline on a dataset (full image size) and print a table of mean ms per frame by stage");
+  AddVoRunOptions(bench, bench_args.get());
+  bench->add_option("--out", bench_args->options.out_dir, "Run folder to write (default: DATASET/../bench_vo_run)");
+  bench->callback([bench_args] {
+    Finalise(bench_args.get());
+    VoOptions options = bench_args->options;
+    if (options.out_dir.empty()) options.out_dir = options.dataset_dir + "_bench_vo_run";
+    const VoSummary s = RunVo(options);
+    const VoStageTimes& t = s.stage_ms;
+    std::printf("rovo bench vo: %s, mode %s, %d frames, threads %d\n", options.dataset_dir.c_str(),
+                ExtrinsicsModeName(options.mode).c_str(), s.frames, options.threads);
+    std::printf("| stage                     | ms/frame |\n|---------------------------|---------:|\n");
+    const std::pair<const char*, double> rows[] = {
+        {"load images", t.load},        {"front-end: warp", t.warp},   {"front-end: detect", t.detect},
+        {"front-end: track", t.track},  {"front-end: match", t.match}, {"back-end: RANSAC", t.ransac},
+        {"back-end: refine", t.refine}, {"back-end: triangulate", t.triangulate}, {"back-end: local BA", t.ba},
+        {"back-end: total", t.backend_total}, {"whole frame", t.total}};
+    for (const auto& [name, value] : rows) std::printf("| %-25s | %8.2f |\n", name, value);
+    std::printf("RANSAC: %.2f us per hypothesis\n", t.ransac_us_per_hypothesis);
+    std::printf("whole pipeline: %.2f frames/s (target 10 Hz)\n", t.total > 0 ? 1000.0 / t.total : 0.0);
+  });
+
+#ifdef ROVO_HAVE_PROJECTION_STUDY
+  AddProjectionStudyCommand(groups);
+#endif
+}
 
 }  // namespace rovo

@@ -1,9 +1,29 @@
 #pragma once
 // The whole ROVO pipeline over a dataset, writing a run folder (datasets/run.h). Entry point of
 // `rovo vo`.
+//
+// Per frame (paper Sec. IV): front-end features -> 2D-3D correspondences of tracked landmarks ->
+// multi-view P3P RANSAC (ransac.h) -> Cauchy pose refinement (pose_refinement.h) -> new landmarks by
+// inter-view and multi-frame triangulation (triangulation.h) -> on keyframes, local BA over a
+// sliding window, with online extrinsic calibration in OnlineExt mode (local_ba.h).
+// Start: the ground-truth first pose; metric scale from inter-view triangulation (rig baselines).
+// Failure handling: a frame with too few correspondences, no RANSAC consensus, or a black/missing
+// image gets status "lost" and the pose of a constant-velocity prediction; the map is then rebuilt
+// from inter-view triangulation at the predicted pose (status "init").
+
+#include "datasets/rigid3.h"
+#include "datasets/run.h"
+#include "vo/frontend.h"
+#include "vo/local_ba.h"
+#include "vo/map.h"
+#include "vo/pose_refinement.h"
+#include "vo/ransac.h"
+#include "vo/triangulation.h"
 
 #include <cstdint>
+#include <map>
 #include <string>
+#include <vector>
 
 namespace rovo {
 
@@ -26,13 +46,90 @@ struct VoOptions {
   bool quiet = false;
 };
 
+// Mean wall time per processed frame, by stage, in milliseconds.
+struct VoStageTimes {
+  double warp = 0, detect = 0, track = 0, match = 0;  // front-end (FrontendFrame::ms_*)
+  double load = 0;                                      // image reading
+  double ransac = 0, refine = 0, triangulate = 0, ba = 0, backend_total = 0;
+  double ransac_us_per_hypothesis = 0;
+  double total = 0;                                     // whole frame incl. loading
+};
+
 struct VoSummary {
   int frames = 0;
   int frames_ok = 0;
   int frames_lost = 0;
   double seconds = 0.0;
+  int frames_init = 0;
+  double mean_inlier_ratio = 0.0;        // over "ok" frames
+  double mean_reproj_error_deg = 0.0;    // over "ok" frames
+  VoStageTimes stage_ms;
 };
 
 VoSummary RunVo(const VoOptions& options);
+
+// ---------------------------------------------------------------------------------------------
+// The back-end alone (everything after the front-end), usable on synthetic FrontendFrames.
+
+struct BackendOptions {
+  MultiViewRansacOptions ransac;
+  PoseRefinementOptions refine;
+  TriangulationOptions interview_triangulation;   // same frame, >= 2 cameras
+  TriangulationOptions multiframe_triangulation;  // several frames
+  LocalBaOptions ba;                              // ba.optimize_extrinsics = OnlineExt
+  KeyframeOptions keyframes;
+  bool local_ba = true;
+  int window_keyframes = 6;          // sliding window size
+  int max_ba_landmarks = 1500;       // bound on BA size (landmarks with most observations)
+  int min_features = 20;             // fewer features in all views: frame lost (e.g. black image)
+  int min_correspondences = 15;      // fewer 2D-3D correspondences: frame lost
+  double min_inlier_ratio = 0.15;    // below: no consensus
+  int min_init_landmarks = 15;       // inter-view points needed to (re)initialise
+  int max_unseen_frames = 2;         // landmarks unseen for longer are dropped
+  double max_landmark_error_deg = 2.0;  // BA observations above are dropped
+  // Online calibration: observations are kept (and BA sees them) up to this angle, so that a camera
+  // whose extrinsics are degrees off still contributes until BA has corrected it.
+  double online_max_error_deg = 12.0;
+  void Check() const;
+};
+
+struct BackendFrameResult {
+  Rigid3 world_from_rig;
+  FrameRecord record;        // status, counts, errors (frame and timestamp filled by the caller)
+  double ms_ransac = 0, ms_refine = 0, ms_triangulate = 0, ms_ba = 0;
+  int ransac_hypotheses = 0;
+  int num_landmarks = 0;
+};
+
+class VoBackend {
+ public:
+  VoBackend(const std::vector<Rigid3>& initial_cam_from_rig, const Rigid3& initial_world_from_rig,
+            const BackendOptions& options);
+
+  // `frame` must increase between calls (gaps allowed). `frontend` may be empty (unreadable image).
+  BackendFrameResult ProcessFrame(int frame, const FrontendFrame& frontend);
+
+  const std::vector<Rigid3>& cam_from_rig() const { return cam_from_rig_; }
+  const LandmarkMap& map() const { return map_; }
+
+ private:
+  bool Initialise(int frame, const Rigid3& rig_from_world, BackendFrameResult* result);
+  void AddObservations(int frame, const FrontendFrame& frontend, const std::vector<std::vector<char>>* rejected);
+  int TriangulateNew(int frame);
+  double RunLocalBa(int frame);
+  Rigid3 PredictRigFromWorld(int frame) const;
+  std::vector<Rigid3> WorldFromCam(const Rigid3& rig_from_world) const;
+
+  BackendOptions options_;
+  std::vector<Rigid3> cam_from_rig_;
+  std::vector<double> baseline_lengths_;
+  Rigid3 initial_rig_from_world_;
+  LandmarkMap map_;
+  std::map<int, Rigid3> rig_from_world_;  // estimated poses of recent frames
+  std::vector<int> keyframes_;            // window, oldest first
+  bool initialised_ = false;
+  int last_good_frame_ = -1;
+  int previous_good_frame_ = -1;
+};
 
 }  // namespace rovo

@@ -1,0 +1,178 @@
+#include "vo/local_ba.h"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <stdexcept>
+
+namespace rovo {
+namespace {
+
+// r = b - pi0(cam_from_rig * rig_from_world * X). Unknowns: rig_from_world (aa, t),
+// cam_from_rig (aa, t), point_in_world.
+struct BearingCost {
+  explicit BearingCost(const Eigen::Vector3d& bearing_in_cam) : bearing(bearing_in_cam) {}
+
+  template <typename T>
+  bool operator()(const T* rig_aa, const T* rig_t, const T* cam_aa, const T* cam_t, const T* point_in_world,
+                  T* residual) const {
+    T in_rig[3], in_cam[3];
+    ceres::AngleAxisRotatePoint(rig_aa, point_in_world, in_rig);
+    for (int r = 0; r < 3; ++r) in_rig[r] += rig_t[r];
+    ceres::AngleAxisRotatePoint(cam_aa, in_rig, in_cam);
+    for (int r = 0; r < 3; ++r) in_cam[r] += cam_t[r];
+    const T norm = ceres::sqrt(in_cam[0] * in_cam[0] + in_cam[1] * in_cam[1] + in_cam[2] * in_cam[2]);
+    for (int r = 0; r < 3; ++r) residual[r] = T(bearing(r)) - in_cam[r] / norm;
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Vector3d& bearing_in_cam) {
+    return new ceres::AutoDiffCostFunction<BearingCost, 3, 3, 3, 3, 3, 3>(new BearingCost(bearing_in_cam));
+  }
+
+  Eigen::Vector3d bearing;
+};
+
+// r = s * (|c_j - c_i| - L0), c = -R^T t = -R(-aa) t.
+struct BaselineCost {
+  BaselineCost(double length, double weight) : length0(length), scale(weight) {}
+
+  template <typename T>
+  bool operator()(const T* aa_i, const T* t_i, const T* aa_j, const T* t_j, T* residual) const {
+    T c_i[3], c_j[3];
+    const T minus_aa_i[3] = {-aa_i[0], -aa_i[1], -aa_i[2]};
+    const T minus_aa_j[3] = {-aa_j[0], -aa_j[1], -aa_j[2]};
+    ceres::AngleAxisRotatePoint(minus_aa_i, t_i, c_i);
+    ceres::AngleAxisRotatePoint(minus_aa_j, t_j, c_j);
+    T d2 = T(0.0);
+    for (int r = 0; r < 3; ++r) d2 += (c_j[r] - c_i[r]) * (c_j[r] - c_i[r]);
+    residual[0] = T(scale) * (ceres::sqrt(d2) - T(length0));
+    return true;
+  }
+
+  static ceres::CostFunction* Create(double length, double weight) {
+    return new ceres::AutoDiffCostFunction<BaselineCost, 1, 3, 3, 3, 3>(new BaselineCost(length, weight));
+  }
+
+  double length0, scale;
+};
+
+struct PoseParams {
+  Eigen::Vector3d aa, t;
+};
+
+PoseParams ToParams(const Rigid3& x) { return {x.AxisAngle(), x.translation}; }
+Rigid3 FromParams(const PoseParams& p) { return Rigid3::FromAxisAngle(p.aa, p.t); }
+
+}  // namespace
+
+void LocalBaOptions::Check() const {
+  if (!(cauchy_scale_rad > 0.0)) throw std::invalid_argument("LocalBaOptions.cauchy_scale_rad must be > 0");
+  if (!(multi_camera_weight > 0.0)) throw std::invalid_argument("LocalBaOptions.multi_camera_weight must be > 0");
+  if (!(baseline_weight >= 0.0)) throw std::invalid_argument("LocalBaOptions.baseline_weight must be >= 0");
+  if (max_iterations < 1) throw std::invalid_argument("LocalBaOptions.max_iterations must be >= 1");
+  if (num_threads < 1) throw std::invalid_argument("LocalBaOptions.num_threads must be >= 1");
+}
+
+std::vector<double> RingBaselineLengths(const std::vector<Rigid3>& cam_from_rig) {
+  const size_t n = cam_from_rig.size();
+  std::vector<double> out;
+  if (n < 2) return out;
+  for (size_t j = 0; j < n; ++j) {
+    const size_t k = (j + 1) % n;
+    if (n == 2 && j == 1) break;  // a single pair
+    out.push_back((cam_from_rig[j].Inverse().translation - cam_from_rig[k].Inverse().translation).norm());
+  }
+  return out;
+}
+
+LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& options) {
+  options.Check();
+  LocalBaReport report;
+  const int num_poses = static_cast<int>(problem.rig_from_world.size());
+  const int num_cams = static_cast<int>(problem.cam_from_rig.size());
+  if (num_poses < 1 || problem.observations.empty()) return report;
+  std::vector<PoseParams> poses(num_poses), cams(num_cams);
+  for (int i = 0; i < num_poses; ++i) poses[i] = ToParams(problem.rig_from_world[i]);
+  for (int j = 0; j < num_cams; ++j) cams[j] = ToParams(problem.cam_from_rig[j]);
+  std::vector<double> baselines =
+      problem.baseline_lengths.empty() ? RingBaselineLengths(problem.cam_from_rig) : problem.baseline_lengths;
+
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::TAKE_OWNERSHIP;
+  ceres::Problem ceres_problem(problem_options);
+  std::vector<char> pose_used(num_poses, 0), cam_used(num_cams, 0), point_used(problem.points_in_world.size(), 0);
+  for (const LocalBaObservation& o : problem.observations) {
+    const double weight =
+        (o.point_index < static_cast<int>(problem.point_num_cameras.size()) && problem.point_num_cameras[o.point_index] >= 2)
+            ? options.multi_camera_weight
+            : 1.0;
+    ceres::LossFunction* loss =
+        new ceres::ScaledLoss(new ceres::CauchyLoss(options.cauchy_scale_rad), weight, ceres::TAKE_OWNERSHIP);
+    ceres_problem.AddResidualBlock(BearingCost::Create(o.bearing_in_cam), loss, poses[o.pose_index].aa.data(),
+                                   poses[o.pose_index].t.data(), cams[o.camera].aa.data(), cams[o.camera].t.data(),
+                                   problem.points_in_world[o.point_index].data());
+    pose_used[o.pose_index] = cam_used[o.camera] = point_used[o.point_index] = 1;
+    ++report.num_residuals;
+  }
+  if (pose_used[0]) {
+    ceres_problem.SetParameterBlockConstant(poses[0].aa.data());
+    ceres_problem.SetParameterBlockConstant(poses[0].t.data());
+  }
+  for (int j = 0; j < num_cams; ++j) {
+    if (!cam_used[j]) continue;
+    if (!options.optimize_extrinsics || j == 0) {
+      ceres_problem.SetParameterBlockConstant(cams[j].aa.data());
+      ceres_problem.SetParameterBlockConstant(cams[j].t.data());
+    }
+  }
+  if (options.optimize_extrinsics && options.baseline_weight > 0.0) {
+    for (size_t p = 0; p < baselines.size(); ++p) {
+      const int a = static_cast<int>(p), b = static_cast<int>((p + 1) % num_cams);
+      if (!cam_used[a] || !cam_used[b]) continue;
+      ceres_problem.AddResidualBlock(BaselineCost::Create(baselines[p], options.baseline_weight), nullptr,
+                                     cams[a].aa.data(), cams[a].t.data(), cams[b].aa.data(), cams[b].t.data());
+    }
+  }
+
+  // Schur ordering: landmarks first, then poses and extrinsics.
+  auto* ordering = new ceres::ParameterBlockOrdering;
+  for (size_t i = 0; i < problem.points_in_world.size(); ++i) {
+    if (point_used[i]) ordering->AddElementToGroup(problem.points_in_world[i].data(), 0);
+  }
+  for (int i = 0; i < num_poses; ++i) {
+    if (!pose_used[i]) continue;
+    ordering->AddElementToGroup(poses[i].aa.data(), 1);
+    ordering->AddElementToGroup(poses[i].t.data(), 1);
+  }
+  for (int j = 0; j < num_cams; ++j) {
+    if (!cam_used[j]) continue;
+    ordering->AddElementToGroup(cams[j].aa.data(), 1);
+    ordering->AddElementToGroup(cams[j].t.data(), 1);
+  }
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
+  solver_options.linear_solver_ordering.reset(ordering);
+  solver_options.max_num_iterations = options.max_iterations;
+  if (options.max_time_s > 0.0) solver_options.max_solver_time_in_seconds = options.max_time_s;
+  solver_options.num_threads = options.num_threads;
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &ceres_problem, &summary);
+  report.usable = summary.IsSolutionUsable();
+  report.iterations = static_cast<int>(summary.iterations.size());
+  report.initial_cost = summary.initial_cost;
+  report.final_cost = summary.final_cost;
+  report.seconds = summary.total_time_in_seconds;
+  if (!report.usable) return report;
+  // Write back only what was free (a round trip through angle-axis would perturb fixed blocks).
+  for (int i = 1; i < num_poses; ++i) {
+    if (pose_used[i]) problem.rig_from_world[i] = FromParams(poses[i]);
+  }
+  for (int j = 1; j < num_cams && options.optimize_extrinsics; ++j) {
+    if (cam_used[j]) problem.cam_from_rig[j] = FromParams(cams[j]);
+  }
+  return report;
+}
+
+}  // namespace rovo

@@ -1,0 +1,66 @@
+#pragma once
+// Local bundle adjustment with online extrinsic calibration (ROVO paper, Sec. IV-D):
+//     min sum_t sum_j sum_i w_ij rho( | b_ijt - pi0(cam_from_rig_j * rig_from_world_t * X_i) |^2 )
+//         + sum_{(i,j) neighbours} ( s * ( |c_j - c_i| - L0_ij ) )^2
+// over the rig poses rig_from_world_t of the window, the landmarks X_i (point_in_world) and, in
+// online mode, cam_from_rig_j of cameras 1..N-1. pi0(p) = p/|p|, rho = Cauchy, w_ij =
+// multi_camera_weight for points seen by >= 2 cameras (they carry the metric scale), else 1.
+// c_j = -R_j^T t_j is camera j's centre in the rig frame (cam_from_rig_j = (R_j, t_j)) and L0_ij its
+// initial distance to its neighbour (ring order 0-1, 1-2, ..., N-1-0): without it the rig could
+// grow or shrink and metric scale would be lost.
+// Gauge: the oldest rig pose (index 0) is fixed; camera 0's cam_from_rig is fixed (rig.h).
+// Parametrisation: angle-axis (radians) + translation per pose and extrinsic; Ceres DENSE_SCHUR with
+// landmarks eliminated first. Bounded time: max_iterations (and an optional wall-time limit, which
+// trades determinism for latency). Deterministic for a fixed input with num_threads = 1.
+
+#include "datasets/rigid3.h"
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace rovo {
+
+struct LocalBaOptions {
+  bool optimize_extrinsics = false;  // online extrinsic calibration
+  double cauchy_scale_rad = 0.005;   // Cauchy scale on the bearing chord
+  double multi_camera_weight = 2.0;  // w for points seen by >= 2 cameras
+  double baseline_weight = 1000.0;   // s, per metre of baseline change
+  int max_iterations = 10;
+  double max_time_s = 0.0;           // 0: no wall-time limit (deterministic)
+  int num_threads = 1;
+  void Check() const;
+};
+
+struct LocalBaObservation {
+  int pose_index = 0;
+  int camera = 0;
+  int point_index = 0;
+  Eigen::Vector3d bearing_in_cam;  // unit
+};
+
+struct LocalBaProblem {
+  std::vector<Rigid3> rig_from_world;          // window poses, [0] = oldest (fixed)
+  std::vector<Rigid3> cam_from_rig;            // [0] fixed
+  std::vector<Eigen::Vector3d> points_in_world;
+  std::vector<int> point_num_cameras;          // distinct cameras per point (weights)
+  std::vector<LocalBaObservation> observations;
+  std::vector<double> baseline_lengths;        // L0 of ring pair (j, j+1 mod N); empty = from cam_from_rig
+};
+
+struct LocalBaReport {
+  bool usable = false;
+  int num_residuals = 0;
+  int iterations = 0;
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  double seconds = 0.0;
+};
+
+// Centre distances of ring neighbours (j, j+1 mod N) of a set of extrinsics.
+std::vector<double> RingBaselineLengths(const std::vector<Rigid3>& cam_from_rig);
+
+// Optimises `problem` in place.
+LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& options);
+
+}  // namespace rovo
