@@ -1,0 +1,108 @@
+// End-to-end accuracy gate: renders the quick dataset of the gates file's suite into a cache keyed
+// by a content hash of the code and settings that make it, runs GTExt / NoisyExt / OnlineExt with
+// the real `rovo` binary, and checks ci/gates.json. A second test shows the gate fails (exit
+// status 1) when a threshold is tightened below the measured value.
+#include "datasets/io.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace rovo {
+namespace {
+namespace fs = std::filesystem;
+
+struct CommandResult {
+  int status = -1;
+  std::string output;
+};
+
+CommandResult RunShell(const std::string& command) {
+  CommandResult result;
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return result;
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.output.append(buffer.data(), n);
+  const int status = ::pclose(pipe);
+  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+// Hash of everything that determines the rendered dataset: the gates file's suite settings and
+// the sources of scenes/, render/ and datasets/.
+std::string DatasetCacheKey(const nlohmann::json& suite_settings) {
+  std::vector<fs::path> files;
+  for (const char* part : {"scenes", "render", "datasets"}) {
+    for (const auto& entry : fs::recursive_directory_iterator(fs::path(ROVO_SOURCE_DIR) / part)) {
+      const std::string ext = entry.path().extension().string();
+      if (entry.is_regular_file() && (ext == ".cc" || ext == ".h" || ext == ".py")) files.push_back(entry.path());
+    }
+  }
+  std::sort(files.begin(), files.end());
+  std::string content = suite_settings.dump();
+  for (const fs::path& f : files) content += f.lexically_relative(ROVO_SOURCE_DIR).string() + "\n" + ReadFile(f.string());
+  return HashHex(content.data(), content.size());
+}
+
+class GateTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    gates_path_ = std::string(ROVO_SOURCE_DIR) + "/ci/gates.json";
+    const nlohmann::json gates = ReadJsonFile(gates_path_);
+    const fs::path cache_root = fs::path(ROVO_BINARY).parent_path().parent_path() / "eval_gate_cache";
+    data_dir_ = (cache_root / DatasetCacheKey(gates["suite"])).string();
+    suite_dir_ = (fs::temp_directory_path() / ("rovo_gate_suite_" + std::to_string(::getpid()))).string();
+    fs::remove_all(suite_dir_);
+    std::fprintf(stderr, "gate test: dataset cache %s, suite %s\n", data_dir_.c_str(), suite_dir_.c_str());
+    first_ = RunShell(std::string(ROVO_BINARY) + " gate --run --gates " + gates_path_ + " --suite " + suite_dir_ +
+                 " --data " + data_dir_);
+  }
+  static void TearDownTestSuite() { fs::remove_all(suite_dir_); }
+
+  static std::string gates_path_, data_dir_, suite_dir_;
+  static CommandResult first_;
+};
+std::string GateTest::gates_path_, GateTest::data_dir_, GateTest::suite_dir_;
+CommandResult GateTest::first_;
+
+TEST_F(GateTest, QuickSuitePassesTheGates) {
+  EXPECT_EQ(first_.status, 0) << first_.output;
+  EXPECT_NE(first_.output.find("| preset | mode | metric |"), std::string::npos) << first_.output;
+  EXPECT_TRUE(fs::is_regular_file(suite_dir_ + "/suite.json"));
+  for (const char* run : {"gt", "noisy_0", "online_0"}) {
+    EXPECT_TRUE(fs::is_regular_file(suite_dir_ + "/runs/cloudy_urban/" + run + "/run.json")) << run;
+  }
+}
+
+TEST_F(GateTest, TightenedThresholdFails) {
+  ASSERT_TRUE(fs::is_regular_file(suite_dir_ + "/suite.json")) << first_.output;
+  const nlohmann::json suite = ReadJsonFile(suite_dir_ + "/suite.json");
+  const nlohmann::json::json_pointer pointer("/presets/cloudy_urban/modes/gt/rmse_se3_m/mean");
+  ASSERT_TRUE(suite.contains(pointer)) << suite.dump(2);
+  const double measured = suite[pointer].get<double>();
+  ASSERT_GT(measured, 0.0);
+  nlohmann::json gates = ReadJsonFile(gates_path_);
+  gates["gates"] = {{{"preset", "cloudy_urban"}, {"mode", "gt"}, {"metric", "rmse_se3_m"}, {"max", 0.5 * measured}}};
+  const std::string tight = suite_dir_ + "/tight_gates.json";
+  WriteJsonFileAtomic(tight, gates);
+  const CommandResult result = RunShell(std::string(ROVO_BINARY) + " gate --gates " + tight + " --suite " + suite_dir_);
+  EXPECT_EQ(result.status, 1) << result.output;
+  EXPECT_NE(result.output.find("**FAIL**"), std::string::npos) << result.output;
+  // Loosened above the measured value it passes: the failure above is the threshold's doing.
+  gates["gates"][0]["max"] = 2.0 * measured;
+  WriteJsonFileAtomic(tight, gates);
+  const CommandResult loose = RunShell(std::string(ROVO_BINARY) + " gate --gates " + tight + " --suite " + suite_dir_);
+  EXPECT_EQ(loose.status, 0) << loose.output;
+}
+
+}  // namespace
+}  // namespace rovo
