@@ -20,8 +20,8 @@ void RunValidate(const std::string& dir) {
     for (const ValidationIssue& issue : issues) {
       std::printf("%s: %s: %s\n", issue.file.c_str(), issue.field.c_str(), issue.message.c_str());
     }
-    std::fprintf(stderr, "rovo: %s: %zu problem%s\n", dir.c_str(), issues.size(), issues.size() == 1 ? "" : "s");
     std::fflush(stdout);
+    std::fprintf(stderr, "rovo: %s: %zu problem%s\n", dir.c_str(), issues.size(), issues.size() == 1 ? "" : "s");
     throw CLI::RuntimeError(1);
   }
   const DatasetInfo info = ReadDatasetInfo(dir);

@@ -566,7 +566,8 @@ std::vector<ValidationIssue> ValidateDataset(const std::string& dir) {
     info = ParseDatasetJson(check, root);
     json_ok = true;
   } catch (const std::exception& e) {
-    issues.push_back({json_path, "/", StripPrefix(e.what(), json_path + ": ")});
+    const std::string message = StripPrefix(e.what(), json_path + ": ");
+    issues.push_back({json_path, "/", message == e.what() ? "cannot read JSON: " + message : message});
   }
 
   // groundtruth.tum: every line parses, unit quaternions, increasing timestamps, one per frame.

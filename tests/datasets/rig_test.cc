@@ -148,6 +148,18 @@ TEST(Rig, ScaledProjectsToScaledPixels) {
       EXPECT_LT(AngleBetween(*back, bearing.normalized()), 1e-4) << name << " " << deg;
     }
   }
+  // Double sphere (Usenko et al. example parameters), same rule.
+  Rig ds = MakeRigPreset("omnimvs4");
+  ds.cameras[0].camera.model = CameraModelId::kDoubleSphere;
+  ds.cameras[0].camera.params = {160.0, 160.0, 399.5, 383.5, -0.2, 0.6};
+  ds.cameras[0].camera.max_fov_deg = 200.0;
+  const Rig ds_small = ds.Scaled(0.5);
+  const Eigen::Vector3d bearing(0.5, -0.3, 0.2);
+  const auto uv = ds.cameras[0].camera.Project(bearing);
+  const auto uv_small = ds_small.cameras[0].camera.Project(bearing);
+  ASSERT_TRUE(uv && uv_small);
+  EXPECT_NEAR(uv_small->x(), (uv->x() + 0.5) * 0.5 - 0.5, 1e-9);
+  EXPECT_NEAR(uv_small->y(), (uv->y() + 0.5) * 0.5 - 0.5, 1e-9);
   EXPECT_THROW(MakeRigPreset("rovo4").Scaled(0.0), std::invalid_argument);
 }
 
