@@ -4,6 +4,7 @@
 #include "scenes/scene.h"
 
 #include <OpenImageIO/imageio.h>
+#include <tbb/parallel_for.h>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -291,6 +292,7 @@ void SaveScene(const Scene& scene, const std::string& dir) {
                       {"exposure", static_cast<double>(l.exposure)}};
 
   json textures = json::array();
+  std::vector<std::string> png_names(scene.textures.size());
   for (size_t i = 0; i < scene.textures.size(); ++i) {
     const Texture& t = scene.textures[i];
     if (t.width <= 0 || t.height <= 0 || t.rgb.size() != static_cast<size_t>(t.width) * t.height * 3) {
@@ -298,9 +300,12 @@ void SaveScene(const Scene& scene, const std::string& dir) {
     }
     char name[64];
     std::snprintf(name, sizeof(name), "textures/%03zu.png", i);
-    WritePng((fs::path(dir) / name).string(), t);
+    png_names[i] = name;
     textures.push_back({{"name", t.name}, {"file", name}, {"width", t.width}, {"height", t.height}});
   }
+  // PNG encoding dominates saving; textures are independent files.
+  tbb::parallel_for(size_t{0}, scene.textures.size(),
+                    [&](size_t i) { WritePng((fs::path(dir) / png_names[i]).string(), scene.textures[i]); });
   root["textures"] = textures;
 
   json materials = json::array();
