@@ -8,7 +8,7 @@ For export frame k (Blender frame A + k, the same numbering as export_scene.py) 
 multilayer OpenEXR (float32) with the passes of view layer 'ViewLayer':
   ViewLayer.Combined.{R,G,B,A}  scene-linear colour
   ViewLayer.Depth.Z             ray length in metres (see below); 1e10 where no surface was hit
-and OUT/cycles.json with the settings and the seconds of every view (wall time of the whole
+and OUT/cycles.json with the settings and the seconds of every view (wall and CPU time of the whole
 render call: scene sync, BVH build, path tracing and writing).
 
 Depth: for panoramic cameras Cycles' Depth pass is the distance from the camera position to the
@@ -109,17 +109,17 @@ def main():
                 path = os.path.join(args.out, "cam%d" % i, "%06d.exr" % k)
                 tmp = rb.atomic_path(path) + ".exr"
                 scene.render.filepath = tmp
-                t0 = time.perf_counter()
+                t0, c0 = time.perf_counter(), time.process_time()
                 bpy.ops.render.render(write_still=True)
-                seconds = time.perf_counter() - t0
+                seconds, cpu_seconds = time.perf_counter() - t0, time.process_time() - c0
                 if not os.path.exists(tmp):
                     raise rb.ExportError("Cycles wrote no image for camera '%s' frame %d" % (cam.name, frame))
                 os.replace(tmp, path)
                 if os.path.exists(tmp[:-4]):
                     os.remove(tmp[:-4])
                 views.append({"frame": k, "blender_frame": frame, "camera": i, "blender_camera": cam.name,
-                              "seconds": seconds})
-                print("cycles: frame %d camera %d: %.2f s" % (frame, i, seconds), flush=True)
+                              "seconds": seconds, "cpu_seconds": cpu_seconds})
+                print("cycles: frame %d camera %d: %.2f s (%.2f CPU s)" % (frame, i, seconds, cpu_seconds), flush=True)
         total = time.perf_counter() - t_all
         summary = {
             "generator": "rovo scenes/blender/cycles_reference.py",

@@ -20,8 +20,8 @@ What is exported (depsgraph-evaluated, i.e. with modifiers applied, at the first
     found upstream of it (then base_color = 1). Images are written as 8-bit sRGB PNG, top row
     first; UV v is flipped (rovo: v down from the top-left corner, Blender: v up from bottom-left).
   * lighting: the first render-enabled Sun lamp: direction_to_sun = its local +z,
-    sun_radiance = colour * strength / pi (so that albedo * sun_radiance * cos equals the radiance
-    Cycles computes for a Lambertian surface), angular diameter = its angle; world Background
+    sun_radiance = colour * strength (irradiance; the renderer shades albedo * sun_radiance * cos / pi,
+    the radiance Cycles computes for a Lambertian surface), angular diameter = its angle; world Background
     colour * strength -> uniform sky (zenith = horizon) with ambient 1; exposure from the film and
     view transform exposure.
   * rig: an Empty named 'rig' (or --rig NAME) whose children are Cycles FISHEYE_EQUIDISTANT
@@ -328,7 +328,7 @@ class Exporter:
                 self.warn("%d sun lamps; exporting '%s' only" % (len(suns), sun.name))
             z = sun.matrix_world.to_3x3().normalized().col[2]
             light["direction_to_sun"] = [z.x, z.y, z.z]
-            k = sun.data.energy / math.pi
+            k = sun.data.energy  # W/m^2 irradiance; the renderer divides by pi (Lambertian)
             light["sun_radiance"] = [sun.data.color[0] * k, sun.data.color[1] * k, sun.data.color[2] * k]
             light["sun_angular_diameter_deg"] = math.degrees(sun.data.angle)
         others = [o.name for o in scene.objects if o.type == "LIGHT" and o.data.type != "SUN" and not o.hide_render]

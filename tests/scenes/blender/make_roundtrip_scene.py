@@ -1,7 +1,7 @@
 """Builds the small Blender scene of the Blender round-trip test and saves it as a .blend.
 
     blender -b --factory-startup --python tests/scenes/blender/make_roundtrip_scene.py -- OUT.blend
-            [--size N] [--frames N]
+            [--size N] [--height N] [--frames N]
 
 Contents (chosen to exercise every exporter path): a textured open-top room (a cube scaled
 non-uniformly: scale baking, two material slots), textured and plain boxes (rotated, one with a negative scale), a
@@ -24,7 +24,8 @@ def args():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     p = argparse.ArgumentParser(prog="make_roundtrip_scene.py")
     p.add_argument("out")
-    p.add_argument("--size", type=int, default=192, help="square image size of each camera")
+    p.add_argument("--size", type=int, default=192, help="image width of each camera (square by default)")
+    p.add_argument("--height", type=int, default=0, help="image height (default: --size)")
     p.add_argument("--frames", type=int, default=2, help="number of frames (Blender 1..N)")
     return p.parse_args(argv)
 
@@ -81,7 +82,8 @@ def main():
     scene = bpy.context.scene
     scene.frame_start, scene.frame_end = 1, a.frames
     scene.render.fps, scene.render.fps_base = 10, 1.0
-    scene.render.resolution_x = scene.render.resolution_y = a.size
+    scene.render.resolution_x = a.size
+    scene.render.resolution_y = a.height or a.size
     scene.render.resolution_percentage = 100
     scene.render.engine = "CYCLES"
 
