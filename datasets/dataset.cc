@@ -650,7 +650,7 @@ std::vector<ValidationIssue> ValidateDataset(const std::string& dir) {
         issues.push_back({folder, "files", std::to_string(missing) + " frames missing in total"});
       }
       for (int frame : present) {
-        if (frame >= info.frame_count) {
+        if (info.frame_count > 0 && frame >= info.frame_count) {  // 0: /frame_count itself was bad
           issues.push_back({layer.path(dir, rc.name, frame), "file",
                             "frame " + std::to_string(frame) + " beyond dataset.json /frame_count " +
                                 std::to_string(info.frame_count)});

@@ -7,6 +7,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -114,6 +116,18 @@ TEST(Validate, ReportsAllProblemsNotJustTheFirst) {
   WriteFileAtomic((fs::path(dir) / "groundtruth.tum").string(), "0 0 0 0 0 0 0 1\n");
   const std::vector<ValidationIssue> issues = ValidateDataset(dir);
   EXPECT_GE(issues.size(), 3u);
+  fs::remove_all(dir);
+}
+
+TEST(Validate, BadFrameCountIsOneIssueNotOnePerImage) {
+  const std::string dir = MakeCase("");
+  nlohmann::json json = ReadJsonFile(DatasetJsonPath(dir));
+  json.erase("frame_count");
+  WriteJsonFileAtomic(DatasetJsonPath(dir), json);
+  const std::vector<ValidationIssue> issues = ValidateDataset(dir);
+  ASSERT_EQ(issues.size(), 1u);
+  EXPECT_EQ(issues[0].field, "/frame_count");
+  EXPECT_EQ(issues[0].file, DatasetJsonPath(dir));
   fs::remove_all(dir);
 }
 
