@@ -439,6 +439,8 @@ Scene GenerateScene(const std::string& preset_name, uint64_t seed, bool quick) {
   jobs.push_back([=] { return MakeBarkTexture(texture_seed); });
   const int t_foliage = static_cast<int>(jobs.size());
   jobs.push_back([=] { return MakeFoliageTexture(texture_seed); });
+  const int t_sign = static_cast<int>(jobs.size());
+  for (int k = 0; k < kSignKinds; ++k) jobs.push_back([=] { return MakeSignTexture(texture_seed, k); });
   scene.textures.resize(jobs.size());
   tbb::parallel_for(size_t{0}, jobs.size(), [&](size_t i) { scene.textures[i] = jobs[i](); });
 
@@ -579,6 +581,35 @@ Scene GenerateScene(const std::string& preset_name, uint64_t seed, bool quick) {
       b.Tri(jitter(tris[t]), jitter(tris[t + 1]), jitter(tris[t + 2]), uv(tris[t]), uv(tris[t + 1]), uv(tris[t + 2]), m_foliage);
     }
     mesh_tree[v] = AddMesh(scene, b.Finish());
+  }
+  // Road signs: pole and a 0.6 m plate whose face (sign texture) looks along the mesh's +x.
+  int mesh_sign[kSignKinds];
+  for (int k = 0; k < kSignKinds; ++k) {
+    MeshBuilder b("sign_" + std::to_string(k));
+    const int m_face = AddMaterial(scene, "sign_" + std::to_string(k), {1, 1, 1}, t_sign + k);
+    b.Prism({-0.05f, 0, 0}, 0.04f, 0.0f, 2.9f, 6, m_metal, m_metal);
+    const int plate[5] = {m_metal, m_face, m_metal, m_metal, m_metal};
+    b.Box({0.0f, -0.3f, 2.3f}, {0.025f, 0.3f, 2.9f}, plate);
+    mesh_sign[k] = AddMesh(scene, b.Finish());
+  }
+  // One sign at about half of the block corners, 0.7 m from both curbs, facing traffic on one of
+  // the two streets.
+  {
+    int signs = 0;
+    for (const Box2& blk : L.blocks) {
+      const bool inner_x = blk.min.x() > g.MinX() && blk.max.x() < g.MaxX();
+      const bool inner_y = blk.min.y() > g.MinY() && blk.max.y() < g.MaxY();
+      if (!inner_x && !inner_y) continue;  // outer corner blocks face no intersection
+      for (int corner = 0; corner < 4; ++corner) {
+        if (!rng.Bernoulli(0.5)) continue;
+        const double sx = corner & 1 ? 1.0 : -1.0, sy = corner & 2 ? 1.0 : -1.0;
+        const double x = (sx > 0 ? blk.max.x() : blk.min.x()) - 0.7 * sx, y = (sy > 0 ? blk.max.y() : blk.min.y()) - 0.7 * sy;
+        // Face traffic approaching along x (yaw 0 or pi) or along y (yaw +-pi/2) on this corner's side.
+        const double yaw = rng.Bernoulli(0.5) ? (sx > 0 ? 0.0 : M_PI) : (sy > 0 ? M_PI / 2 : -M_PI / 2);
+        AddStatic(scene, "sign_" + std::to_string(signs++), mesh_sign[rng.UniformInt(0, kSignKinds - 1)],
+                  PlaceYaw(x, y, yaw, kCurbHeight));
+      }
+    }
   }
   CarFactory cars(scene, car_tex);
   {

@@ -415,6 +415,7 @@ Scene LoadScene(const std::string& dir) {
 
   const Field jt = root["textures"];
   scene.textures.resize(jt.ArraySize());
+  std::vector<std::string> png_paths(scene.textures.size());
   for (size_t i = 0; i < scene.textures.size(); ++i) {
     const Field f = jt[i];
     Texture& t = scene.textures[i];
@@ -425,8 +426,12 @@ Scene LoadScene(const std::string& dir) {
     if (png.empty() || png[0] == '/' || png.find("..") != std::string::npos) {
       Fail(file, f.path() + ".file", "must be a relative path inside the scene folder");
     }
-    ReadPng((fs::path(dir) / png).string(), t, file, f.path() + ".file");
+    png_paths[i] = (fs::path(dir) / png).string();
   }
+  // PNG decoding dominates loading; the first failure (by TBB's rules) is rethrown here.
+  tbb::parallel_for(size_t{0}, scene.textures.size(), [&](size_t i) {
+    ReadPng(png_paths[i], scene.textures[i], file, "textures[" + std::to_string(i) + "].file");
+  });
 
   const Field jmat = root["materials"];
   scene.materials.resize(jmat.ArraySize());

@@ -3,6 +3,7 @@
 #include "scenes/rng.h"
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -600,6 +601,66 @@ Texture MakeBarkTexture(uint64_t seed) {
       c.At(x, y) = Color(v * 1.1f, v * 0.95f, v * 0.75f);
     }
   return c.ToTexture("bark");
+}
+
+Texture MakeSignTexture(uint64_t seed, int kind) {
+  SceneRng rng(SubSeed(seed, "sign", static_cast<uint64_t>(kind)));
+  const int N = 256;
+  const float c = N / 2.0f;
+  Canvas img(N, N, Gray(0.62f));
+  const Color red(0.8f, 0.08f, 0.06f), white = Gray(0.95f), blue(0.05f, 0.25f, 0.65f), black = Gray(0.05f);
+  auto fill = [&](const std::function<bool(float, float)>& inside, const Color& color) {
+    for (int y = 0; y < N; ++y)
+      for (int x = 0; x < N; ++x)
+        if (inside(x + 0.5f - c, y + 0.5f - c)) img.At(x, y) = color;
+  };
+  auto octagon = [](float r) {
+    return [r](float x, float y) {
+      return std::abs(x) < r && std::abs(y) < r && std::abs(x) + std::abs(y) < r * 1.414f;
+    };
+  };
+  auto disc = [](float r) { return [r](float x, float y) { return x * x + y * y < r * r; }; };
+  switch (kind) {
+    case 0:  // stop
+      fill(octagon(120), white);
+      fill(octagon(110), red);
+      for (int k = 0; k < 4; ++k) img.Rect(50 + k * 42, 105, 50 + k * 42 + 30, 150, white);
+      for (int k = 0; k < 4; ++k) img.Rect(58 + k * 42, 113, 50 + k * 42 + 22, 142, red);
+      break;
+    case 1:  // give way: inverted triangle
+      fill([](float x, float y) { return y > -110 && y < 110 && std::abs(x) < (110 - y) * 0.577f; }, red);
+      fill([](float x, float y) { return y > -85 && y < 75 && std::abs(x) < (75 - y) * 0.577f; }, white);
+      break;
+    case 2:  // no entry
+      fill(disc(120), white);
+      fill(disc(112), red);
+      img.Rect(40, 112, 216, 144, white);
+      break;
+    case 3: {  // speed limit: digits as blocks
+      fill(disc(120), white);
+      fill(disc(120), red);
+      fill(disc(96), white);
+      const int tens = rng.UniformInt(2, 6);
+      for (int d = 0; d < 2; ++d) {
+        const int x0 = 78 + d * 56;
+        img.Frame(x0, 82, x0 + 44, 174, 12, black);
+        if (d == 0 && tens % 2) img.Rect(x0 + 12, 122, x0 + 44, 134, black);
+      }
+      break;
+    }
+    default:  // pedestrian crossing: blue square, white triangle, walking figure
+      img.Rect(16, 16, 240, 240, white);
+      img.Rect(24, 24, 232, 232, blue);
+      fill([](float x, float y) { return y > -80 && y < 80 && std::abs(x) < (y + 80) * 0.6f; }, white);
+      img.Disc(c, c - 20, 12, black, 1.0f);
+      img.Line(c, c - 5, c - 6, c + 35, 5, black, 1.0f);
+      img.Line(c - 6, c + 35, c - 25, c + 65, 5, black, 1.0f);
+      img.Line(c - 6, c + 35, c + 18, c + 65, 5, black, 1.0f);
+      for (int k = 0; k < 4; ++k) img.Rect(70 + k * 30, 196, 88 + k * 30, 206, black);
+      break;
+  }
+  AddGrime(img, rng.Next(), 0.05f, 0.04f);
+  return img.ToTexture("sign_" + std::to_string(kind));
 }
 
 Texture MakeFoliageTexture(uint64_t seed) {

@@ -38,6 +38,10 @@ Texture MakeCarSideTexture(uint64_t seed);    // 512 x 128: doors, handles, sill
 Texture MakeCarEndTexture(uint64_t seed);     // 256 x 128: grille, lights, plate
 Texture MakeCarGlassTexture(uint64_t seed);   // 256 x 64: dark glass with pillars
 Texture MakeBarkTexture(uint64_t seed);
+// Road sign face, 256 x 256 px for a 0.6 m plate; kind in [0, kSignKinds): stop, give way, no
+// entry, speed limit, pedestrian crossing. Outside the sign shape: the grey plate.
+inline constexpr int kSignKinds = 5;
+Texture MakeSignTexture(uint64_t seed, int kind);
 Texture MakeFoliageTexture(uint64_t seed);
 
 }  // namespace rovo
