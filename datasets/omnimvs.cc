@@ -78,8 +78,17 @@ std::vector<double> ForwardParams(const OmniMvsCamera& cam, const std::string& w
       throw std::runtime_error(where + ".poly: degree above 4 is not supported (a" + std::to_string(i) + " != 0)");
     }
   }
-  std::vector<double> params = {cam.center_col, cam.center_row, cam.affine[0], cam.affine[1], cam.affine[2]};
-  for (size_t i = 0; i < 5; ++i) params.push_back(i < cam.poly.size() ? cam.poly[i] : 0.0);
+  // OCamCalib's convention, as OmniMVS reads it: (row, col) = [c d; e 1] (x_o, y_o) + (center_row,
+  // center_col), x_o along rows, and the OpenCV ray is (y_o, x_o, -poly(rho)). Our layout has x
+  // along columns and v's y-coefficient 1; scaling the sensor plane by c (X = c y_o, Y = c x_o)
+  // gives u = X / c + (e / c) Y + cx, v = (d / c) X + Y + cy, and the same rays with
+  // a'_i = a_i c^(1 - i) (see ReadOcamCalibTxt in ocam.h for the same mapping).
+  const double c = cam.affine[0], d = cam.affine[1], e = cam.affine[2];
+  if (!(std::abs(c) > 1e-6) || !(std::abs(c - d * e) > 1e-9)) {
+    throw std::runtime_error(where + ".affine: singular stretch matrix");
+  }
+  std::vector<double> params = {cam.center_col, cam.center_row, 1.0 / c, e / c, d / c};
+  for (size_t i = 0; i < 5; ++i) params.push_back((i < cam.poly.size() ? cam.poly[i] : 0.0) * std::pow(c, 1.0 - i));
   return params;
 }
 
@@ -103,8 +112,9 @@ RigCamera ConvertCamera(const OmniMvsCamera& cam, int index, const std::string& 
       std::snprintf(line, sizeof(line), "%s: refitted inverse polynomial (%zu coefficients) max error %.5f px\n",
                     rc.name.c_str(), rc.camera.params.size() - 10, fit_error_px);
     } else {
+      // The file's inverse gives rho in the unscaled sensor plane: b'_i = c b_i.
       std::vector<double> with_file_inverse = forward;
-      with_file_inverse.insert(with_file_inverse.end(), cam.inv_poly.begin(), cam.inv_poly.end());
+      for (double b : cam.inv_poly) with_file_inverse.push_back(b * cam.affine[0]);
       const double file_error_px = OcamInverseMaxErrorPx(with_file_inverse, cam.max_fov_deg);
       std::snprintf(line, sizeof(line),
                     "%s: file inv_poly (%zu coefficients) off by up to %.3f px; refitted (%zu coefficients) max "

@@ -16,8 +16,10 @@
 //   cam_from_rig = (rig_ours_from_rig_file * cam2rig)^-1.
 // Camera i of the file (cam_id i+1) becomes "cam<i>".
 //
-// Intrinsics become our ocam layout [cx, cy, c, d, e, a0..a4, b0..b(K-1)] with cx = col,
-// cy = row of the file's centre. The file's own inverse polynomial is NOT used: it disagrees with
+// Intrinsics: OmniMVS reads the file with OCamCalib's conventions (x_o along rows:
+// (row, col) = [c d; e 1] (x_o, y_o) + center, OpenCV ray (y_o, x_o, -poly)). In our ocam layout
+// [cx, cy, c', d', e', a0'..a4', b0..b(K-1)] (x along columns) that is, after scaling the sensor
+// plane by c: cx = col, cy = row, c' = 1/c, d' = e/c, e' = d/c, a'_i = a_i c^(1-i). The file's own inverse polynomial is NOT used: it disagrees with
 // its forward polynomial by pixels; the inverse is refitted (FitOcamInversePolynomial) over the
 // full field of view.
 

@@ -102,16 +102,17 @@ Rig MakeRovo4() {
   return rig;
 }
 
-// OmniMVS synthetic rig: four ideal equidistant 220-degree lenses, 800x768 (width x height), on a
-// circle of radius 0.6 m facing 0, 90, 180 and -90 degrees of yaw. f = 200 px puts the 110-degree
-// rim at 384 px from the centre, i.e. on the top and bottom image edges.
+// OmniMVS synthetic rig: four ideal equidistant 220-degree lenses, 800x768 (width x height, as the
+// OmniMVS synthetic config.yaml's image_size [768, 800]), centre (col 399, row 383) as in that file,
+// f = 191.5 px (its ocam polynomial maps 30/60/90 degrees to 191.4-191.6 px per radian), on a
+// circle of radius 0.6 m facing 0, 90, 180 and -90 degrees of yaw.
 Rig MakeOmniMvs4() {
   Camera camera;
   camera.model = CameraModelId::kEquidistant;
   camera.width = 800;
   camera.height = 768;
   camera.max_fov_deg = 220.0;
-  camera.params = {200.0, 200.0, 399.5, 383.5, 0.0, 0.0, 0.0, 0.0};
+  camera.params = {191.5, 191.5, 399.0, 383.0, 0.0, 0.0, 0.0, 0.0};
   const double yaws_deg[4] = {0.0, 90.0, 180.0, -90.0};
   Rig rig;
   for (int i = 0; i < 4; ++i) {

@@ -47,7 +47,46 @@ TEST(OmniMvs, ImportRefitsAndReportsTheFilesInverseError) {
   // center is [row, col]: cx (column) = 811.661, cy (row) = 756.215.
   EXPECT_DOUBLE_EQ(rig.cameras[0].camera.params[0], 811.661);
   EXPECT_DOUBLE_EQ(rig.cameras[0].camera.params[1], 756.215);
-  EXPECT_DOUBLE_EQ(rig.cameras[1].camera.params[3], -0.032979);  // affine d
+  // Affine [c, d, e] of OCamCalib (x along rows) -> ours (x along columns): 1/c, e/c, d/c.
+  EXPECT_DOUBLE_EQ(rig.cameras[1].camera.params[2], 1.0 / 1.00028);
+  EXPECT_DOUBLE_EQ(rig.cameras[1].camera.params[3], 0.0327437 / 1.00028);
+  EXPECT_DOUBLE_EQ(rig.cameras[1].camera.params[4], -0.032979 / 1.00028);
+}
+
+// Bearing of pixel (col, row) computed directly in the file's conventions (the yaml header):
+// (row - center_row, col - center_col) = [c d; e 1] (x_o, y_o), ray = (y_o, x_o, -poly(rho)).
+Eigen::Vector3d FileBearing(double col, double row, const double center[2], const double affine[3],
+                            const double poly[5]) {
+  const double dr = row - center[0], dc = col - center[1];
+  const double det = affine[0] - affine[1] * affine[2];
+  const double x_o = (dr - affine[1] * dc) / det;
+  const double y_o = (affine[0] * dc - affine[2] * dr) / det;
+  const double rho = std::hypot(x_o, y_o);
+  double z = 0.0;
+  for (int i = 4; i >= 0; --i) z = z * rho + poly[i];
+  return Eigen::Vector3d(y_o, x_o, -z).normalized();
+}
+
+TEST(OmniMvs, PixelBearingsMatchTheFileConvention) {
+  const Rig rig = ReadOmniMvsConfig(kConfig, nullptr);
+  // Camera 2 of the file (cam1 here) has the largest skew (d = -0.033, e = 0.033).
+  const double center[2] = {793.1, 817.845};
+  const double affine[3] = {1.00028, -0.032979, 0.0327437};
+  const double poly[5] = {-393.2636335626606, 0.0, 0.0013030161088532755,
+                          -1.8689651365463267E-6, 2.3792432009042225E-9};
+  const Camera& camera = rig.cameras[1].camera;
+  for (double col : {100.0, 500.0, 817.845, 1000.0, 1500.0}) {
+    for (double row : {80.0, 400.0, 793.1, 1100.0, 1450.0}) {
+      const Eigen::Vector3d expected = FileBearing(col, row, center, affine, poly);
+      if (AngleBetween(expected, Eigen::Vector3d::UnitZ()) > 109.0 * M_PI / 180.0) continue;
+      const auto bearing = camera.Unproject(Eigen::Vector2d(col, row));
+      ASSERT_TRUE(bearing.has_value()) << col << " " << row;
+      EXPECT_LT(AngleBetween(*bearing, expected), 1e-9) << col << " " << row;
+      const auto uv = camera.Project(expected);
+      ASSERT_TRUE(uv.has_value());
+      EXPECT_LT((*uv - Eigen::Vector2d(col, row)).norm(), 0.01) << col << " " << row;
+    }
+  }
 }
 
 TEST(OmniMvs, EmbeddedPresetEqualsImport) {
