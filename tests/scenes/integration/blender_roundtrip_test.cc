@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -69,59 +70,48 @@ std::vector<float> ReadExrChannel(const std::string& path, const std::string& ch
   return data;
 }
 
-class BlenderRoundTrip : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    work_ = (fs::path(::testing::TempDir()) / "rovo_blender_roundtrip").string();
-    fs::remove_all(work_);
-    fs::create_directories(work_);
-    log_ = work_ + "/log.txt";
+// The pipeline's folders; Run() makes the scene, exports it and renders it both ways.
+struct RoundTrip {
+  std::string work, log, blend, exported, cycles, dataset;
+
+  // Returns "" on success, else which step failed with the log's tail.
+  std::string Run() {
+    work = (fs::path(::testing::TempDir()) / ("rovo_blender_roundtrip_" + std::to_string(getpid()))).string();
+    fs::remove_all(work);
+    fs::create_directories(work);
+    log = work + "/log.txt";
+    blend = work + "/roundtrip.blend";
+    exported = work + "/exported";
+    cycles = work + "/cycles";
+    dataset = work + "/dataset";
     const std::string src = ROVO_SOURCE_DIR;
     const std::string blender = "blender -b --factory-startup ";
-    blend_ = work_ + "/roundtrip.blend";
-    exported_ = work_ + "/exported";
-    cycles_ = work_ + "/cycles";
-    dataset_ = work_ + "/dataset";
-    if (RunShell("command -v blender", log_) != 0) {
-      setup_error_ = "blender is not on PATH (Debian package `blender`)";
-      return;
-    }
+    if (RunShell("command -v blender", log) != 0) return "blender is not on PATH (Debian package `blender`)";
     struct Step {
       std::string name, command;
     };
     const std::vector<Step> steps = {
-        {"make scene", blender + "--python-exit-code 1 --python " + Quote(src + "/tests/scenes/blender/make_roundtrip_scene.py") +
-                           " -- " + Quote(blend_) + " --size " + std::to_string(kImageSize) + " --frames " +
-                           std::to_string(kFrames)},
-        {"export", blender + Quote(blend_) + " --python-exit-code 1 --python " +
-                       Quote(src + "/scenes/blender/export_scene.py") + " -- " + Quote(exported_)},
-        {"cycles", blender + Quote(blend_) + " --python-exit-code 1 --python " +
-                       Quote(src + "/scenes/blender/cycles_reference.py") + " -- " + Quote(cycles_) +
+        {"make scene", blender + "--python-exit-code 1 --python " +
+                           Quote(src + "/tests/scenes/blender/make_roundtrip_scene.py") + " -- " + Quote(blend) +
+                           " --size " + std::to_string(kImageSize) + " --frames " + std::to_string(kFrames)},
+        {"export", blender + Quote(blend) + " --python-exit-code 1 --python " +
+                       Quote(src + "/scenes/blender/export_scene.py") + " -- " + Quote(exported)},
+        {"cycles", blender + Quote(blend) + " --python-exit-code 1 --python " +
+                       Quote(src + "/scenes/blender/cycles_reference.py") + " -- " + Quote(cycles) +
                        " --samples 16 --threads 2"},
-        {"rovo render", Quote(ROVO_BINARY) + " render --scene " + Quote(exported_) + " --rig " +
-                            Quote(exported_ + "/rig.json") + " --out " + Quote(dataset_) +
+        {"rovo render", Quote(ROVO_BINARY) + " render --scene " + Quote(exported) + " --rig " +
+                            Quote(exported + "/rig.json") + " --out " + Quote(dataset) +
                             " --depth --spp 1 --threads 2 --quiet"},
     };
     for (const Step& step : steps) {
-      if (RunShell(step.command, log_) != 0) {
-        setup_error_ = step.name + " failed:\n" + Tail(log_);
-        return;
-      }
+      if (RunShell(step.command, log) != 0) return step.name + " failed:\n" + Tail(log);
     }
+    return "";
   }
-
-  void SetUp() override {
-    ASSERT_TRUE(setup_error_.empty()) << setup_error_;
-  }
-
-  static std::string work_, log_, blend_, exported_, cycles_, dataset_, setup_error_;
 };
 
-std::string BlenderRoundTrip::work_, BlenderRoundTrip::log_, BlenderRoundTrip::blend_, BlenderRoundTrip::exported_,
-    BlenderRoundTrip::cycles_, BlenderRoundTrip::dataset_, BlenderRoundTrip::setup_error_;
-
-TEST_F(BlenderRoundTrip, ExportedSceneLoadsWithExpectedContent) {
-  const Scene scene = LoadScene(exported_);
+void CheckExportedScene(const RoundTrip& rt) {
+  const Scene scene = LoadScene(rt.exported);
   EXPECT_EQ(scene.metadata.preset, "blender");
   EXPECT_EQ(scene.frame_rate, 10.0);
   ASSERT_EQ(scene.rig_trajectory.size(), static_cast<size_t>(kFrames));
@@ -172,7 +162,7 @@ TEST_F(BlenderRoundTrip, ExportedSceneLoadsWithExpectedContent) {
   EXPECT_NEAR(scene.lighting.sun_radiance.x(), 3.0, 1e-5);
   EXPECT_NEAR(scene.lighting.sky_zenith.z(), 0.7, 1e-6);
 
-  const Rig rig = ReadRigJson(exported_ + "/rig.json");
+  const Rig rig = ReadRigJson(rt.exported + "/rig.json");
   ASSERT_EQ(rig.NumCameras(), kCameras);
   const double fov = 220.0 * M_PI / 180.0;
   for (const RigCamera& cam : rig.cameras) {
@@ -188,7 +178,7 @@ TEST_F(BlenderRoundTrip, ExportedSceneLoadsWithExpectedContent) {
   EXPECT_NEAR(CameraYawDeg(rig.cameras[1].cam_from_rig), 135.0, 1e-4);
 }
 
-TEST_F(BlenderRoundTrip, DepthAgreesWithCyclesPixelByPixel) {
+void CheckDepthAgainstCycles(const RoundTrip& rt) {
   long common = 0, agree = 0, hit_mismatch = 0, cycles_hits = 0;
   double sum_rel = 0.0;
   for (int frame = 0; frame < kFrames; ++frame) {
@@ -196,8 +186,8 @@ TEST_F(BlenderRoundTrip, DepthAgreesWithCyclesPixelByPixel) {
       char name[32];
       std::snprintf(name, sizeof(name), "cam%d/%06d.exr", cam, frame);
       int w = 0, h = 0, cw = 0, ch = 0;
-      const std::vector<float> ours = ReadExrChannel(dataset_ + "/depth/" + name, "", &w, &h);
-      const std::vector<float> ref = ReadExrChannel(cycles_ + "/" + name, "ViewLayer.Depth.Z", &cw, &ch);
+      const std::vector<float> ours = ReadExrChannel(rt.dataset + "/depth/" + name, "", &w, &h);
+      const std::vector<float> ref = ReadExrChannel(rt.cycles + "/" + name, "ViewLayer.Depth.Z", &cw, &ch);
       ASSERT_EQ(w, cw);
       ASSERT_EQ(h, ch);
       long view_common = 0, view_agree = 0;
@@ -256,16 +246,16 @@ std::vector<float> Luminance(const std::string& path, bool cycles) {
 // Cycles at 16 spp is noisy), but textures, UV orientation and materials must line up: the
 // normalised cross-correlation of the luminance over pixels that hit geometry in both is high
 // (a texture flipped in v turns the wall checkers' correlation negative).
-TEST_F(BlenderRoundTrip, ColourCorrelatesWithCycles) {
+void CheckColourAgainstCycles(const RoundTrip& rt) {
   double worst = 1.0;
   for (int frame = 0; frame < kFrames; ++frame) {
     for (int cam = 0; cam < kCameras; ++cam) {
       char name[32];
       std::snprintf(name, sizeof(name), "cam%d/%06d", cam, frame);
       int w = 0, h = 0;
-      const std::vector<float> depth = ReadExrChannel(cycles_ + "/" + name + ".exr", "ViewLayer.Depth.Z", &w, &h);
-      const std::vector<float> ours = Luminance(dataset_ + "/" + name + ".png", false);
-      const std::vector<float> ref = Luminance(cycles_ + "/" + name + ".exr", true);
+      const std::vector<float> depth = ReadExrChannel(rt.cycles + "/" + name + ".exr", "ViewLayer.Depth.Z", &w, &h);
+      const std::vector<float> ours = Luminance(rt.dataset + "/" + name + ".png", false);
+      const std::vector<float> ref = Luminance(rt.cycles + "/" + name + ".exr", true);
       ASSERT_EQ(ours.size(), ref.size());
       double n = 0, sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
       for (size_t i = 0; i < ours.size(); ++i) {
@@ -287,14 +277,39 @@ TEST_F(BlenderRoundTrip, ColourCorrelatesWithCycles) {
   EXPECT_GT(worst, 0.8);
 }
 
-TEST_F(BlenderRoundTrip, ExportedRigMatchesBlenderRayCast) {
+void CheckRigWithBlenderRayCast(const RoundTrip& rt) {
   // Independent of `rovo render`: Blender's own ray caster through the exported rig.json and
   // trajectory against the Cycles depth (lens mapping, camera axes, extrinsics, trajectory).
-  const std::string command = "blender -b --factory-startup " + Quote(blend_) + " --python-exit-code 1 --python " +
+  const std::string command = "blender -b --factory-startup " + Quote(rt.blend) + " --python-exit-code 1 --python " +
                               Quote(std::string(ROVO_SOURCE_DIR) + "/tests/scenes/blender/check_lens_raycast.py") +
-                              " -- " + Quote(exported_) + " " + Quote(cycles_) + " --stride 6 --min-agree 0.99";
-  const std::string log = work_ + "/raycast_log.txt";
+                              " -- " + Quote(rt.exported) + " " + Quote(rt.cycles) + " --stride 6 --min-agree 0.99";
+  const std::string log = rt.work + "/raycast_log.txt";
   EXPECT_EQ(RunShell(command, log), 0) << Tail(log);
+}
+
+// One test (one pipeline run; CTest runs each gtest case in its own process): scene, export,
+// Cycles and rovo renders take about a minute on 2 idle cores.
+TEST(BlenderRoundTrip, ExportRenderAndCompareWithCycles) {
+  RoundTrip rt;
+  const std::string error = rt.Run();
+  ASSERT_TRUE(error.empty()) << error;
+  {
+    SCOPED_TRACE("exported scene and rig");
+    CheckExportedScene(rt);
+  }
+  {
+    SCOPED_TRACE("depth vs Cycles");
+    CheckDepthAgainstCycles(rt);
+  }
+  {
+    SCOPED_TRACE("colour vs Cycles");
+    CheckColourAgainstCycles(rt);
+  }
+  {
+    SCOPED_TRACE("Blender ray cast through the exported rig");
+    CheckRigWithBlenderRayCast(rt);
+  }
+  if (!::testing::Test::HasFailure()) fs::remove_all(rt.work);
 }
 
 }  // namespace
