@@ -397,7 +397,7 @@ Scene GenerateScene(const std::string& preset_name, uint64_t seed, bool quick) {
   const ScenePreset& preset = FindScenePreset(preset_name);
   const CityLayout L = MakeCityLayout(preset, seed, quick);
   const CityStyle& st = L.style;
-  const uint64_t layout_seed = SubSeed(seed, (preset.name == "cloudy_urban" || preset.name == "sunset_urban") ? "town" : preset.name.c_str());
+  const uint64_t layout_seed = LayoutSeed(preset.name, seed);
   const uint64_t texture_seed = SubSeed(layout_seed, "textures");
   SceneRng rng(SubSeed(layout_seed, "props"));
 

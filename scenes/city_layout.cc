@@ -22,12 +22,12 @@ constexpr double kMaxSpeed = 30.0;
 
 const Eigen::Vector2i kDirs[4] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
 
-std::string LayoutFamily(const std::string& preset) {
-  if (preset == "cloudy_urban" || preset == "sunset_urban") return "town";
-  return preset;
-}
-
 }  // namespace
+
+uint64_t LayoutSeed(const std::string& preset, uint64_t seed) {
+  const bool town = preset == "cloudy_urban" || preset == "sunset_urban";
+  return SubSeed(seed, town ? "town" : preset.c_str());
+}
 
 CityStyle StyleForPreset(const std::string& preset) {
   CityStyle s;
@@ -354,7 +354,7 @@ CityLayout MakeCityLayout(const ScenePreset& preset, uint64_t seed, bool quick) 
   L.style = StyleForPreset(preset.name);
   L.quick = quick;
   const CityStyle& st = L.style;
-  const uint64_t layout_seed = SubSeed(seed, LayoutFamily(preset.name).c_str());
+  const uint64_t layout_seed = LayoutSeed(preset.name, seed);
   SceneRng rng(SubSeed(layout_seed, "plan"));
 
   const int frames = quick ? preset.quick_frames : preset.frames;

@@ -136,6 +136,10 @@ struct CityLayout {
 // a family (cloudy_urban, sunset_urban) share streets and buildings for the same seed.
 CityLayout MakeCityLayout(const ScenePreset& preset, uint64_t seed, bool quick);
 
+// Seed of everything that shapes the world (plan, textures, props) for a preset and user seed.
+// cloudy_urban and sunset_urban share one layout family, so they share it.
+uint64_t LayoutSeed(const std::string& preset, uint64_t seed);
+
 // Quick-form path length: the full length scaled by the frame ratio (same speeds).
 double QuickPathLength(const ScenePreset& preset);
 
