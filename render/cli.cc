@@ -135,6 +135,9 @@ void AddRenderCommands(CliGroups& groups) {
     cmd->add_option("--scale", options->scale, "Image scale")->capture_default_str();
     cmd->add_option("--threads", options->threads, "Threads (default: all cores)");
     cmd->add_option("--spp", options->spp, "Default-quality spp (0 = the default)");
+    cmd->add_flag("--quality", options->quality,
+                  "Also measure anti-aliasing per spp / texture LOD bias: mean error vs. a 16-spp reference and "
+                  "frame-to-frame flicker of a camera nudged by quarter-pixel steps");
     cmd->add_option("--write", options->write_dir, "Also time a full `rovo render` of the frames into this folder");
     cmd->callback([options] { RunRenderBenchmark(*options); });
   }

@@ -51,6 +51,8 @@ void WriteExrFloat(const std::string& path, int width, int height, const std::ve
   spec.channelnames = {"Z"};
   spec.attribute("compression", "zip");
   spec.attribute("Software", "rovo " ROVO_VERSION);
+  // A fixed DateTime (OpenImageIO would stamp the wall clock) keeps reruns byte-identical.
+  spec.attribute("DateTime", "1970:01:01 00:00:00");
   WriteImage(path, "openexr", spec, values.data());
 }
 

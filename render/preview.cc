@@ -7,6 +7,7 @@
 #include <tbb/task_arena.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
@@ -19,6 +20,86 @@ namespace fs = std::filesystem;
 
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+// Process CPU seconds (user + system): stable on a shared machine where wall time is not.
+double CpuSeconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_utime.tv_sec + usage.ru_stime.tv_sec + 1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
+
+double MeanAbsDiff(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b, const std::vector<uint8_t>& valid) {
+  double sum = 0.0;
+  size_t n = 0;
+  for (size_t i = 0; i < valid.size(); ++i) {
+    if (!valid[i]) continue;
+    for (int c = 0; c < 3; ++c) sum += std::abs(static_cast<int>(a[3 * i + c]) - static_cast<int>(b[3 * i + c]));
+    n += 3;
+  }
+  return n ? sum / n : 0.0;
+}
+
+// Renders camera 0 of frame 0 nudged by quarter-pixel yaw steps and prints, per (spp, LOD bias),
+// the mean absolute difference to a 16-spp reference and the shimmer (frame-to-frame change that
+// deviates from the reference's change).
+void RunQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, const CameraRays& rays,
+                     tbb::task_arena& arena) {
+  const int kSteps = 5;
+  const Rigid3 world_from_cam =
+      scene.rig_trajectory[0].world_from_rig * rig.cameras[0].cam_from_rig.Inverse();
+  const size_t centre = static_cast<size_t>(rays.height / 2) * rays.width + rays.width / 2;
+  const double step_rad = 0.25 * rays.pixel_angle[centre];
+  auto render_steps = [&](int spp, float lod_bias) {
+    std::vector<std::vector<uint8_t>> images;
+    ShadeSettings settings;
+    settings.spp = spp;
+    settings.lod_bias = lod_bias;
+    for (int k = 0; k < kSteps; ++k) {
+      // Yaw about the camera's y axis (image columns shift by about k/4 px at the centre).
+      const Rigid3 nudge = Rigid3::FromAxisAngle(Eigen::Vector3d(0, k * step_rad, 0), Eigen::Vector3d::Zero());
+      CameraImage image;
+      arena.execute([&] {
+        tracer.SetFrame(0);
+        tracer.Render(rays, world_from_cam * nudge, settings, &image);
+      });
+      images.push_back(std::move(image.rgb));
+    }
+    return images;
+  };
+  // Shimmer: how far the frame-to-frame change deviates from the reference's change,
+  // mean |(I_k - I_k-1) - (R_k - R_k-1)| (a perfectly filtered image moves like the reference).
+  auto shimmer = [&](const std::vector<std::vector<uint8_t>>& images, const std::vector<std::vector<uint8_t>>& ref) {
+    double sum = 0.0;
+    size_t n = 0;
+    for (int k = 1; k < kSteps; ++k) {
+      for (size_t i = 0; i < rays.valid.size(); ++i) {
+        if (!rays.valid[i]) continue;
+        for (int c = 0; c < 3; ++c) {
+          const int d_img = images[k][3 * i + c] - images[k - 1][3 * i + c];
+          const int d_ref = ref[k][3 * i + c] - ref[k - 1][3 * i + c];
+          sum += std::abs(d_img - d_ref);
+          ++n;
+        }
+      }
+    }
+    return n ? sum / n : 0.0;
+  };
+  const auto reference = render_steps(16, 0.0f);
+  std::printf("\nanti-aliasing (camera 0, %dx%d, %d quarter-pixel yaw steps; 8-bit units, mean over valid pixels)\n",
+              rays.width, rays.height, kSteps);
+  std::printf("| spp | LOD bias | mean abs error vs 16 spp | shimmer vs 16 spp | CPU s/view |\n");
+  std::printf("|---:|---:|---:|---:|---:|\n");
+  for (int spp : {1, 2, 4, 8}) {
+    for (float bias : {-1.0f, -0.5f, 0.0f}) {
+      const double cpu0 = CpuSeconds();
+      const auto images = render_steps(spp, bias);
+      const double cpu = (CpuSeconds() - cpu0) / kSteps;
+      double error = 0.0;
+      for (int k = 0; k < kSteps; ++k) error += MeanAbsDiff(images[k], reference[k], rays.valid);
+      std::printf("| %d | %+.1f | %.3f | %.3f | %.3f |\n", spp, bias, error / kSteps, shimmer(images, reference), cpu);
+    }
+  }
 }
 
 double PeakMemoryMb() {
@@ -110,6 +191,7 @@ void RunRenderBenchmark(const RenderBenchOptions& options) {
     int spp;
     bool raw;
     double seconds_per_frame = 0;
+    double cpu_seconds_per_frame = 0;
   };
   std::vector<Row> rows = {{"raw cast (primary + sun shadow)", 1, true},
                            {"full render", 1, false},
@@ -123,6 +205,7 @@ void RunRenderBenchmark(const RenderBenchOptions& options) {
     // One untimed warm-up frame, then the timed frames.
     for (int pass = 0; pass < 2; ++pass) {
       const auto t = std::chrono::steady_clock::now();
+      const double cpu0 = CpuSeconds();
       const int n = pass == 0 ? 1 : frames;
       for (int f = 0; f < n; ++f) {
         arena.execute([&] {
@@ -132,7 +215,10 @@ void RunRenderBenchmark(const RenderBenchOptions& options) {
             tracer->Render(rays[c], world_from_rig * rig.cameras[c].cam_from_rig.Inverse(), settings, &images[c]);
         });
       }
-      if (pass == 1) row.seconds_per_frame = Seconds(t) / frames;
+      if (pass == 1) {
+        row.seconds_per_frame = Seconds(t) / frames;
+        row.cpu_seconds_per_frame = (CpuSeconds() - cpu0) / frames;
+      }
     }
   }
 
@@ -160,17 +246,23 @@ void RunRenderBenchmark(const RenderBenchOptions& options) {
               "pixel bearings %.2f s\n",
               tracer->num_static_triangles(), scene.objects.size(), scene_seconds, tracer->static_build_seconds(),
               rays_seconds);
-  std::printf("\n| mode | spp | s/frame | camera Mrays/s |\n|---|---:|---:|---:|\n");
+  std::printf("\n| mode | spp | wall s/frame | CPU s/frame | camera Mrays/s (wall) | camera Mrays/CPU-s |\n"
+              "|---|---:|---:|---:|---:|---:|\n");
   for (const Row& row : rows) {
-    const double mrays = valid_pixels * static_cast<double>(row.spp) / row.seconds_per_frame / 1e6;
-    std::printf("| %s | %d | %.3f | %.1f |\n", row.name.c_str(), row.spp, row.seconds_per_frame, mrays);
+    const double rays_per_frame = valid_pixels * static_cast<double>(row.spp);
+    std::printf("| %s | %d | %.3f | %.3f | %.1f | %.1f |\n", row.name.c_str(), row.spp, row.seconds_per_frame,
+                row.cpu_seconds_per_frame, rays_per_frame / row.seconds_per_frame / 1e6,
+                rays_per_frame / row.cpu_seconds_per_frame / 1e6);
   }
-  std::printf("\nfull/raw at 1 spp: %.2f (target <= 1.5); full/raw at %d spp: %.2f\n",
-              rows[1].seconds_per_frame / rows[0].seconds_per_frame, spp_default,
-              rows[3].seconds_per_frame / rows[2].seconds_per_frame);
+  std::printf("\nfull/raw at 1 spp: wall %.2f, CPU %.2f (target <= 1.5); full/raw at %d spp: wall %.2f, CPU %.2f\n",
+              rows[1].seconds_per_frame / rows[0].seconds_per_frame,
+              rows[1].cpu_seconds_per_frame / rows[0].cpu_seconds_per_frame, spp_default,
+              rows[3].seconds_per_frame / rows[2].seconds_per_frame,
+              rows[3].cpu_seconds_per_frame / rows[2].cpu_seconds_per_frame);
   if (write_seconds_per_frame >= 0.0)
     std::printf("rovo render incl. PNG writing (%d spp): %.3f s/frame\n", spp_default, write_seconds_per_frame);
   std::printf("peak memory (getrusage): %.0f MB\n", PeakMemoryMb());
+  if (options.quality) RunQualityStudy(scene, rig, *tracer, rays[0], arena);
 }
 
 }  // namespace rovo

@@ -85,6 +85,7 @@ struct RenderBenchOptions {
   int threads = 0;
   int spp = 0;                 // default-quality spp (0 = kDefaultSpp)
   std::string write_dir;       // if set, also time full dataset writing into this folder
+  bool quality = false;        // also measure aliasing: error vs. a 16-spp reference and flicker
 };
 void RunRenderBenchmark(const RenderBenchOptions& options);
 

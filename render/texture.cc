@@ -29,8 +29,12 @@ MipTexture::MipTexture(const Texture& texture) {
   Level base;
   base.width = texture.width;
   base.height = texture.height;
-  base.rgb.resize(texture.rgb.size());
-  for (size_t i = 0; i < texture.rgb.size(); ++i) base.rgb[i] = lut[texture.rgb[i]];
+  const size_t n = static_cast<size_t>(texture.width) * texture.height;
+  base.rgba.resize(n * 4);
+  for (size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) base.rgba[4 * i + c] = lut[texture.rgb[3 * i + c]];
+    base.rgba[4 * i + 3] = 1.0f;
+  }
   levels_.push_back(std::move(base));
   texels_per_uv_ = std::sqrt(static_cast<float>(texture.width) * static_cast<float>(texture.height));
 
@@ -40,21 +44,25 @@ MipTexture::MipTexture(const Texture& texture) {
     Level dst;
     dst.width = std::max(1, src.width / 2);
     dst.height = std::max(1, src.height / 2);
-    dst.rgb.resize(static_cast<size_t>(dst.width) * dst.height * 3);
+    dst.rgba.resize(static_cast<size_t>(dst.width) * dst.height * 4);
     for (int y = 0; y < dst.height; ++y) {
       const int y0 = std::min(2 * y, src.height - 1), y1 = std::min(2 * y + 1, src.height - 1);
       for (int x = 0; x < dst.width; ++x) {
         const int x0 = std::min(2 * x, src.width - 1), x1 = std::min(2 * x + 1, src.width - 1);
-        for (int c = 0; c < 3; ++c) {
-          const float sum = src.rgb[(static_cast<size_t>(y0) * src.width + x0) * 3 + c] +
-                            src.rgb[(static_cast<size_t>(y0) * src.width + x1) * 3 + c] +
-                            src.rgb[(static_cast<size_t>(y1) * src.width + x0) * 3 + c] +
-                            src.rgb[(static_cast<size_t>(y1) * src.width + x1) * 3 + c];
-          dst.rgb[(static_cast<size_t>(y) * dst.width + x) * 3 + c] = 0.25f * sum;
+        for (int c = 0; c < 4; ++c) {
+          const float sum = src.rgba[(static_cast<size_t>(y0) * src.width + x0) * 4 + c] +
+                            src.rgba[(static_cast<size_t>(y0) * src.width + x1) * 4 + c] +
+                            src.rgba[(static_cast<size_t>(y1) * src.width + x0) * 4 + c] +
+                            src.rgba[(static_cast<size_t>(y1) * src.width + x1) * 4 + c];
+          dst.rgba[(static_cast<size_t>(y) * dst.width + x) * 4 + c] = 0.25f * sum;
         }
       }
     }
     levels_.push_back(std::move(dst));
+  }
+  for (Level& l : levels_) {
+    l.fwidth = static_cast<float>(l.width);
+    l.fheight = static_cast<float>(l.height);
   }
 }
 
@@ -64,44 +72,66 @@ Eigen::Vector3f MipTexture::Texel(int level, int x, int y) const {
   if (x < 0) x += l.width;
   y %= l.height;
   if (y < 0) y += l.height;
-  const float* p = &l.rgb[(static_cast<size_t>(y) * l.width + x) * 3];
+  const float* p = &l.rgba[(static_cast<size_t>(y) * l.width + x) * 4];
   return Eigen::Vector3f(p[0], p[1], p[2]);
 }
 
-Eigen::Vector3f MipTexture::SampleLevel(float u, float v, int level) const {
+namespace {
+
+// Wraps a texel index into [0, size).
+inline int WrapIndex(float index, int size, float fsize) {
+  if (std::abs(index) < 1e9f) {
+    if ((size & (size - 1)) == 0) return static_cast<int>(index) & (size - 1);  // power of two
+    int i = static_cast<int>(index) % size;
+    return i < 0 ? i + size : i;
+  }
+  return std::min(size - 1, std::max(0, static_cast<int>(index - fsize * std::floor(index / fsize))));
+}
+
+}  // namespace
+
+__m128 MipTexture::SampleLevel4(float u, float v, int level) const {
   const Level& l = levels_[level];
   // Texel centres sit at (i + 0.5) / width in UV.
-  const float fu = u * l.width - 0.5f;
-  const float fv = v * l.height - 0.5f;
+  const float fu = u * l.fwidth - 0.5f;
+  const float fv = v * l.fheight - 0.5f;
   const float x0f = std::floor(fu), y0f = std::floor(fv);
-  const float ax = fu - x0f, ay = fv - y0f;
-  // Wrap once in floating point so that huge UVs do not overflow int.
-  const int x0 = static_cast<int>(x0f - l.width * std::floor(x0f / l.width));
-  const int y0 = static_cast<int>(y0f - l.height * std::floor(y0f / l.height));
-  const int xa = std::min(x0, l.width - 1);
-  const int ya = std::min(y0, l.height - 1);
+  const int xa = WrapIndex(x0f, l.width, l.fwidth);
+  const int ya = WrapIndex(y0f, l.height, l.fheight);
   const int xb = xa + 1 == l.width ? 0 : xa + 1;
   const int yb = ya + 1 == l.height ? 0 : ya + 1;
-  const float* r0 = &l.rgb[static_cast<size_t>(ya) * l.width * 3];
-  const float* r1 = &l.rgb[static_cast<size_t>(yb) * l.width * 3];
-  Eigen::Vector3f out;
-  for (int c = 0; c < 3; ++c) {
-    const float top = r0[xa * 3 + c] + ax * (r0[xb * 3 + c] - r0[xa * 3 + c]);
-    const float bottom = r1[xa * 3 + c] + ax * (r1[xb * 3 + c] - r1[xa * 3 + c]);
-    out[c] = top + ay * (bottom - top);
-  }
-  return out;
+  const float* r0 = &l.rgba[static_cast<size_t>(ya) * l.width * 4];
+  const float* r1 = &l.rgba[static_cast<size_t>(yb) * l.width * 4];
+  const __m128 ax = _mm_set1_ps(fu - x0f), ay = _mm_set1_ps(fv - y0f);
+  const __m128 t00 = _mm_loadu_ps(r0 + 4 * xa), t10 = _mm_loadu_ps(r0 + 4 * xb);
+  const __m128 t01 = _mm_loadu_ps(r1 + 4 * xa), t11 = _mm_loadu_ps(r1 + 4 * xb);
+  const __m128 top = _mm_add_ps(t00, _mm_mul_ps(ax, _mm_sub_ps(t10, t00)));
+  const __m128 bottom = _mm_add_ps(t01, _mm_mul_ps(ax, _mm_sub_ps(t11, t01)));
+  return _mm_add_ps(top, _mm_mul_ps(ay, _mm_sub_ps(bottom, top)));
+}
+
+Eigen::Vector3f MipTexture::SampleLevel(float u, float v, int level) const {
+  alignas(16) float out[4];
+  _mm_store_ps(out, SampleLevel4(u, v, level));
+  return Eigen::Vector3f(out[0], out[1], out[2]);
 }
 
 Eigen::Vector3f MipTexture::Sample(float u, float v, float lod) const {
-  if (!(lod > 0.0f)) return SampleLevel(u, v, 0);  // also catches NaN
   const int last = NumLevels() - 1;
-  if (lod >= static_cast<float>(last)) return SampleLevel(u, v, last);
-  const int l0 = static_cast<int>(lod);
-  const float a = lod - static_cast<float>(l0);
-  const Eigen::Vector3f c0 = SampleLevel(u, v, l0);
-  if (a <= 0.0f) return c0;
-  return c0 + a * (SampleLevel(u, v, l0 + 1) - c0);
+  __m128 c;
+  if (!(lod > 0.0f)) {  // also catches NaN
+    c = SampleLevel4(u, v, 0);
+  } else if (lod >= static_cast<float>(last)) {
+    c = SampleLevel4(u, v, last);
+  } else {
+    const int l0 = static_cast<int>(lod);
+    const float a = lod - static_cast<float>(l0);
+    c = SampleLevel4(u, v, l0);
+    if (a > 0.0f) c = _mm_add_ps(c, _mm_mul_ps(_mm_set1_ps(a), _mm_sub_ps(SampleLevel4(u, v, l0 + 1), c)));
+  }
+  alignas(16) float out[4];
+  _mm_store_ps(out, c);
+  return Eigen::Vector3f(out[0], out[1], out[2]);
 }
 
 }  // namespace rovo

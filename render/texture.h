@@ -16,6 +16,8 @@
 
 #include <vector>
 
+#include <xmmintrin.h>
+
 namespace rovo {
 
 class MipTexture {
@@ -36,12 +38,15 @@ class MipTexture {
   Eigen::Vector3f SampleLevel(float u, float v, int level) const;
   // Texel of one level (wrapped coordinates), linear RGB.
   Eigen::Vector3f Texel(int level, int x, int y) const;
+  // Bilinear lookup as an SSE register (r, g, b, 1).
+  __m128 SampleLevel4(float u, float v, int level) const;
 
  private:
   struct Level {
     int width = 0;
     int height = 0;
-    std::vector<float> rgb;  // linear, 3 floats per texel, row-major
+    float fwidth = 0.0f, fheight = 0.0f;
+    std::vector<float> rgba;  // linear, 4 floats per texel (alpha unused, for SSE loads), row-major
   };
   std::vector<Level> levels_;
   float texels_per_uv_ = 1.0f;

@@ -102,32 +102,50 @@ CameraRays CameraRays::Make(const Camera& camera, int threads) {
   } else {
     run();
   }
-  // Angular pixel size: mean angle to the right and lower neighbours (left/upper at the borders).
-  float fallback = 0.0f;
-  for (int y = 0; y < camera.height; ++y) {
-    for (int x = 0; x < camera.width; ++x) {
-      const size_t i = static_cast<size_t>(y) * camera.width + x;
-      if (!rays.valid[i]) continue;
-      ++rays.num_valid;
-      float sum = 0.0f;
-      int count = 0;
-      const int nx = x + 1 < camera.width ? x + 1 : x - 1;
-      const int ny = y + 1 < camera.height ? y + 1 : y - 1;
-      for (const size_t j : {static_cast<size_t>(y) * camera.width + nx, static_cast<size_t>(ny) * camera.width + x}) {
-        if (nx < 0 || ny < 0 || !rays.valid[j]) continue;
-        const Eigen::Vector3f& a = rays.bearing[i];
-        const Eigen::Vector3f& b = rays.bearing[j];
-        sum += std::atan2(a.cross(b).norm(), a.dot(b));
-        ++count;
+  // Angular pixel size: mean angle to the valid neighbours among right/left and down/up.
+  auto angle = [&](size_t i, size_t j) {
+    const Eigen::Vector3f& a = rays.bearing[i];
+    const Eigen::Vector3f& b = rays.bearing[j];
+    return std::atan2(a.cross(b).norm(), a.dot(b));
+  };
+  auto pixel_angles = [&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& r) {
+      for (int y = r.begin(); y < r.end(); ++y) {
+        for (int x = 0; x < camera.width; ++x) {
+          const size_t i = static_cast<size_t>(y) * camera.width + x;
+          if (!rays.valid[i]) continue;
+          float sum = 0.0f;
+          int count = 0;
+          for (const int dx : {1, -1}) {
+            const int nx = x + dx;
+            if (nx < 0 || nx >= camera.width || !rays.valid[i + dx]) continue;
+            sum += angle(i, i + dx);
+            ++count;
+            break;
+          }
+          for (const int dy : {1, -1}) {
+            const int ny = y + dy;
+            const size_t j = static_cast<size_t>(ny) * camera.width + x;
+            if (ny < 0 || ny >= camera.height || !rays.valid[j]) continue;
+            sum += angle(i, j);
+            ++count;
+            break;
+          }
+          // An isolated valid pixel: use the equidistant estimate max_fov / diameter.
+          rays.pixel_angle[i] = count > 0 ? sum / count
+                                          : static_cast<float>(camera.max_fov_deg * M_PI / 180.0 /
+                                                               std::max(camera.width, camera.height));
+        }
       }
-      if (count > 0) {
-        rays.pixel_angle[i] = sum / count;
-        fallback = rays.pixel_angle[i];
-      } else {
-        rays.pixel_angle[i] = fallback;
-      }
-    }
+    });
+  };
+  if (threads > 0) {
+    tbb::task_arena arena(threads);
+    arena.execute(pixel_angles);
+  } else {
+    pixel_angles();
   }
+  for (uint8_t v : rays.valid) rays.num_valid += v;
   return rays;
 }
 
@@ -269,6 +287,9 @@ Tracer::Tracer(const Scene& scene) : impl_(std::make_unique<Impl>(scene)) {
 
   const auto start = std::chrono::steady_clock::now();
   d.static_scene = rtcNewScene(d.device);
+  // Robust mode keeps the triangle test watertight along edges shared by separate meshes (a ray
+  // exactly along a room corner must not slip through).
+  rtcSetSceneFlags(d.static_scene, RTC_SCENE_FLAG_ROBUST);
   rtcSetSceneBuildQuality(d.static_scene, RTC_BUILD_QUALITY_HIGH);
   d.object_rotation.assign(scene.objects.size(), Eigen::Matrix3f::Identity());
   d.mesh_scenes.assign(scene.meshes.size(), nullptr);
@@ -279,6 +300,7 @@ Tracer::Tracer(const Scene& scene) : impl_(std::make_unique<Impl>(scene)) {
     if (obj.IsDynamic()) {
       if (!d.mesh_scenes[obj.mesh]) {
         RTCScene ms = rtcNewScene(d.device);
+        rtcSetSceneFlags(ms, RTC_SCENE_FLAG_ROBUST);
         rtcSetSceneBuildQuality(ms, RTC_BUILD_QUALITY_HIGH);
         RTCGeometry g = d.MakeTriangles(mesh, nullptr, RTC_BUILD_QUALITY_HIGH);
         rtcAttachGeometry(ms, g);
@@ -301,7 +323,7 @@ Tracer::Tracer(const Scene& scene) : impl_(std::make_unique<Impl>(scene)) {
   d.CheckDevice("building the static scene");
 
   d.top = rtcNewScene(d.device);
-  rtcSetSceneFlags(d.top, RTC_SCENE_FLAG_DYNAMIC);
+  rtcSetSceneFlags(d.top, static_cast<RTCSceneFlags>(RTC_SCENE_FLAG_DYNAMIC | RTC_SCENE_FLAG_ROBUST));
   rtcSetSceneBuildQuality(d.top, RTC_BUILD_QUALITY_LOW);
   {
     RTCGeometry inst = rtcNewGeometry(d.device, RTC_GEOMETRY_TYPE_INSTANCE);

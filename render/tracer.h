@@ -65,7 +65,7 @@ struct ShadeSettings {
   bool shadows = true;
   bool soft_shadows = true;     // sample the sun disc (Lighting::sun_angular_diameter_deg)
   bool textures = true;
-  float lod_bias = 0.0f;        // added to the texture level of detail
+  float lod_bias = -0.5f;       // added to the texture level of detail (measured: render/README.md)
   bool want_depth = false;      // fill CameraImage::depth
   bool want_mask = false;       // fill CameraImage::mask
   bool raw_cast_only = false;   // benchmark: intersect the camera rays, no shading, no output

@@ -169,7 +169,7 @@ TEST(TracerTest, DynamicObjectFollowsItsPerFrameTransform) {
                                       testing::kMoverHalf, &t_cube) &&
                         t_cube < t_room;
       const double t = cube ? t_cube : t_room;
-      EXPECT_NEAR(image.depth[i], t, 1e-3);
+      EXPECT_NEAR(image.depth[i], t, 1e-3) << "frame " << frame << " pixel " << i % camera.width << "," << i / camera.width << " cube " << cube;
       if (cube && std::abs(image.depth[i] - t) < 1e-3) {
         EXPECT_EQ(image.mask[i], 7);
         ++mover_pixels;
