@@ -36,8 +36,9 @@ cv::Mat ReadGray(const std::string& path) {
   return image;
 }
 
-// Ray length in metres (channel 0), CV_32F.
-cv::Mat ReadDepth(const std::string& path) {
+}  // namespace
+
+cv::Mat ReadDepthImage(const std::string& path) {
   auto input = OIIO::ImageInput::open(path);
   if (!input) throw std::runtime_error(path + ": cannot read depth: " + OIIO::geterror());
   const OIIO::ImageSpec& spec = input->spec();
@@ -54,16 +55,19 @@ cv::Mat ReadDepth(const std::string& path) {
   return depth;
 }
 
+namespace {
+
 float DepthAt(const cv::Mat& depth, const Eigen::Vector2d& px) {
   const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
   if (u < 0 || v < 0 || u >= depth.cols || v >= depth.rows) return 0.0f;
   return depth.at<float>(v, u);
 }
 
-// Ground-truth verdict of a match (see the header). Returns -1 when A has no depth (not counted).
-int GroundTruthInlier(const Rig& rig, int camera_a, const Eigen::Vector3d& bearing_a, const Eigen::Vector2d& fisheye_a,
-                      int camera_b, const Eigen::Vector2d& fisheye_b, const cv::Mat& depth_a, const cv::Mat& depth_b,
-                      double inlier_px) {
+}  // namespace
+
+int GroundTruthMatchVerdict(const Rig& rig, int camera_a, const Eigen::Vector3d& bearing_a, const Eigen::Vector2d& fisheye_a,
+                            int camera_b, const Eigen::Vector2d& fisheye_b, const cv::Mat& depth_a, const cv::Mat& depth_b,
+                            double inlier_px) {
   const float range = DepthAt(depth_a, fisheye_a);
   if (!(range > 0.0f) || !std::isfinite(range)) return -1;
   const Rigid3& a_from_rig = rig.cameras[camera_a].cam_from_rig;
@@ -83,6 +87,8 @@ int GroundTruthInlier(const Rig& rig, int camera_a, const Eigen::Vector3d& beari
   }
   return 0;
 }
+
+namespace {
 
 struct DrawnMatch {
   cv::Point2f a, b;
@@ -188,7 +194,7 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
     std::vector<cv::Mat> images(n), depths(n);
     tbb::parallel_for(0, n, [&](int i) {
       images[i] = ReadGray(ImagePath(options.dataset_dir, rig.cameras[i].name, t));
-      depths[i] = ReadDepth(DepthPath(options.dataset_dir, rig.cameras[i].name, t));
+      depths[i] = ReadDepthImage(DepthPath(options.dataset_dir, rig.cameras[i].name, t));
     });
     frontend.Process(images);
 
@@ -258,7 +264,7 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
             if (!fa || !fb) continue;
           }
           const Eigen::Vector3d bearing_a = rig.cameras[a].cam_from_rig.RotationMatrix() * da;
-          const int verdict = GroundTruthInlier(rig, a, bearing_a, *fa, b, *fb, depths[a], depths[b], options.inlier_px);
+          const int verdict = GroundTruthMatchVerdict(rig, a, bearing_a, *fa, b, *fb, depths[a], depths[b], options.inlier_px);
           if (verdict < 0) continue;
           ++arm->matches;
           arm->inliers += verdict;
@@ -276,7 +282,7 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
       const auto fa = frontend.projection(m.camera_a).FisheyeFromWarped(Eigen::Vector2d(pa.x, pa.y));
       const auto fb = frontend.projection(m.camera_b).FisheyeFromWarped(Eigen::Vector2d(pb.x, pb.y));
       if (!bearing_a || !fa || !fb) continue;
-      const int verdict = GroundTruthInlier(rig, m.camera_a, *bearing_a, *fa, m.camera_b, *fb, depths[m.camera_a],
+      const int verdict = GroundTruthMatchVerdict(rig, m.camera_a, *bearing_a, *fa, m.camera_b, *fb, depths[m.camera_a],
                                             depths[m.camera_b], options.inlier_px);
       if (verdict < 0) continue;
       ++result.matches_frontend;

@@ -18,12 +18,28 @@
 // Outputs in --out: table.md, study.json (numbers, dataset seed, settings), matches_hybrid.png and
 // matches_fisheye.png (one neighbour pair of the last frame; green = inlier, red = outlier).
 
+#include "datasets/rig.h"
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
 #include <cstdint>
 #include <string>
 
 namespace rovo {
 
 struct CliGroups;
+
+// Depth image (EXR, channel 0 = ray length in metres, 0 = none) as CV_32F; throws naming the file.
+cv::Mat ReadDepthImage(const std::string& path);
+
+// Ground-truth verdict of an inter-view match: feature A (unit bearing in camera A and its fisheye
+// pixel) and feature B (fisheye pixel), with both cameras' depth images. 1 = inlier (A's depth
+// point reprojects within inlier_px of B and is not occluded in B), 0 = outlier, -1 = A has no
+// depth (not counted).
+int GroundTruthMatchVerdict(const Rig& rig, int camera_a, const Eigen::Vector3d& bearing_a_in_cam,
+                            const Eigen::Vector2d& fisheye_a, int camera_b, const Eigen::Vector2d& fisheye_b,
+                            const cv::Mat& depth_a, const cv::Mat& depth_b, double inlier_px);
 
 struct ProjectionStudyOptions {
   std::string dataset_dir;

@@ -1,0 +1,80 @@
+// Front-end speed at full size (rovo4: 4 x 1600x1532 ocam views) on textured synthetic images that
+// move by one pixel per frame. Reports ms per frame by stage as counters (warp, track, detect,
+// match) and the CPU time of all threads per frame (cpu_ms). Run: build/vo/rovo_vo_benchmark --benchmark_filter=Frontend
+#include "datasets/rig.h"
+#include "vo/frontend.h"
+
+#include <benchmark/benchmark.h>
+#include <opencv2/imgproc.hpp>
+
+#include <ctime>
+#include <vector>
+
+namespace rovo {
+namespace {
+
+cv::Mat Texture(int width, int height, uint64_t seed) {
+  cv::Mat image(height, width, CV_8UC1);
+  cv::RNG rng(seed);
+  rng.fill(image, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 2.0);
+  cv::normalize(image, image, 0, 255, cv::NORM_MINMAX);
+  for (int k = 0; k < 3000; ++k) {
+    cv::rectangle(image, cv::Rect(rng.uniform(0, width), rng.uniform(0, height), rng.uniform(8, 50), rng.uniform(8, 50)),
+                  cv::Scalar(rng.uniform(0, 255)), cv::FILLED);
+  }
+  return image;
+}
+
+void BM_FrontendFullSize(benchmark::State& state) {
+  const Rig rig = MakeRigPreset("rovo4");
+  FrontendOptions options;
+  options.target_features_per_view = static_cast<int>(state.range(0));
+  Frontend frontend(rig, options);
+  std::vector<std::vector<cv::Mat>> frames(2);
+  for (int i = 0; i < rig.NumCameras(); ++i) {
+    const cv::Mat base = Texture(rig.cameras[i].camera.width + 4, rig.cameras[i].camera.height + 4, 100 + i);
+    for (int k = 0; k < 2; ++k) {
+      frames[k].push_back(base(cv::Rect(k, k, rig.cameras[i].camera.width, rig.cameras[i].camera.height)).clone());
+    }
+  }
+  frontend.Process(frames[0]);
+  double warp = 0, track = 0, detect = 0, match = 0;
+  int64_t iterations = 0, features = 0;
+  const std::clock_t cpu_start = std::clock();  // process CPU time, all threads
+  for (auto _ : state) {
+    const FrontendFrame frame = frontend.Process(frames[(iterations + 1) % 2]);
+    warp += frame.ms_warp;
+    track += frame.ms_track;
+    detect += frame.ms_detect;
+    match += frame.ms_match;
+    for (const auto& f : frame.features_per_camera) features += static_cast<int64_t>(f.size());
+    ++iterations;
+  }
+  // CPU time of all threads per frame: on a loaded machine wall time says little; cpu_ms / 2 is the
+  // wall time two free cores would need at perfect scaling.
+  state.counters["cpu_ms"] = 1000.0 * static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC / iterations;
+  state.counters["ms_warp"] = warp / iterations;
+  state.counters["ms_track"] = track / iterations;
+  state.counters["ms_detect"] = detect / iterations;
+  state.counters["ms_match"] = match / iterations;
+  state.counters["features"] = static_cast<double>(features) / iterations;
+}
+BENCHMARK(BM_FrontendFullSize)->Arg(600)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+
+void BM_HybridWarpOneView(benchmark::State& state) {
+  const Rig rig = MakeRigPreset("rovo4");
+  const auto projections = HybridProjection::ForRig(rig);
+  const cv::Mat image = Texture(rig.cameras[0].camera.width, rig.cameras[0].camera.height, 7);
+  cv::Mat warped;
+  for (auto _ : state) {
+    projections[0].Warp(image, &warped);
+    benchmark::DoNotOptimize(warped.data);
+  }
+  state.counters["warped_width"] = projections[0].width();
+  state.counters["warped_height"] = projections[0].height();
+}
+BENCHMARK(BM_HybridWarpOneView)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace rovo
