@@ -291,7 +291,9 @@ class Exporter:
                 continue
             if inst.is_instance:
                 parent = inst.parent  # the instancer
-                if parent is not None and parent.original.hide_render:
+                if parent is not None and (parent.original.hide_render or parent.original == ob.original):
+                    # Hidden instancer, or an object's own evaluated geometry (curves and text are
+                    # also listed as an instance of themselves): exported once, as the object.
                     continue
             elif ob.original.hide_render:
                 continue
