@@ -44,6 +44,7 @@ from array import array
 
 import bpy
 
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import rovo_blender as rb  # noqa: E402
 
