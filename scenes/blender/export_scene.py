@@ -6,7 +6,8 @@
 Writes OUT/scene.json, OUT/geometry.bin, OUT/motion.bin, OUT/textures/*.png, OUT/trajectory.tum and,
 when the file has a rig, OUT/rig.json (datasets/FORMAT.md rig JSON); every file atomically.
 
-What is exported (depsgraph-evaluated, i.e. with modifiers applied, at the first exported frame):
+What is exported (depsgraph-evaluated, i.e. with modifiers applied at their viewport settings,
+since a background Blender evaluates a viewport depsgraph; at the first exported frame):
   * every visible, render-enabled mesh-like object (mesh, curve, surface, text, metaball) and every
     instance (collection instances, particles, geometry-node instances): triangulated with
     loop_triangles; vertices are split where UVs differ (one rovo vertex per distinct
