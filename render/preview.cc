@@ -260,7 +260,7 @@ void RunRenderBenchmark(const RenderBenchOptions& options) {
               rows[3].seconds_per_frame / rows[2].seconds_per_frame,
               rows[3].cpu_seconds_per_frame / rows[2].cpu_seconds_per_frame);
   if (write_seconds_per_frame >= 0.0)
-    std::printf("rovo render incl. PNG writing (%d spp): %.3f s/frame\n", spp_default, write_seconds_per_frame);
+    std::printf("rovo render incl. PNG writing (%d spp): %.3f s/frame (includes scene generation and set-up)\n", spp_default, write_seconds_per_frame);
   std::printf("peak memory (getrusage): %.0f MB\n", PeakMemoryMb());
   if (options.quality) RunQualityStudy(scene, rig, *tracer, rays[0], arena);
 }
