@@ -240,7 +240,8 @@ RunEvaluation EvaluateRun(const Trajectory& gt, const std::vector<Rigid3>& gt_ca
   RunMetrics& m = out.metrics;
   m.label = label;
   m.mode = run.info.value("mode", std::string());
-  if (run.info.contains("noise_set") && run.info["noise_set"].is_number_integer()) {
+  // GTExt uses no noise set, whatever run.json says.
+  if (m.mode != "gt" && run.info.contains("noise_set") && run.info["noise_set"].is_number_integer()) {
     m.noise_set = run.info["noise_set"].get<int>();
   }
   m.gt_frames = static_cast<int>(gt.size());

@@ -94,7 +94,7 @@ std::vector<ExtrinsicError> ExtrinsicErrors(const std::vector<ExtrinsicsRecord>&
 struct RunMetrics {
   std::string label;
   std::string mode;           // gt | noisy | online
-  int noise_set = -1;         // -1 when run.json does not say
+  int noise_set = -1;         // -1 for GTExt or when run.json does not say
   int gt_frames = 0;
   int estimated_frames = 0;
   int associated_frames = 0;
