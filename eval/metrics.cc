@@ -206,8 +206,12 @@ std::vector<ExtrinsicError> ExtrinsicErrors(const std::vector<ExtrinsicsRecord>&
       e.camera = camera;
       e.rotation_error_deg = RotationDistanceDeg(gt.rotation, est.rotation);
       e.translation_error_m = (est.translation - gt.translation).norm();
-      e.rpy_est_deg = RollPitchYawDegFromQuaternion(est.rotation);
-      e.rpy_gt_deg = RollPitchYawDegFromQuaternion(gt.rotation);
+      // Orientation of camera i relative to camera 0 in rig axes: C R_cam0_from_cami C^T with C the
+      // ground-truth rig_from_cam0 rotation (a horizontal ring of cameras reads as yaw offsets, far
+      // from the pitch = +-90 deg singularity that OpenCV camera axes would hit).
+      const Eigen::Quaterniond c = gt_rig_from_cam0.rotation;
+      e.rpy_est_deg = RollPitchYawDegFromQuaternion(c * est.rotation.conjugate() * c.conjugate());
+      e.rpy_gt_deg = RollPitchYawDegFromQuaternion(c * gt.rotation.conjugate() * c.conjugate());
       errors.push_back(e);
     }
   }

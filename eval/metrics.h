@@ -75,7 +75,9 @@ DriftResult RelativeDrift(const Trajectory& gt, const Trajectory& estimate, cons
 // Extrinsic error of camera i relative to camera 0 at one frame (the gauge of online calibration):
 //   cam_i_from_cam0 = cam_i_from_rig * cam0_from_rig^-1, estimated vs ground truth;
 //   rotation error = angle(gt^-1 est) in degrees, translation error = |t_est - t_gt| in metres.
-// Roll/pitch/yaw (degrees, datasets/rigid3.h convention) of cam_i_from_cam0 are kept for Fig. 8.
+// For Fig. 8, roll/pitch/yaw (degrees, datasets/rigid3.h convention) of camera i's orientation
+// relative to camera 0 expressed in rig axes, C R_cam0_from_cami C^T with C = gt rig_from_cam0
+// rotation (estimated and ground truth use the same C, so their difference is the error).
 struct ExtrinsicError {
   int frame = 0;
   double timestamp = 0.0;

@@ -7,7 +7,8 @@
 //   <out>/<label>/errors.csv      per associated frame: gt and aligned estimated position, error
 //   <out>/<label>/frames.csv      the run's per-frame records (inlier ratio, reprojection error)
 //   <out>/<label>/extrinsic_errors.csv  per frame and camera i >= 1: errors and roll/pitch/yaw of
-//                                       cam_i_from_cam0, estimated and ground truth
+//                                       camera i relative to camera 0 in rig axes (metrics.h),
+//                                       estimated and ground truth
 //   with --kitti: <out>/<label>/kitti_estimate.txt (aligned) and kitti_groundtruth.txt, line by line
 //   associated.
 

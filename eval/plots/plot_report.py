@@ -4,7 +4,7 @@
   trajectories.png      top view (x, y in the ground-truth world) of ground truth and every run,
                         after SE(3) alignment; colours as the paper's Fig. 5: black GT, red GTExt,
                         blue OnlineExt, green NoisyExt
-  extrinsics.png        roll / pitch / yaw of cam_i relative to cam 0 per frame (OnlineExt runs),
+  extrinsics.png        roll / pitch / yaw of cam_i relative to cam 0 (in rig axes) per frame (OnlineExt runs),
                         ground truth dotted (the paper's Fig. 8)
   frames.png            per-frame inlier ratio and mean angular reprojection error of inliers
   error_along_path.png  translation error after alignment against distance travelled
@@ -116,13 +116,15 @@ def plot_extrinsics(report, runs, out):
                 cam_rows = [r for r in rows if int(r["camera"]) == cam]
                 frames = column(cam_rows, "frame", int)
                 color, name = style(run)
-                ax.plot(frames, unwrap_deg(column(cam_rows, angle + "_est_deg")), color=color, lw=1.0,
-                        label=name, alpha=0.8)
+                gt_values = unwrap_deg(column(cam_rows, angle + "_gt_deg"))
+                # Each estimate within +-180 deg of its ground truth (the same angle, drawn next to it).
+                est_values = [e + 360.0 * round((g - e) / 360.0)
+                              for e, g in zip(column(cam_rows, angle + "_est_deg"), gt_values)]
+                ax.plot(frames, est_values, color=color, lw=1.0, label=name, alpha=0.8)
                 if not gt_drawn:
-                    ax.plot(frames, unwrap_deg(column(cam_rows, angle + "_gt_deg")), color="black", ls=":", lw=1.5,
-                            label="ground truth")
+                    ax.plot(frames, gt_values, color="black", ls=":", lw=1.5, label="ground truth")
                     gt_drawn = True
-            ax.set_title("cam%d rel. cam0: %s [deg]" % (cam, angle), fontsize=9)
+            ax.set_title("cam%d rel. cam0 (rig axes): %s [deg]" % (cam, angle), fontsize=9)
             ax.set_xlabel("frame", fontsize=8)
             ax.grid(alpha=0.3)
             if ci == 0 and ai == 0:
