@@ -80,7 +80,7 @@ struct BackendOptions {
   KeyframeOptions keyframes;
   bool local_ba = true;
   int window_keyframes = 6;          // sliding window size
-  int max_ba_landmarks = 1500;       // bound on BA size (landmarks with most observations)
+  int max_ba_landmarks = 800;        // bound on BA size (landmarks with most observations)
   int min_features = 20;             // fewer features in all views: frame lost (e.g. black image)
   int min_correspondences = 15;      // fewer 2D-3D correspondences: frame lost
   double min_inlier_ratio = 0.15;    // below: no consensus
