@@ -454,6 +454,12 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    // Shadow rays towards a wide sun disc are not coherent; Embree 3.13's coherent stream path
+    // never returned for such rays (a 30-degree overcast sun hung the render), so they go
+    // through the incoherent path.
+    RTCIntersectContext shadow_context;
+    rtcInitIntersectContext(&shadow_context);
+    shadow_context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
     for (int i = 0; i < kTilePixels; ++i) {
       tb.sum[i].setZero();
       tb.count[i] = 0;
@@ -604,7 +610,7 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
         ++num_shadow;
       }
       if (num_shadow == 0) continue;
-      rtcOccluded1M(d.top, &context, tb.shadow, static_cast<unsigned>(num_shadow), sizeof(RTCRay));
+      rtcOccluded1M(d.top, &shadow_context, tb.shadow, static_cast<unsigned>(num_shadow), sizeof(RTCRay));
       if (settings.raw_cast_only) continue;
       for (int k = 0; k < num_shadow; ++k) {
         // Embree sets tfar to -inf for occluded rays.
