@@ -1,0 +1,92 @@
+// Front-end on a small rendered dataset (cloudy_urban, quick form, with depth): accepted inter-view
+// matches are checked against the depth ground truth, and the projection study runs end to end.
+#include "datasets/dataset.h"
+#include "vo/frontend.h"
+#include "vo/projection_study.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <unistd.h>
+
+namespace rovo {
+namespace {
+
+constexpr int kFrames = 4;
+
+class RenderedQuick : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new std::string((std::filesystem::temp_directory_path() /
+                            ("rovo_frontend_it_" + std::to_string(::getpid())))
+                               .string());
+    const std::string command = std::string(ROVO_BINARY) + " render --preset cloudy_urban --quick --depth --quiet --frames 0:" +
+                                std::to_string(kFrames) + " --out " + *dir_;
+    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  }
+  static void TearDownTestSuite() {
+    std::filesystem::remove_all(*dir_);
+    delete dir_;
+  }
+  static std::string* dir_;
+};
+std::string* RenderedQuick::dir_ = nullptr;
+
+TEST_F(RenderedQuick, AcceptedInterViewMatchesAreCorrect) {
+  const DatasetInfo info = ReadDatasetInfo(*dir_);
+  ASSERT_TRUE(info.has_depth);
+  const Rig& rig = info.rig;
+  Frontend frontend(rig, FrontendOptions{});
+  int64_t counted = 0, inliers = 0, merged = 0;
+  for (int t = 0; t < kFrames; ++t) {
+    std::vector<cv::Mat> images;
+    std::vector<cv::Mat> depths;
+    for (const RigCamera& rc : rig.cameras) {
+      images.push_back(cv::imread(ImagePath(*dir_, rc.name, t), cv::IMREAD_GRAYSCALE));
+      ASSERT_FALSE(images.back().empty());
+      depths.push_back(ReadDepthImage(DepthPath(*dir_, rc.name, t)));
+    }
+    const FrontendFrame frame = frontend.Process(images);
+    merged += static_cast<int64_t>(frame.merged_ids.size());
+    for (int c = 0; c < rig.NumCameras(); ++c) EXPECT_GT(frame.features_per_camera[c].size(), 200u);
+    for (const Frontend::ViewMatch& m : frontend.last_matches()) {
+      const cv::Point2f pa = frontend.tracker(m.camera_a).points()[m.index_a].px;
+      const cv::Point2f pb = frontend.tracker(m.camera_b).points()[m.index_b].px;
+      const auto bearing = frontend.projection(m.camera_a).BearingFromWarped(Eigen::Vector2d(pa.x, pa.y));
+      const auto fa = frontend.projection(m.camera_a).FisheyeFromWarped(Eigen::Vector2d(pa.x, pa.y));
+      const auto fb = frontend.projection(m.camera_b).FisheyeFromWarped(Eigen::Vector2d(pb.x, pb.y));
+      ASSERT_TRUE(bearing && fa && fb);
+      const int verdict = GroundTruthMatchVerdict(rig, m.camera_a, *bearing, *fa, m.camera_b, *fb, depths[m.camera_a],
+                                                  depths[m.camera_b], 2.0);
+      if (verdict < 0) continue;
+      ++counted;
+      inliers += verdict;
+    }
+  }
+  EXPECT_GT(counted, 50);
+  EXPECT_GT(merged, 0);
+  EXPECT_GE(inliers, 0.9 * counted) << inliers << " of " << counted;
+}
+
+TEST_F(RenderedQuick, ProjectionStudyWritesItsTable) {
+  ProjectionStudyOptions options;
+  options.dataset_dir = *dir_;
+  options.out_dir = *dir_ + "/study";
+  options.frames = kFrames;
+  options.quiet = true;
+  const ProjectionStudyResult result = RunProjectionStudy(options);
+  EXPECT_EQ(result.frames, kFrames);
+  EXPECT_GT(result.tracked_pairs_hybrid, 500);
+  EXPECT_GT(result.tracked_pairs_fisheye, 500);
+  EXPECT_LT(result.hamming_hybrid, result.hamming_fisheye);
+  EXPECT_GT(result.InlierRatioHybrid(), result.InlierRatioFisheye());
+  for (const char* name : {"table.md", "study.json", "matches_hybrid.png", "matches_fisheye.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(options.out_dir + "/" + name)) << name;
+  }
+}
+
+}  // namespace
+}  // namespace rovo
