@@ -161,6 +161,7 @@ void AddGateCommand(CLI::App& root) {
         options.noise_sets = s.value("noise_sets", 1);
         options.scene_seed = s.value("scene_seed", uint64_t{0});
         options.vo_seed = s.value("vo_seed", uint64_t{0});
+        options.vo_threads = s.value("vo_threads", 0);
       } catch (const nlohmann::json::exception& e) {
         throw std::runtime_error(args->gates + ": field \"suite\": " + e.what());
       }

@@ -306,7 +306,7 @@ std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
     }
   }
   const int parallel = std::min<int>(options.jobs, std::max<int>(1, static_cast<int>(todo.size())));
-  const int threads_per_job = std::max(1, cores / parallel);
+  const int threads_per_job = options.vo_threads > 0 ? options.vo_threads : std::max(1, cores / parallel);
   {
     Progress progress("suite VO runs", static_cast<int64_t>(todo.size()), "runs", options.quiet);
     std::atomic<size_t> next{0};

@@ -29,6 +29,8 @@ struct SuiteOptions {
   int noise_sets = 1;                // K: NoisyExt/OnlineExt runs per preset (noise_set 0..K-1)
   int jobs = 1;                      // VO runs in parallel; each gets cores / jobs threads
   int threads = 0;                   // cores to use; 0 = all
+  int vo_threads = 0;                // threads of each VO run; 0 = cores / jobs. 1 makes OnlineExt
+                                     // runs reproducible (see vo/README: multi-thread online race)
   std::string data_dir;              // "" = <out>/data
   std::string out_dir;
   uint64_t scene_seed = 0;           // scene / render seed
