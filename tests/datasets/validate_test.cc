@@ -50,7 +50,10 @@ std::string MakeCase(const std::string& fault) {
   fs::copy(kFixtures / "valid", dir, fs::copy_options::recursive);
   if (fault.empty()) return dir.string();
   const fs::path fault_dir = kFixtures / "faults" / fault;
-  fs::copy(fault_dir / "overlay", dir, fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+  // A fault that only deletes files has no overlay (git does not keep empty folders).
+  if (fs::exists(fault_dir / "overlay")) {
+    fs::copy(fault_dir / "overlay", dir, fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+  }
   std::ifstream deletions(fault_dir / "delete.txt");
   std::string rel;
   while (std::getline(deletions, rel)) {
