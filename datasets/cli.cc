@@ -5,6 +5,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include <stdexcept>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -137,6 +139,20 @@ void AddDatasetCommands(CliGroups& groups) {
     WriteRigJson(import_options->out, imported, "omnimvs " + import_options->yaml);
     std::printf("wrote %s (%d cameras)\n", import_options->out.c_str(), imported.NumCameras());
   });
+}
+
+
+void ParseFrameRange(const std::string& text, int* begin, int* end) {
+  if (text.empty()) return;
+  const size_t colon = text.find(':');
+  if (colon == std::string::npos) throw std::invalid_argument("--frames '" + text + "': expected A:B");
+  try {
+    const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
+    *begin = a.empty() ? 0 : std::stoi(a);
+    *end = b.empty() ? -1 : std::stoi(b);
+  } catch (const std::exception&) {
+    throw std::invalid_argument("--frames '" + text + "': expected integers A:B");
+  }
 }
 
 }  // namespace rovo

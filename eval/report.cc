@@ -1,4 +1,5 @@
 #include "eval/report.h"
+#include "eval/format.h"
 
 #include "datasets/dataset.h"
 #include "datasets/io.h"
@@ -15,11 +16,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string Fmt(const char* format, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), format, value);
-  return buffer;
-}
 
 std::string FmtOpt(const char* format, const std::optional<double>& value) {
   return value ? Fmt(format, *value) : std::string("n/a");

@@ -1,4 +1,5 @@
 #include "eval/suite.h"
+#include "eval/format.h"
 
 #include "datasets/dataset.h"
 #include "datasets/io.h"
@@ -26,11 +27,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string Fmt(const char* format, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), format, value);
-  return buffer;
-}
 
 // "mean +- std" (std omitted for a single run).
 std::string FmtStat(const std::optional<Stat>& stat, const char* format, double factor = 1.0) {

@@ -12,18 +12,6 @@
 namespace rovo {
 namespace {
 
-// "A:B", "A:" or ":B" -> [A, B) with B = -1 for "to the end".
-void ParseFrameRange(const std::string& text, int* begin, int* end) {
-  const size_t colon = text.find(':');
-  if (colon == std::string::npos) throw std::invalid_argument("--frames '" + text + "': expected A:B");
-  try {
-    const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
-    *begin = a.empty() ? 0 : std::stoi(a);
-    *end = b.empty() ? -1 : std::stoi(b);
-  } catch (const std::exception&) {
-    throw std::invalid_argument("--frames '" + text + "': expected integers A:B");
-  }
-}
 
 void ParseShard(const std::string& text, int* index, int* count) {
   const size_t slash = text.find('/');

@@ -2,10 +2,7 @@
 #include "datasets/cli_groups.h"
 #include "vo/pipeline.h"
 
-#if __has_include("vo/projection_study.h")
 #include "vo/projection_study.h"
-#define ROVO_HAVE_PROJECTION_STUDY 1
-#endif
 
 #include <CLI/CLI.hpp>
 
@@ -17,19 +14,6 @@
 namespace rovo {
 namespace {
 
-// "A:B" (B exclusive; either side may be empty) -> [begin, end), end = -1 for "to the end".
-void ParseFrameRange(const std::string& text, int* begin, int* end) {
-  if (text.empty()) return;
-  const size_t colon = text.find(':');
-  if (colon == std::string::npos) throw std::invalid_argument("--frames: expected A:B, got '" + text + "'");
-  try {
-    const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
-    *begin = a.empty() ? 0 : std::stoi(a);
-    *end = b.empty() ? -1 : std::stoi(b);
-  } catch (const std::exception&) {
-    throw std::invalid_argument("--frames: expected integers A:B, got '" + text + "'");
-  }
-}
 
 struct VoArgs {
   VoOptions options;
@@ -109,9 +93,7 @@ void AddVoCommands(CliGroups& groups) {
     std::printf("whole pipeline: %.2f frames/s (target 10 Hz)\n", t.total > 0 ? 1000.0 / t.total : 0.0);
   });
 
-#ifdef ROVO_HAVE_PROJECTION_STUDY
   AddProjectionStudyCommand(groups);
-#endif
 }
 
 }  // namespace rovo
