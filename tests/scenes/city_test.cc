@@ -3,6 +3,8 @@
 #include "scenes/city_layout.h"
 #include "scenes/texture_gen.h"
 
+#include "tests/scenes/scratch_dir.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -18,24 +20,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path TestRoot() { return fs::temp_directory_path() / ("rovo_city_test_" + std::to_string(::getpid())); }
-
-// Removes this process's scratch folders after the last test.
-class RemoveTestRoot : public ::testing::Environment {
- public:
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(TestRoot(), ec);
-  }
-};
-[[maybe_unused]] ::testing::Environment* const kRemoveTestRoot = ::testing::AddGlobalTestEnvironment(new RemoveTestRoot);
-
-std::string FreshDir(const std::string& name) {
-  const fs::path dir = TestRoot() / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir.string();
-}
+using test::FreshDir;
 
 TEST(ScenePresets, TableOneOrderAndLookup) {
   const auto& presets = ScenePresets();

@@ -1,6 +1,8 @@
 #include "datasets/io.h"
 #include "scenes/scene.h"
 
+#include "tests/scenes/scratch_dir.h"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -15,24 +17,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path TestRoot() { return fs::temp_directory_path() / ("rovo_scene_io_test_" + std::to_string(::getpid())); }
-
-// Removes this process's scratch folders after the last test.
-class RemoveTestRoot : public ::testing::Environment {
- public:
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(TestRoot(), ec);
-  }
-};
-[[maybe_unused]] ::testing::Environment* const kRemoveTestRoot = ::testing::AddGlobalTestEnvironment(new RemoveTestRoot);
-
-std::string FreshDir(const std::string& name) {
-  const fs::path dir = TestRoot() / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir.string();
-}
+using test::FreshDir;
 
 // A small scene exercising every field: two textures, per-triangle materials, a mesh without UVs,
 // a static and a dynamic object, non-trivial quaternions.
