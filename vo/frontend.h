@@ -66,6 +66,10 @@ class Frontend {
   // on a wrong count, size or type.
   FrontendFrame Process(const std::vector<cv::Mat>& fisheye_images);
   void SetExtrinsics(const std::vector<Rigid3>& cam_from_rig);
+  // Inter-view filter thresholds from the next Process call on (the back-end loosens the epipolar
+  // and y filters while online calibration has not converged).
+  void SetMatchingOptions(const InterviewMatchOptions& matching);
+  const FrontendOptions& options() const;
 
   const HybridProjection& projection(int camera) const;
   int NumCameras() const;
