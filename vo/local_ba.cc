@@ -92,7 +92,12 @@ LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& option
   const int num_poses = static_cast<int>(problem.rig_from_world.size());
   const int num_cams = static_cast<int>(problem.cam_from_rig.size());
   if (num_poses < 1 || problem.observations.empty()) return report;
-  std::vector<PoseParams> poses(num_poses), cams(num_cams);
+  // Poses and extrinsics live in ONE array, poses first: Ceres orders the blocks of an elimination
+  // group by address, so two separate heap arrays would make the reduced system's order (and the
+  // floating-point result) depend on the heap layout, i.e. differ from run to run.
+  std::vector<PoseParams> blocks(num_poses + num_cams);
+  PoseParams* poses = blocks.data();
+  PoseParams* cams = blocks.data() + num_poses;
   for (int i = 0; i < num_poses; ++i) poses[i] = ToParams(problem.rig_from_world[i]);
   for (int j = 0; j < num_cams; ++j) cams[j] = ToParams(problem.cam_from_rig[j]);
   std::vector<double> baselines =
