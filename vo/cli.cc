@@ -41,6 +41,12 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
                   "RANSAC scoring: multiview (paper: all views) or single-view (ablation: one view)")
       ->check(CLI::IsMember({"multiview", "single-view"}))
       ->capture_default_str();
+  cmd->add_option("--online-prior", args->options.online_prior_deg,
+                  "OnlineExt: bound on the starting extrinsics' rotation error in degrees; the start-up "
+                  "calibration at the first frame matches with filters this loose (0: no start-up calibration, "
+                  "BA only)")
+      ->check(CLI::Range(0.0, 45.0))
+      ->capture_default_str();
   cmd->add_flag("--quiet", args->options.quiet, "No progress output");
 }
 

@@ -407,6 +407,45 @@ std::vector<cv::Mat> LoadFrameImages(const std::string& dataset_dir, const Rig& 
   return images;
 }
 
+// Inter-view filters loosened for an extrinsic rotation uncertainty of `uncertainty_deg`: the
+// epipolar angle grows with it, the rectified y-distance by the warped focal length times its tangent.
+InterviewMatchOptions LoosenedMatching(InterviewMatchOptions matching, double uncertainty_deg, double focal_px) {
+  matching.max_epipolar_angle_deg = std::max(matching.max_epipolar_angle_deg, uncertainty_deg);
+  matching.max_y_distance_px += focal_px * std::tan(uncertainty_deg * M_PI / 180.0);
+  return matching;
+}
+
+// OnlineExt start-up: rounds of (match at the first frame with filters loosened to the current
+// uncertainty -> CalibrateExtrinsicsFromFrame -> rebuild the warps), shrinking the uncertainty.
+std::vector<Rigid3> BootstrapExtrinsics(const VoOptions& options, const Rig& rig, std::vector<Rigid3> cam_from_rig) {
+  std::string problems;
+  const std::vector<cv::Mat> images = LoadFrameImages(options.dataset_dir, rig, options.frame_begin, &problems);
+  if (!problems.empty()) return cam_from_rig;  // the main loop reports the frame
+  const std::vector<double> baselines = RingBaselineLengths(cam_from_rig);
+  double uncertainty_deg = options.online_prior_deg;
+  for (int round = 0; round < options.online_bootstrap_rounds; ++round) {
+    Frontend probe(rig.WithExtrinsics(cam_from_rig), FrontendOptions{});
+    probe.SetMatchingOptions(LoosenedMatching(probe.options().matching, uncertainty_deg, probe.projection(0).focal_px()));
+    const FrontendFrame frame = probe.Process(images);
+    ExtrinsicBootstrapOptions bopt;
+    bopt.max_error_deg = uncertainty_deg;
+    const ExtrinsicBootstrapReport report = CalibrateExtrinsicsFromFrame(frame, cam_from_rig, baselines, bopt);
+    if (!options.quiet) {
+      std::fprintf(stderr,
+                   "vo online: start-up calibration round %d: uncertainty %.2f deg, %d shared points (>= %d per "
+                   "overlap), median error %.3f -> %.3f deg, largest change %.3f deg%s\n",
+                   round + 1, uncertainty_deg, report.num_points, report.points_per_pair_min,
+                   report.median_error_deg_before, report.median_error_deg_after, report.max_change_deg,
+                   report.usable ? "" : " (not usable: kept)");
+    }
+    if (!report.usable) break;
+    cam_from_rig = report.cam_from_rig;
+    uncertainty_deg = std::max(0.5, std::min(0.5 * uncertainty_deg, 3.0 * report.max_change_deg));
+    if (report.max_change_deg < 0.02) break;
+  }
+  return cam_from_rig;
+}
+
 nlohmann::json PoseJson(const Rigid3& x) {
   return {{"translation", {x.translation.x(), x.translation.y(), x.translation.z()}},
           {"rotation_xyzw", {x.rotation.x(), x.rotation.y(), x.rotation.z(), x.rotation.w()}}};
@@ -461,6 +500,9 @@ VoSummary RunVo(const VoOptions& options) {
   backend_options.ransac.sampling = ViewSamplingFromName(options.sampling);
   backend_options.ransac.views = RansacViewsFromName(options.ransac);
   backend_options.ba.optimize_extrinsics = options.mode == ExtrinsicsMode::kOnline;
+  if (options.mode == ExtrinsicsMode::kOnline && options.online_prior_deg > 0.0) {
+    cam_from_rig = BootstrapExtrinsics(options, info.rig, cam_from_rig);
+  }
   Frontend frontend(info.rig.WithExtrinsics(cam_from_rig), FrontendOptions{});
   VoBackend backend(cam_from_rig, world_from_rig0, backend_options);
 
@@ -538,6 +580,7 @@ VoSummary RunVo(const VoOptions& options) {
   j["generator"] = "rovo vo";
   j["version"] = ROVO_VERSION;
   j["initial_world_from_rig"] = PoseJson(world_from_rig0);
+  j["online_prior_deg"] = options.online_prior_deg;
   j["backend"] = {{"ransac_tau_deg", backend_options.ransac.tau_rad * 180.0 / M_PI},
                   {"ransac_max_iterations", backend_options.ransac.max_iterations},
                   {"ransac_confidence", backend_options.ransac.confidence},

@@ -13,6 +13,7 @@
 
 #include "datasets/rigid3.h"
 #include "datasets/run.h"
+#include "vo/extrinsic_bootstrap.h"
 #include "vo/frontend.h"
 #include "vo/local_ba.h"
 #include "vo/map.h"
@@ -44,6 +45,10 @@ struct VoOptions {
   std::string sampling = "pps";    // "pps" | "uniform" (ablation)
   std::string ransac = "multiview";  // "multiview" | "single-view" (ablation)
   bool quiet = false;
+  // OnlineExt: a bound on the starting extrinsics' rotation error between cameras (degrees). It
+  // loosens the inter-view filters for the start-up calibration (extrinsic_bootstrap.h); 0 = none.
+  double online_prior_deg = 15.0;
+  int online_bootstrap_rounds = 6;
 };
 
 // Mean wall time per processed frame, by stage, in milliseconds.
