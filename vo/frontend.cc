@@ -175,6 +175,13 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
       views[i].points = &s.trackers[i].points();
       views[i].centre_in_rig = s.rig.cameras[i].cam_from_rig.Inverse().translation;
       views[i].image = &s.warped[i];
+      const HybridProjection* projection = &s.projections[i];
+      const Eigen::Matrix3d cam_from_rig = rig_from_cam.transpose();
+      views[i].pixel_from_direction_in_rig = [projection, cam_from_rig](const Eigen::Vector3d& d) {
+        auto px = projection->WarpedFromBearing(cam_from_rig * d);
+        if (px && !projection->InWarpedImage(*px)) px.reset();
+        return px;
+      };
       views[i].bearings_in_rig.reserve(s.trackers[i].points().size());
       for (const TrackedPoint& p : s.trackers[i].points()) {
         const auto bearing = s.projections[i].BearingFromWarped(Eigen::Vector2d(p.px.x, p.px.y));

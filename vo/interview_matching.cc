@@ -69,6 +69,133 @@ std::optional<double> Zncc(const cv::Mat& image_a, cv::Point2f a, const cv::Mat&
   return ab / std::sqrt(aa * bb);
 }
 
+namespace {
+
+// Patch of side patch_px around the nearest pixel of p (row-major); false when it leaves the image.
+bool NearestPatch(const cv::Mat& image, const Eigen::Vector2d& p, int patch_px, float* out) {
+  const int half = patch_px / 2;
+  const int x = static_cast<int>(std::lround(p.x())), y = static_cast<int>(std::lround(p.y()));
+  if (x < half || y < half || x + half >= image.cols || y + half >= image.rows) return false;
+  for (int r = 0; r < patch_px; ++r) {
+    const uint8_t* row = image.ptr<uint8_t>(y - half + r) + (x - half);
+    for (int c = 0; c < patch_px; ++c) *out++ = row[c];
+  }
+  return true;
+}
+
+// Makes `patch` zero-mean and unit-norm; false when it is flat.
+bool Normalise(std::vector<float>* patch) {
+  double sum = 0, sum2 = 0;
+  for (float v : *patch) sum += v, sum2 += double(v) * v;
+  const double n = static_cast<double>(patch->size());
+  const double variance = sum2 - sum * sum / n;
+  if (variance < 1e-6 * n) return false;
+  const double mean = sum / n, scale = 1.0 / std::sqrt(variance);
+  for (float& v : *patch) v = static_cast<float>((v - mean) * scale);
+  return true;
+}
+
+// ZNCC of a normalised patch with a raw one: sum(a_hat * b) / sqrt(sum(b^2) - sum(b)^2 / n).
+std::optional<double> ZnccNormalised(const std::vector<float>& a_hat, const float* b) {
+  double ab = 0, sb = 0, sb2 = 0;
+  for (size_t i = 0; i < a_hat.size(); ++i) {
+    ab += a_hat[i] * b[i];
+    sb += b[i];
+    sb2 += double(b[i]) * b[i];
+  }
+  const double n = static_cast<double>(a_hat.size());
+  const double variance = sb2 - sb * sb / n;
+  if (variance < 1e-6 * n) return std::nullopt;
+  return ab / std::sqrt(variance);
+}
+
+}  // namespace
+
+bool UniqueAlongEpipolarCurve(const cv::Mat& patch_image, cv::Point2f patch_centre, const Eigen::Vector3d& centre_fixed,
+                              const Eigen::Vector3d& bearing_fixed, const MatchView& view,
+                              const Eigen::Vector3d& centre_moving, const Eigen::Vector3d& bearing_moving,
+                              double focal_px, const InterviewMatchOptions& options) {
+  if (!view.pixel_from_direction_in_rig || view.image == nullptr) return true;
+  const int side = options.zncc_patch_px;
+  std::vector<float> reference(static_cast<size_t>(side) * side), sample(reference.size());
+  if (!NearestPatch(patch_image, Eigen::Vector2d(patch_centre.x, patch_centre.y), side, reference.data()) ||
+      !Normalise(&reference)) {
+    return false;
+  }
+  Eigen::Vector3d normal = (centre_moving - centre_fixed).cross(bearing_fixed);
+  if (normal.norm() < 1e-12) return false;
+  normal.normalize();
+  Eigen::Vector3d along = bearing_moving - bearing_moving.dot(normal) * normal;
+  if (along.norm() < 1e-9) return false;
+  along.normalize();
+  const Eigen::Vector3d across = normal.cross(along);
+  const auto centre_px = view.pixel_from_direction_in_rig(along);
+  if (!centre_px) return false;
+  // Directions every pixel (1 / f rad) along the curve; pixels exact every kKnot steps, linear between.
+  constexpr int kKnot = 4;
+  const double step = 1.0 / focal_px;
+  const int half_steps = static_cast<int>(std::ceil(options.uniqueness_range_deg * M_PI / 180.0 / step / kKnot)) * kKnot;
+  const int count = 2 * half_steps + 1;
+  const auto direction = [&](int k) {
+    const double angle = (k - half_steps) * step;
+    return Eigen::Vector3d(std::cos(angle) * along + std::sin(angle) * across);
+  };
+  std::vector<std::optional<Eigen::Vector2d>> knots(count / kKnot + 1);
+  for (int k = 0; k < count; k += kKnot) {
+    const Eigen::Vector3d d = direction(k);
+    if (PositiveDisparity(centre_fixed, bearing_fixed, centre_moving, d)) knots[k / kKnot] = view.pixel_from_direction_in_rig(d);
+  }
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<float> score(count, nan), distance(count, nan);
+  for (int k = 0; k < count; ++k) {
+    const int knot = k / kKnot;
+    const auto& p0 = knots[knot];
+    if (!p0) continue;
+    Eigen::Vector2d px = *p0;
+    if (k % kKnot != 0) {
+      if (knot + 1 >= static_cast<int>(knots.size()) || !knots[knot + 1]) continue;
+      const double t = static_cast<double>(k % kKnot) / kKnot;
+      px = (1.0 - t) * *p0 + t * *knots[knot + 1];
+    }
+    if (!NearestPatch(*view.image, px, side, sample.data())) continue;
+    const auto z = ZnccNormalised(reference, sample.data());
+    if (!z) continue;
+    score[k] = static_cast<float>(*z);
+    distance[k] = static_cast<float>((px - *centre_px).norm());
+  }
+  // Best ZNCC over the 3x3 pixels around px (a sampled peak may sit a pixel off the true one).
+  const auto refined = [&](const Eigen::Vector2d& px) {
+    double best = -2.0;
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (!NearestPatch(*view.image, px + Eigen::Vector2d(dx, dy), side, sample.data())) continue;
+        if (const auto z = ZnccNormalised(reference, sample.data())) best = std::max(best, *z);
+      }
+    }
+    return best;
+  };
+  double z0 = refined(*centre_px);
+  for (int k = 0; k < count; ++k) {
+    if (!std::isnan(score[k]) && distance[k] <= options.uniqueness_exclusion_px) z0 = std::max(z0, double(score[k]));
+  }
+  if (z0 < -1.0) return false;
+  const double limit = z0 - options.uniqueness_margin;
+  for (int k = 1; k + 1 < count; ++k) {
+    if (std::isnan(score[k]) || std::isnan(score[k - 1]) || std::isnan(score[k + 1])) continue;
+    if (distance[k] <= options.uniqueness_exclusion_px || score[k] < score[k - 1] || score[k] < score[k + 1]) continue;
+    if (score[k] >= limit) return false;
+    // Local maxima that could reach the limit are refined, when the refinement stays outside the
+    // exclusion radius (1.5 px >= the 3x3 step).
+    if (score[k] >= limit - 0.3 && distance[k] > options.uniqueness_exclusion_px + 1.5) {
+      const int knot = k / kKnot;
+      const double t = static_cast<double>(k % kKnot) / kKnot;
+      const Eigen::Vector2d px = t == 0.0 ? *knots[knot] : Eigen::Vector2d((1.0 - t) * *knots[knot] + t * *knots[knot + 1]);
+      if (refined(px) >= limit) return false;
+    }
+  }
+  return true;
+}
+
 double AngleDifferenceDeg(double a_deg, double b_deg) {
   double d = std::fmod(std::abs(a_deg - b_deg), 360.0);
   return d > 180.0 ? 360.0 - d : d;
@@ -161,6 +288,13 @@ std::vector<InterviewMatch> MatchViews(const PairGeometry& pair, const MatchView
       const auto score = Zncc(*a.image, pa[i].px, *b.image, pb[j].px, options.zncc_patch_px);
       if (!score || *score < options.min_zncc) continue;
       match.zncc = *score;
+      if (options.use_uniqueness &&
+          (!UniqueAlongEpipolarCurve(*a.image, pa[i].px, a.centre_in_rig, a.bearings_in_rig[i], b, b.centre_in_rig,
+                                     b.bearings_in_rig[j], pair.focal_px, options) ||
+           !UniqueAlongEpipolarCurve(*b.image, pb[j].px, b.centre_in_rig, b.bearings_in_rig[j], a, a.centre_in_rig,
+                                     a.bearings_in_rig[i], pair.focal_px, options))) {
+        continue;
+      }
     }
     matches.push_back(match);
   }

@@ -17,7 +17,17 @@
 //   ratio:           best <= max_ratio * second best (when there is a second),
 //   6. left-right:   a's best is b and b's best is a (mutual),
 //   7. ZNCC:         zero-normalised cross-correlation of the square patches around both points in
-//                    the warped images >= min_zncc.
+//                    the warped images >= min_zncc,
+//   8. uniqueness along the epipolar curve (repeated structure: identical windows of a facade lie
+//                    on one epipolar line, and the true partner may not be among b's features):
+//                    b's bearing is rotated within the epipolar plane (normal n = (c_b - c_a) x d_a)
+//                    by +-uniqueness_range_deg in steps of one warped pixel (1 / f rad), each
+//                    direction with positive disparity is mapped into b's image, and a's patch is
+//                    correlated there (ZNCC, nearest-pixel patches). The match is rejected when a
+//                    local ZNCC maximum more than uniqueness_exclusion_px from the match (refined
+//                    over its 3x3 pixels) reaches z0 - uniqueness_margin, z0 = the best ZNCC within
+//                    that exclusion radius and the 3x3 pixels of the match. The same scan runs in the
+//                    other direction (b's patch along a's curve). Needs pixel_from_direction_in_rig.
 
 #include "datasets/rigid3.h"
 #include "vo/tracking.h"
@@ -25,6 +35,7 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -38,7 +49,11 @@ struct InterviewMatchOptions {
   double min_zncc = 0.7;
   int zncc_patch_px = 11;       // odd side of the ZNCC patch
   double max_ratio = 0.9;       // best / second-best descriptor distance (1 = off)
+  double uniqueness_range_deg = 20.0;   // filter 8: scan half-range along the epipolar curve
+  double uniqueness_margin = 0.02;      // filter 8: rival peak must stay below z0 - margin
+  double uniqueness_exclusion_px = 4.0; // filter 8: peaks this close to the match are the match
   bool use_zncc = true;         // ablation switches (the projection study turns filters off)
+  bool use_uniqueness = true;   // filter 8 (needs use_zncc and pixel_from_direction_in_rig)
   bool use_y_distance = true;
   bool use_mutual = true;
   bool use_positive_disparity = true;
@@ -50,6 +65,9 @@ struct MatchView {
   std::vector<Eigen::Vector3d> bearings_in_rig;  // rotation only (rig_from_cam rotation * bearing_in_cam)
   Eigen::Vector3d centre_in_rig = Eigen::Vector3d::Zero();
   const cv::Mat* image = nullptr;  // 8-bit gray image the points live in (for ZNCC)
+  // Pixel in `image` of a direction given in the rig frame (rotation only); nullopt when it falls
+  // outside the view. Empty: no uniqueness scan (filter 8) into this view.
+  std::function<std::optional<Eigen::Vector2d>(const Eigen::Vector3d&)> pixel_from_direction_in_rig;
 };
 
 struct PairGeometry {
@@ -83,6 +101,15 @@ std::optional<double> RectifiedY(const Eigen::Vector3d& bearing, const Eigen::Ve
 // ZNCC of the patch_px x patch_px patches (bilinear) around a and b; nullopt when a patch leaves its
 // image or is flat.
 std::optional<double> Zncc(const cv::Mat& image_a, cv::Point2f a, const cv::Mat& image_b, cv::Point2f b, int patch_px);
+
+// Filter 8 for one direction: scans `patch_of` (a square patch of `patch_image` around
+// `patch_centre`) along the epipolar curve of (centre_fixed, bearing_fixed) in `view`, around the
+// matched bearing `bearing_moving` (view's camera centre `centre_moving`). Returns true when no
+// rival peak reaches z0 - margin (see the header comment); false also when z0 cannot be measured.
+bool UniqueAlongEpipolarCurve(const cv::Mat& patch_image, cv::Point2f patch_centre, const Eigen::Vector3d& centre_fixed,
+                              const Eigen::Vector3d& bearing_fixed, const MatchView& view,
+                              const Eigen::Vector3d& centre_moving, const Eigen::Vector3d& bearing_moving,
+                              double focal_px, const InterviewMatchOptions& options);
 
 // Smallest difference of two angles in degrees, in [0, 180].
 double AngleDifferenceDeg(double a_deg, double b_deg);

@@ -5,6 +5,7 @@
 #include "datasets/rig.h"
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <cmath>
 #include <map>
@@ -192,6 +193,54 @@ TEST_F(FrontendBox, DeterministicIds) {
       }
     }
     EXPECT_EQ(fa.merged_ids, fb.merged_ids);
+  }
+}
+
+// The whole output (ids, sub-pixel positions, merges, matches), including a warp-map rebuild by
+// SetExtrinsics, is identical for 1, 2 and 4 TBB threads (OpenCV runs on the same TBB pool).
+TEST_F(FrontendBox, IdenticalForAnyThreadCount) {
+  const auto run = [](int threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    FrontendOptions options;
+    options.target_features_per_view = 300;
+    Frontend frontend(*rig_, options);
+    std::vector<FrontendFrame> frames;
+    std::vector<std::vector<Frontend::ViewMatch>> matches;
+    for (int k = 0; k < 3; ++k) {
+      if (k == 2) {
+        std::vector<Rigid3> extrinsics = rig_->Extrinsics();
+        extrinsics[2] = Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(2.0 * M_PI / 180, Eigen::Vector3d::UnitX())),
+                               Eigen::Vector3d::Zero()) *
+                        extrinsics[2];
+        frontend.SetExtrinsics(extrinsics);
+      }
+      frames.push_back(frontend.Process(frames_[k]));
+      matches.push_back(frontend.last_matches());
+    }
+    return std::make_pair(frames, matches);
+  };
+  const auto reference = run(1);
+  for (int threads : {2, 4}) {
+    const auto other = run(threads);
+    for (int k = 0; k < 3; ++k) {
+      const FrontendFrame& fa = reference.first[k];
+      const FrontendFrame& fb = other.first[k];
+      EXPECT_EQ(fa.merged_ids, fb.merged_ids) << threads << " threads, frame " << k;
+      for (int c = 0; c < 4; ++c) {
+        ASSERT_EQ(fa.features_per_camera[c].size(), fb.features_per_camera[c].size()) << threads << " threads";
+        for (size_t i = 0; i < fa.features_per_camera[c].size(); ++i) {
+          EXPECT_EQ(fa.features_per_camera[c][i].track_id, fb.features_per_camera[c][i].track_id);
+          EXPECT_EQ(fa.features_per_camera[c][i].warped_px, fb.features_per_camera[c][i].warped_px);
+        }
+      }
+      const auto& ma = reference.second[k];
+      const auto& mb = other.second[k];
+      ASSERT_EQ(ma.size(), mb.size()) << threads << " threads, frame " << k;
+      for (size_t i = 0; i < ma.size(); ++i) {
+        EXPECT_EQ(ma[i].index_a, mb[i].index_a);
+        EXPECT_EQ(ma[i].index_b, mb[i].index_b);
+      }
+    }
   }
 }
 

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
+#include <optional>
 #include <random>
 
 namespace rovo {
@@ -65,6 +66,56 @@ TEST(InterviewFilters, Zncc) {
   EXPECT_FALSE(Zncc(a, {2, 30}, b, {30, 30}, 11).has_value());  // patch leaves the image
   const cv::Mat flat(64, 64, CV_8UC1, cv::Scalar(90));
   EXPECT_FALSE(Zncc(flat, {30, 30}, a, {30, 30}, 11).has_value());
+}
+
+// Filter 8 on a rectified pair: cameras a at the origin and b 1 m to its right (+x), both looking
+// along +y (z up), pinhole f = 100 px, so epipolar curves are image rows. b's image is a's shifted
+// by the disparity of a point 5 m away; a copy of the matched patch elsewhere on the same row (a
+// repeated structure) makes the match ambiguous, a copy on another row does not.
+TEST(InterviewFilters, UniquenessAlongTheEpipolarCurve) {
+  constexpr double f = 100.0, cx = 200.0, cy = 100.0;
+  const auto pixel = [&](const Eigen::Vector3d& d) -> std::optional<Eigen::Vector2d> {
+    if (d.y() <= 1e-9) return std::nullopt;
+    const Eigen::Vector2d px(cx + f * d.x() / d.y(), cy - f * d.z() / d.y());
+    if (px.x() < 0 || px.y() < 0 || px.x() > 399 || px.y() > 199) return std::nullopt;
+    return px;
+  };
+  const auto bearing = [&](cv::Point2f px) {
+    return Eigen::Vector3d((px.x - cx) / f, 1.0, -(px.y - cy) / f).normalized();
+  };
+  cv::Mat image_a(200, 400, CV_8UC1);
+  cv::RNG rng(11);
+  rng.fill(image_a, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(image_a, image_a, cv::Size(0, 0), 1.5);
+  // Point 5 m ahead: disparity f * 1 m / 5 m = 20 px, u_b = u_a - 20.
+  cv::Mat image_b(200, 400, CV_8UC1, cv::Scalar(0));
+  image_a.colRange(20, 400).copyTo(image_b.colRange(0, 380));
+  const cv::Point2f pa(250, 100), pb(230, 100);
+  const Eigen::Vector3d ca(0, 0, 0), cb(1, 0, 0);
+  InterviewMatchOptions options;
+  options.uniqueness_range_deg = 60.0;
+  MatchView view_b;
+  view_b.image = &image_b;
+  view_b.pixel_from_direction_in_rig = pixel;
+  EXPECT_TRUE(UniqueAlongEpipolarCurve(image_a, pa, ca, bearing(pa), view_b, cb, bearing(pb), f, options));
+
+  cv::Mat repeated = image_b.clone();  // the patch again 80 px to the left on the same row
+  image_b(cv::Rect(220, 90, 21, 21)).copyTo(repeated(cv::Rect(140, 90, 21, 21)));
+  view_b.image = &repeated;
+  EXPECT_FALSE(UniqueAlongEpipolarCurve(image_a, pa, ca, bearing(pa), view_b, cb, bearing(pb), f, options));
+  // The same copy beyond the scan range is not seen.
+  options.uniqueness_range_deg = 20.0;
+  EXPECT_TRUE(UniqueAlongEpipolarCurve(image_a, pa, ca, bearing(pa), view_b, cb, bearing(pb), f, options));
+
+  options.uniqueness_range_deg = 60.0;
+  cv::Mat other_row = image_b.clone();  // the copy 40 px lower: not on the epipolar curve
+  image_b(cv::Rect(220, 90, 21, 21)).copyTo(other_row(cv::Rect(140, 130, 21, 21)));
+  view_b.image = &other_row;
+  EXPECT_TRUE(UniqueAlongEpipolarCurve(image_a, pa, ca, bearing(pa), view_b, cb, bearing(pb), f, options));
+  // Without a mapping into the view there is nothing to scan.
+  view_b.pixel_from_direction_in_rig = nullptr;
+  view_b.image = &repeated;
+  EXPECT_TRUE(UniqueAlongEpipolarCurve(image_a, pa, ca, bearing(pa), view_b, cb, bearing(pb), f, options));
 }
 
 // Synthetic overlap of two omnimvs4 neighbours: true points with (noisy) shared descriptors, plus
