@@ -20,12 +20,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <map>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <unordered_map>
 
 namespace rovo {
 namespace {
@@ -67,25 +68,41 @@ float DepthAt(const cv::Mat& depth, const Eigen::Vector2d& px) {
 
 int GroundTruthMatchVerdict(const Rig& rig, int camera_a, const Eigen::Vector3d& bearing_a, const Eigen::Vector2d& fisheye_a,
                             int camera_b, const Eigen::Vector2d& fisheye_b, const cv::Mat& depth_a, const cv::Mat& depth_b,
-                            double inlier_px) {
-  const float range = DepthAt(depth_a, fisheye_a);
-  if (!(range > 0.0f) || !std::isfinite(range)) return -1;
-  const Rigid3& a_from_rig = rig.cameras[camera_a].cam_from_rig;
+                            double inlier_px, double* error_px) {
+  if (error_px) *error_px = std::numeric_limits<double>::infinity();
+  const float centre_range = DepthAt(depth_a, fisheye_a);
+  if (!(centre_range > 0.0f) || !std::isfinite(centre_range)) return -1;
+  const Rigid3 rig_from_a = rig.cameras[camera_a].cam_from_rig.Inverse();
   const Rigid3& b_from_rig = rig.cameras[camera_b].cam_from_rig;
-  const Eigen::Vector3d point_in_rig = a_from_rig.Inverse() * (static_cast<double>(range) * bearing_a);
-  const Eigen::Vector3d point_in_b = b_from_rig * point_in_rig;
-  const auto predicted = rig.cameras[camera_b].camera.Project(point_in_b);
-  if (!predicted || (*predicted - fisheye_b).norm() > inlier_px) return 0;
-  const double expected = point_in_b.norm();
-  const int u0 = static_cast<int>(std::lround(predicted->x())), v0 = static_cast<int>(std::lround(predicted->y()));
-  for (int v = v0 - 1; v <= v0 + 1; ++v) {
-    for (int u = u0 - 1; u <= u0 + 1; ++u) {
-      if (u < 0 || v < 0 || u >= depth_b.cols || v >= depth_b.rows) continue;
-      const double d = depth_b.at<float>(v, u);
-      if (d > 0 && std::abs(d - expected) <= 0.03 * expected + 0.05) return 1;
+  const int ua = static_cast<int>(std::lround(fisheye_a.x())), va = static_cast<int>(std::lround(fisheye_a.y()));
+  int verdict = 0;
+  for (int dv = -1; dv <= 1; ++dv) {
+    for (int du = -1; du <= 1; ++du) {
+      const int u = ua + du, v = va + dv;
+      if (u < 0 || v < 0 || u >= depth_a.cols || v >= depth_a.rows) continue;
+      const float range = depth_a.at<float>(v, u);
+      if (!(range > 0.0f) || !std::isfinite(range)) continue;
+      const Eigen::Vector3d point_in_b = b_from_rig * (rig_from_a * (static_cast<double>(range) * bearing_a));
+      const auto predicted = rig.cameras[camera_b].camera.Project(point_in_b);
+      if (!predicted) continue;
+      const double error = (*predicted - fisheye_b).norm();
+      if (error_px) *error_px = std::min(*error_px, error);
+      if (error > inlier_px || verdict == 1) continue;
+      const double expected = point_in_b.norm();
+      const int u0 = static_cast<int>(std::lround(predicted->x())), v0 = static_cast<int>(std::lround(predicted->y()));
+      for (int y = v0 - 1; y <= v0 + 1 && verdict == 0; ++y) {
+        for (int x = u0 - 1; x <= u0 + 1; ++x) {
+          if (x < 0 || y < 0 || x >= depth_b.cols || y >= depth_b.rows) continue;
+          const double d = depth_b.at<float>(y, x);
+          if (d > 0 && std::abs(d - expected) <= 0.03 * expected + 0.05) {
+            verdict = 1;
+            break;
+          }
+        }
+      }
     }
   }
-  return 0;
+  return verdict;
 }
 
 namespace {
@@ -117,16 +134,58 @@ void WriteMatchesPng(const std::string& path, const cv::Mat& image_a, const cv::
   WriteFileAtomic(path, std::string(png.begin(), png.end()));
 }
 
+// Error bins of the ground-truth check (fisheye px): [0, .5), [.5, 1), [1, 2), [2, 4), [4, 8), >= 8.
+constexpr double kErrorBinEdges[] = {0.5, 1.0, 2.0, 4.0, 8.0};
+constexpr int kErrorBins = 6;
+
+int ErrorBin(double error_px) {
+  int bin = 0;
+  while (bin < kErrorBins - 1 && error_px >= kErrorBinEdges[bin]) ++bin;
+  return bin;
+}
+
+// A track's descriptors at its first frame and at the previous frame.
+struct TrackHistory {
+  cv::Mat first, previous;
+  int first_frame = 0;
+};
+
 // One image representation (raw fisheye or hybrid) of the study.
 struct Arm {
   std::vector<ViewTracker> trackers;
-  std::vector<std::map<uint64_t, cv::Mat>> previous_descriptors;  // per camera: id -> descriptor at t-1
-  std::vector<std::set<uint64_t>> contributing;                    // per camera: ids that contributed
-  double hamming_sum = 0;
-  int64_t hamming_pairs = 0;
+  std::vector<std::unordered_map<uint64_t, TrackHistory>> history;  // per camera, live tracks only
+  std::vector<std::set<uint64_t>> contributing;                      // per camera: ids that contributed
+  double first_sum = 0, age_sum = 0, step_sum = 0;
+  int64_t first_pairs = 0, step_pairs = 0;
   int64_t matches = 0, inliers = 0;
+  std::vector<int64_t> error_bins = std::vector<int64_t>(kErrorBins, 0);
   std::vector<DrawnMatch> drawn;  // last frame, first pair
 };
+
+// (a): descriptor distances of the live tracks of one view at frame t.
+void AccumulateDescriptorDrift(Arm* arm, int camera, int t) {
+  std::unordered_map<uint64_t, TrackHistory> live;
+  for (const TrackedPoint& p : arm->trackers[camera].points()) {
+    if (!p.has_descriptor) continue;
+    const auto it = arm->history[camera].find(p.track_id);
+    TrackHistory h;
+    if (it == arm->history[camera].end()) {
+      h.first = p.descriptor.clone();
+      h.first_frame = t;
+    } else {
+      h = std::move(it->second);
+      arm->first_sum += HammingDistance(h.first, p.descriptor);
+      arm->age_sum += t - h.first_frame;
+      ++arm->first_pairs;
+      arm->step_sum += HammingDistance(h.previous, p.descriptor);
+      ++arm->step_pairs;
+      arm->contributing[camera].insert(p.track_id);
+    }
+    h.previous = p.descriptor.clone();
+    live.emplace(p.track_id, std::move(h));
+  }
+  arm->history[camera] = std::move(live);
+}
 
 }  // namespace
 
@@ -143,7 +202,7 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
   EnsureWritableDir(options.out_dir);
 
   FrontendOptions frontend_options;
-  frontend_options.target_features_per_view = options.features_per_view;
+  frontend_options.matching = options.frontend_matching;
   Frontend frontend(rig, frontend_options);
   const std::vector<HybridLayout> layouts = ComputeHybridLayouts(rig);
   std::vector<std::pair<int, int>> pairs;
@@ -163,7 +222,7 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
   Arm fisheye_arm, hybrid_arm;
   for (Arm* arm : {&fisheye_arm, &hybrid_arm}) {
     arm->trackers.assign(n, ViewTracker(tracker_options));
-    arm->previous_descriptors.resize(n);
+    arm->history.resize(n);
     arm->contributing.resize(n);
   }
   std::vector<cv::Mat> fisheye_masks(n);
@@ -173,7 +232,7 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
     fisheye_masks[i] = cv::Mat(camera.height, camera.width, CV_8UC1, const_cast<unsigned char*>(mask.data())).clone();
   }
 
-  // Part (b) matcher: mutual nearest descriptors over all features; epipolar check applied after.
+  // Part (b) matcher: mutual nearest descriptors over the overlap features; epipolar check applied after.
   InterviewMatchOptions nn_options;
   nn_options.use_y_distance = false;
   nn_options.use_zncc = false;
@@ -182,10 +241,19 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
   nn_options.max_descriptor_distance = 256;
   nn_options.max_epipolar_angle_deg = 180.0;
   nn_options.max_ratio = 1.0;
+  // A direction (rig frame) is in the overlap of (a, b) when it falls inside both hybrid images.
+  const auto in_hybrid_image = [&](int camera, const Eigen::Vector3d& bearing_in_rig) {
+    const HybridProjection& projection = frontend.projection(camera);
+    const auto px = projection.WarpedFromBearing(rig.cameras[camera].cam_from_rig.RotationMatrix() * bearing_in_rig);
+    if (!px || !projection.InWarpedImage(*px)) return false;
+    const int u = static_cast<int>(std::lround(px->x())), v = static_cast<int>(std::lround(px->y()));
+    return projection.valid_mask().at<uint8_t>(v, u) != 0;
+  };
 
   ProjectionStudyResult result;
   result.frames = frames;
   std::vector<DrawnMatch> drawn_frontend;
+  std::vector<int64_t> frontend_error_bins(kErrorBins, 0);
   cv::Mat last_fisheye_a, last_fisheye_b;
   uint64_t next_id = 0;
   const auto id_source = [&next_id] { return ++next_id; };
@@ -198,65 +266,64 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
     });
     frontend.Process(images);
 
-    // Trackers of both arms (ids drawn sequentially afterwards would need care; one source per arm
-    // under a lock-free sequential loop keeps it simple and deterministic).
     std::vector<cv::Mat> warped(n);
     tbb::parallel_for(0, n, [&](int i) {
       warped[i] = frontend.warped_image(i);
       fisheye_arm.trackers[i].Track(images[i], fisheye_masks[i]);
       hybrid_arm.trackers[i].Track(warped[i], frontend.projection(i).valid_mask());
     });
+    // Ids from one sequential source (deterministic).
     for (Arm* arm : {&fisheye_arm, &hybrid_arm}) {
       for (int i = 0; i < n; ++i) arm->trackers[i].DetectAndDescribe(id_source);
     }
 
-    // (a) descriptor distance of each track between t-1 and t.
+    // (a) descriptor drift along the tracks.
     for (Arm* arm : {&fisheye_arm, &hybrid_arm}) {
-      for (int i = 0; i < n; ++i) {
-        std::map<uint64_t, cv::Mat> current;
-        for (const TrackedPoint& p : arm->trackers[i].points()) {
-          if (!p.has_descriptor) continue;
-          const auto it = arm->previous_descriptors[i].find(p.track_id);
-          if (it != arm->previous_descriptors[i].end()) {
-            arm->hamming_sum += HammingDistance(it->second, p.descriptor);
-            ++arm->hamming_pairs;
-            arm->contributing[i].insert(p.track_id);
-          }
-          current[p.track_id] = p.descriptor.clone();
-        }
-        arm->previous_descriptors[i] = std::move(current);
-      }
+      for (int i = 0; i < n; ++i) AccumulateDescriptorDrift(arm, i, t);
     }
 
-    // (b) inter-view matching, verified with depth.
+    // (b) inter-view matching in the overlaps, verified with depth.
     const bool last = t + 1 == frames;
     for (Arm* arm : {&fisheye_arm, &hybrid_arm}) {
       const bool hybrid = arm == &hybrid_arm;
-      std::vector<MatchView> views(n);
+      std::vector<std::vector<Eigen::Vector3d>> bearings_in_rig(n);
       for (int i = 0; i < n; ++i) {
         const Eigen::Matrix3d rig_from_cam = rig.cameras[i].cam_from_rig.RotationMatrix().transpose();
-        views[i].points = &arm->trackers[i].points();
-        views[i].centre_in_rig = rig.cameras[i].cam_from_rig.Inverse().translation;
-        views[i].image = hybrid ? &warped[i] : &images[i];
         for (const TrackedPoint& p : arm->trackers[i].points()) {
           const Eigen::Vector2d px(p.px.x, p.px.y);
           const auto bearing =
               hybrid ? frontend.projection(i).BearingFromWarped(px) : rig.cameras[i].camera.Unproject(px);
-          views[i].bearings_in_rig.push_back(bearing ? Eigen::Vector3d(rig_from_cam * *bearing) : Eigen::Vector3d::Zero());
+          bearings_in_rig[i].push_back(bearing ? Eigen::Vector3d(rig_from_cam * *bearing) : Eigen::Vector3d::Zero());
         }
       }
       if (last) arm->drawn.clear();
       for (size_t k = 0; k < pairs.size(); ++k) {
         const auto [a, b] = pairs[k];
-        const std::vector<InterviewMatch> matches = MatchViews(PairGeometry{}, views[a], views[b], nn_options);
-        for (const InterviewMatch& m : matches) {
-          const Eigen::Vector3d& da = views[a].bearings_in_rig[m.index_a];
-          const Eigen::Vector3d& db = views[b].bearings_in_rig[m.index_b];
-          if (da.isZero() || db.isZero()) continue;
-          if (EpipolarAngle(views[a].centre_in_rig, da, views[b].centre_in_rig, db) > options.epipolar_deg * M_PI / 180) {
+        // The overlap features of both views (indices into the trackers' points).
+        std::vector<int> index[2];
+        std::vector<TrackedPoint> points[2];
+        MatchView views[2];
+        for (int side = 0; side < 2; ++side) {
+          const int camera = side == 0 ? a : b;
+          const auto& all = arm->trackers[camera].points();
+          for (int q = 0; q < static_cast<int>(all.size()); ++q) {
+            const Eigen::Vector3d& d = bearings_in_rig[camera][q];
+            if (!all[q].has_descriptor || d.isZero() || !in_hybrid_image(a, d) || !in_hybrid_image(b, d)) continue;
+            index[side].push_back(q);
+            points[side].push_back(all[q]);
+            views[side].bearings_in_rig.push_back(d);
+          }
+          views[side].points = &points[side];
+          views[side].centre_in_rig = rig.cameras[camera].cam_from_rig.Inverse().translation;
+          views[side].image = hybrid ? &warped[camera] : &images[camera];
+        }
+        for (const InterviewMatch& m : MatchViews(PairGeometry{}, views[0], views[1], nn_options)) {
+          const Eigen::Vector3d& da = views[0].bearings_in_rig[m.index_a];
+          const Eigen::Vector3d& db = views[1].bearings_in_rig[m.index_b];
+          if (EpipolarAngle(views[0].centre_in_rig, da, views[1].centre_in_rig, db) > options.epipolar_deg * M_PI / 180) {
             continue;
           }
-          const cv::Point2f pa = (*views[a].points)[m.index_a].px, pb = (*views[b].points)[m.index_b].px;
+          const cv::Point2f pa = points[0][m.index_a].px, pb = points[1][m.index_b].px;
           std::optional<Eigen::Vector2d> fa(Eigen::Vector2d(pa.x, pa.y)), fb(Eigen::Vector2d(pb.x, pb.y));
           if (hybrid) {
             fa = frontend.projection(a).FisheyeFromWarped(*fa);
@@ -264,10 +331,13 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
             if (!fa || !fb) continue;
           }
           const Eigen::Vector3d bearing_a = rig.cameras[a].cam_from_rig.RotationMatrix() * da;
-          const int verdict = GroundTruthMatchVerdict(rig, a, bearing_a, *fa, b, *fb, depths[a], depths[b], options.inlier_px);
+          double error = 0;
+          const int verdict =
+              GroundTruthMatchVerdict(rig, a, bearing_a, *fa, b, *fb, depths[a], depths[b], options.inlier_px, &error);
           if (verdict < 0) continue;
           ++arm->matches;
           arm->inliers += verdict;
+          ++arm->error_bins[ErrorBin(error)];
           if (last && k == 0) arm->drawn.push_back({pa, pb, verdict == 1});
         }
       }
@@ -282,11 +352,13 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
       const auto fa = frontend.projection(m.camera_a).FisheyeFromWarped(Eigen::Vector2d(pa.x, pa.y));
       const auto fb = frontend.projection(m.camera_b).FisheyeFromWarped(Eigen::Vector2d(pb.x, pb.y));
       if (!bearing_a || !fa || !fb) continue;
+      double error = 0;
       const int verdict = GroundTruthMatchVerdict(rig, m.camera_a, *bearing_a, *fa, m.camera_b, *fb, depths[m.camera_a],
-                                            depths[m.camera_b], options.inlier_px);
+                                                  depths[m.camera_b], options.inlier_px, &error);
       if (verdict < 0) continue;
       ++result.matches_frontend;
       result.inliers_frontend += verdict;
+      ++frontend_error_bins[ErrorBin(error)];
       if (last && !pairs.empty() && m.camera_a == pairs[0].first && m.camera_b == pairs[0].second) {
         drawn_frontend.push_back({pa, pb, verdict == 1});
       }
@@ -299,16 +371,20 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
   }
   progress.Finish();
 
-  const auto mean = [](const Arm& arm) { return arm.hamming_pairs ? arm.hamming_sum / arm.hamming_pairs : 0.0; };
   const auto distinct = [](const Arm& arm) {
     int64_t count = 0;
     for (const auto& ids : arm.contributing) count += static_cast<int64_t>(ids.size());
     return count;
   };
-  result.hamming_fisheye = mean(fisheye_arm);
-  result.hamming_hybrid = mean(hybrid_arm);
-  result.tracked_pairs_fisheye = fisheye_arm.hamming_pairs;
-  result.tracked_pairs_hybrid = hybrid_arm.hamming_pairs;
+  const auto ratio = [](double sum, int64_t count) { return count ? sum / static_cast<double>(count) : 0.0; };
+  result.hamming_fisheye = ratio(fisheye_arm.first_sum, fisheye_arm.first_pairs);
+  result.hamming_hybrid = ratio(hybrid_arm.first_sum, hybrid_arm.first_pairs);
+  result.hamming_step_fisheye = ratio(fisheye_arm.step_sum, fisheye_arm.step_pairs);
+  result.hamming_step_hybrid = ratio(hybrid_arm.step_sum, hybrid_arm.step_pairs);
+  result.mean_age_fisheye = ratio(fisheye_arm.age_sum, fisheye_arm.first_pairs);
+  result.mean_age_hybrid = ratio(hybrid_arm.age_sum, hybrid_arm.first_pairs);
+  result.tracked_pairs_fisheye = fisheye_arm.first_pairs;
+  result.tracked_pairs_hybrid = hybrid_arm.first_pairs;
   result.features_fisheye = distinct(fisheye_arm);
   result.features_hybrid = distinct(hybrid_arm);
   result.matches_fisheye = fisheye_arm.matches;
@@ -317,17 +393,23 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
   result.inliers_hybrid = hybrid_arm.inliers;
 
   // Outputs.
-  char line[512];
+  char line[1024];
   std::ostringstream md;
   md << "# Hybrid projection vs raw fisheye (paper Table II)\n\n";
   md << "Dataset: `" << options.dataset_dir << "` (preset " << (info.preset.empty() ? "custom" : info.preset)
-     << ", seed " << info.seed << "), frames 0-" << frames - 1 << ", " << n << " cameras, "
-     << options.features_per_view << " features per view. rovo " << ROVO_VERSION << ".\n\n";
+     << ", seed " << info.seed << "), frames 0-" << frames - 1 << ", " << n << " cameras of "
+     << rig.cameras[0].camera.width << "x" << rig.cameras[0].camera.height << ", " << options.features_per_view
+     << " features per view. rovo " << ROVO_VERSION << ".\n\n";
   md << "| | Original fisheye | Hybrid projection (ours) | Paper: fisheye / hybrid |\n|---|---|---|---|\n";
-  std::snprintf(line, sizeof(line), "| Descriptor distance (mean Hamming, t vs t+1) | %.2f | %.2f | 124.85 / 35.27 |\n",
+  std::snprintf(line, sizeof(line),
+                "| Descriptor distance (mean Hamming, track's first frame vs each later frame) | %.2f | %.2f | 124.85 / 35.27 |\n",
                 result.hamming_fisheye, result.hamming_hybrid);
   md << line;
-  std::snprintf(line, sizeof(line), "| Inter-view inlier ratio (%%), epipolar-consistent NN matches | %.2f | %.2f | 21.53 / 73.16 |\n",
+  std::snprintf(line, sizeof(line), "| Descriptor distance (mean Hamming, frame t vs t+1) | %.2f | %.2f | - |\n",
+                result.hamming_step_fisheye, result.hamming_step_hybrid);
+  md << line;
+  std::snprintf(line, sizeof(line),
+                "| Inter-view inlier ratio (%%), epipolar-consistent mutual-NN matches in the overlaps | %.2f | %.2f | 21.53 / 73.16 |\n",
                 100.0 * result.InlierRatioFisheye(), 100.0 * result.InlierRatioHybrid());
   md << line;
   std::snprintf(line, sizeof(line), "| Inter-view inlier ratio (%%), front-end filters (hybrid only) | - | %.2f | - |\n\n",
@@ -339,17 +421,36 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
                 result.hamming_fisheye > 0 ? result.hamming_hybrid / result.hamming_fisheye : 0.0,
                 result.InlierRatioFisheye() > 0 ? result.InlierRatioHybrid() / result.InlierRatioFisheye() : 0.0);
   md << line;
-  md << "Counts: tracked descriptor pairs fisheye " << result.tracked_pairs_fisheye << " (" << result.features_fisheye
-     << " tracks), hybrid " << result.tracked_pairs_hybrid << " (" << result.features_hybrid
-     << " tracks); matches (inliers) fisheye " << result.matches_fisheye << " (" << result.inliers_fisheye
-     << "), hybrid " << result.matches_hybrid << " (" << result.inliers_hybrid << "), front-end "
-     << result.matches_frontend << " (" << result.inliers_frontend << ").\n\n";
+  std::snprintf(line, sizeof(line),
+                "Counts: (track, later frame) pairs fisheye %lld (%lld tracks, mean %.1f frames after the first), "
+                "hybrid %lld (%lld tracks, mean %.1f frames); matches (inliers) fisheye %lld (%lld), hybrid %lld "
+                "(%lld), front-end %lld (%lld).\n\n",
+                static_cast<long long>(result.tracked_pairs_fisheye), static_cast<long long>(result.features_fisheye),
+                result.mean_age_fisheye, static_cast<long long>(result.tracked_pairs_hybrid),
+                static_cast<long long>(result.features_hybrid), result.mean_age_hybrid,
+                static_cast<long long>(result.matches_fisheye), static_cast<long long>(result.inliers_fisheye),
+                static_cast<long long>(result.matches_hybrid), static_cast<long long>(result.inliers_hybrid),
+                static_cast<long long>(result.matches_frontend), static_cast<long long>(result.inliers_frontend));
+  md << line;
+  const auto bins_row = [](const char* name, const std::vector<int64_t>& bins) {
+    std::string row = std::string("| ") + name;
+    for (int64_t count : bins) row += " | " + std::to_string(count);
+    return row + " |\n";
+  };
+  md << "Ground-truth reprojection distance of the counted matches (fisheye px):\n\n"
+     << "| | < 0.5 | 0.5-1 | 1-2 | 2-4 | 4-8 | >= 8 |\n|---|---|---|---|---|---|---|\n"
+     << bins_row("fisheye, NN", fisheye_arm.error_bins) << bins_row("hybrid, NN", hybrid_arm.error_bins)
+     << bins_row("hybrid, front-end", frontend_error_bins) << "\n";
   md << "Method: the same tracker (FAST + " << frontend_options.min_feature_distance_px
-     << " px minimum distance, pyramidal KLT with forward-backward check, ORB descriptors) on both image kinds. "
-        "Matches: mutual nearest ORB neighbours between neighbouring views, kept when within "
+     << " px minimum distance, pyramidal KLT with forward-backward check, re-detection to the target, ORB "
+        "descriptors recomputed every frame) on both image kinds. Descriptor distance: Hamming distance between a "
+        "track's ORB descriptor at its first frame and at every later frame it is alive, averaged over all such "
+        "pairs. Matches: mutual nearest ORB neighbours between neighbouring views among the features whose "
+        "direction lies inside both views' hybrid images (same scene area for both arms), kept when within "
      << options.epipolar_deg << " deg of the epipolar plane (ground-truth extrinsics). Inlier: the depth-map "
-     << "back-projection of the first feature reprojects within " << options.inlier_px
-     << " fisheye px of the second and is not occluded (depth agrees). Matches without depth (sky) are not counted.\n";
+     << "back-projection of the first feature (any of its 3x3 depth pixels) reprojects within " << options.inlier_px
+     << " fisheye px of the second and is not occluded (depth agrees). Matches without depth (sky) are not "
+        "counted.\n";
   WriteFileAtomic(options.out_dir + "/table.md", md.str());
 
   nlohmann::json json;
@@ -362,32 +463,38 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
   json["features_per_view"] = options.features_per_view;
   json["epipolar_deg"] = options.epipolar_deg;
   json["inlier_px"] = options.inlier_px;
-  json["fisheye"] = {{"mean_hamming", result.hamming_fisheye},
-                     {"tracked_pairs", result.tracked_pairs_fisheye},
-                     {"tracks", result.features_fisheye},
-                     {"matches", result.matches_fisheye},
-                     {"inliers", result.inliers_fisheye},
-                     {"inlier_ratio", result.InlierRatioFisheye()}};
-  json["hybrid"] = {{"mean_hamming", result.hamming_hybrid},
-                    {"tracked_pairs", result.tracked_pairs_hybrid},
-                    {"tracks", result.features_hybrid},
-                    {"matches", result.matches_hybrid},
-                    {"inliers", result.inliers_hybrid},
-                    {"inlier_ratio", result.InlierRatioHybrid()}};
+  json["error_bin_edges_px"] = std::vector<double>(std::begin(kErrorBinEdges), std::end(kErrorBinEdges));
+  const auto arm_json = [&](const Arm& arm, double hamming, double step, double age, int64_t tracks, double ratio_value) {
+    return nlohmann::json{{"mean_hamming_first_vs_later", hamming},
+                          {"mean_hamming_consecutive", step},
+                          {"tracked_pairs", arm.first_pairs},
+                          {"mean_frames_after_first", age},
+                          {"tracks", tracks},
+                          {"matches", arm.matches},
+                          {"inliers", arm.inliers},
+                          {"inlier_ratio", ratio_value},
+                          {"error_bins", arm.error_bins}};
+  };
+  json["fisheye"] = arm_json(fisheye_arm, result.hamming_fisheye, result.hamming_step_fisheye, result.mean_age_fisheye,
+                             result.features_fisheye, result.InlierRatioFisheye());
+  json["hybrid"] = arm_json(hybrid_arm, result.hamming_hybrid, result.hamming_step_hybrid, result.mean_age_hybrid,
+                            result.features_hybrid, result.InlierRatioHybrid());
   json["frontend"] = {{"matches", result.matches_frontend},
                       {"inliers", result.inliers_frontend},
-                      {"inlier_ratio", result.InlierRatioFrontend()}};
+                      {"inlier_ratio", result.InlierRatioFrontend()},
+                      {"error_bins", frontend_error_bins}};
   WriteJsonFileAtomic(options.out_dir + "/study.json", json);
 
   if (!pairs.empty()) {
     const auto [a, b] = pairs[0];
-    std::vector<DrawnMatch> hybrid_drawn = drawn_frontend;
+    const std::string pair_name = "cam" + std::to_string(a) + "-cam" + std::to_string(b) + " frame " +
+                                  std::to_string(frames - 1) + " (green: inlier by depth GT, red: outlier)";
+    WriteMatchesPng(options.out_dir + "/matches_frontend.png", frontend.warped_image(a), frontend.warped_image(b),
+                    drawn_frontend, "hybrid, front-end matches " + pair_name);
     WriteMatchesPng(options.out_dir + "/matches_hybrid.png", frontend.warped_image(a), frontend.warped_image(b),
-                    hybrid_drawn,
-                    "hybrid, front-end matches cam" + std::to_string(a) + "-cam" + std::to_string(b) + " frame " +
-                        std::to_string(frames - 1) + " (green: inlier by depth GT, red: outlier)");
+                    hybrid_arm.drawn, "hybrid, epipolar-consistent NN matches " + pair_name);
     WriteMatchesPng(options.out_dir + "/matches_fisheye.png", last_fisheye_a, last_fisheye_b, fisheye_arm.drawn,
-                    "raw fisheye, epipolar-consistent NN matches cam" + std::to_string(a) + "-cam" + std::to_string(b));
+                    "raw fisheye, epipolar-consistent NN matches " + pair_name);
   }
   return result;
 }
@@ -396,7 +503,7 @@ void AddProjectionStudyCommand(CliGroups& groups) {
   auto options = std::make_shared<ProjectionStudyOptions>();
   CLI::App* cmd = groups.study->add_subcommand(
       "projection",
-      "Paper Table II on a dataset: ORB descriptor distance of tracked features (frame t vs t+1) and "
+      "Paper Table II on a dataset: ORB descriptor distance of tracked features (first frame vs later) and "
       "inter-view matching inlier ratio (verified with the dataset's depth), raw fisheye vs hybrid "
       "projection. Writes table.md, study.json and match drawings. Needs a dataset rendered with --depth.");
   cmd->add_option("dataset", options->dataset_dir, "Dataset folder (with depth/)")->required();
@@ -410,10 +517,22 @@ void AddProjectionStudyCommand(CliGroups& groups) {
       ->capture_default_str();
   cmd->add_option("--inlier-px", options->inlier_px, "Ground-truth inlier tolerance, fisheye pixels")
       ->capture_default_str();
+  InterviewMatchOptions& m = options->frontend_matching;
+  cmd->add_option("--fe-max-ratio", m.max_ratio, "Front-end column: descriptor ratio test")->capture_default_str();
+  cmd->add_option("--fe-min-zncc", m.min_zncc, "Front-end column: minimum ZNCC")->capture_default_str();
+  cmd->add_option("--fe-epipolar-deg", m.max_epipolar_angle_deg, "Front-end column: epipolar threshold, degrees")
+      ->capture_default_str();
+  cmd->add_option("--fe-y-px", m.max_y_distance_px, "Front-end column: y-distance threshold, warped px")
+      ->capture_default_str();
+  cmd->add_option("--fe-uniqueness-margin", m.uniqueness_margin, "Front-end column: epipolar uniqueness margin")
+      ->capture_default_str();
+  cmd->add_option("--fe-uniqueness-deg", m.uniqueness_range_deg, "Front-end column: epipolar uniqueness half-range")
+      ->capture_default_str();
+  cmd->add_flag("!--fe-no-uniqueness", m.use_uniqueness, "Front-end column: no epipolar uniqueness scan");
   cmd->add_flag("--quiet", options->quiet, "No progress output");
   cmd->callback([options] {
     const ProjectionStudyResult r = RunProjectionStudy(*options);
-    std::printf("descriptor distance: fisheye %.2f, hybrid %.2f (%lld / %lld tracked pairs)\n", r.hamming_fisheye,
+    std::printf("descriptor distance (first vs later): fisheye %.2f, hybrid %.2f (%lld / %lld pairs)\n", r.hamming_fisheye,
                 r.hamming_hybrid, static_cast<long long>(r.tracked_pairs_fisheye),
                 static_cast<long long>(r.tracked_pairs_hybrid));
     std::printf("inter-view inlier ratio: fisheye %.2f%% (%lld), hybrid %.2f%% (%lld), front-end %.2f%% (%lld)\n",

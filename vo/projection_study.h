@@ -1,24 +1,26 @@
 #pragma once
 // `rovo study projection`: the paper's Table II (hybrid projection vs raw fisheye) on a dataset.
 //
-// (a) Descriptor stability: the same tracker (FAST + min distance, KLT with forward-backward check,
-//     ORB descriptors recomputed each frame; tracking.h) runs on the raw fisheye images (with the
-//     lens' valid-pixel mask) and on the hybrid-warped images. For every track alive at frames t
-//     and t+1 in one view, the Hamming distance between its two ORB descriptors is accumulated;
-//     the table reports the mean.
-// (b) Inter-view matching inlier ratio between neighbouring views: mutual nearest-neighbour ORB
-//     matching of all features of the two views, kept when epipolar-consistent (angle to the
-//     epipolar plane <= epipolar_deg under the ground-truth extrinsics), as in the paper. A match is
-//     an inlier by GROUND TRUTH: feature A is back-projected with the dataset's depth (ray length,
-//     depth/camN/NNNNNN.exr) into the rig frame, projected into camera B; inlier when that pixel is
-//     within inlier_px (fisheye pixels) of B's feature and B's depth there agrees with the distance
-//     (not occluded: |depth_B - |X - c_B|| <= 3% + 0.05 m over the 3x3 neighbourhood). Matches
-//     whose A pixel has no depth (sky) are not counted. The front-end's full filter chain
-//     (interview_matching.h) on the hybrid images is reported as a third column.
+// (a) Descriptor stability along tracks: the same tracker (FAST + min distance, KLT with
+//     forward-backward check, re-detection to the target count, ORB descriptors recomputed each
+//     frame; tracking.h) runs on the raw fisheye images (with the lens' valid-pixel mask) and on the
+//     hybrid-warped images, features_per_view per view (4 x 500 = the paper's 2000 features), over
+//     `frames` frames (the paper: 100). For every track and every frame after its first, the
+//     Hamming distance between its ORB descriptor at that frame and at its FIRST frame is
+//     accumulated; the table reports the mean (appearance drift along the track, which the lens
+//     distortion drives). The frame-to-frame mean (t vs t+1) is reported as a second row.
+// (b) Inter-view matching inlier ratio between neighbouring views (a, b), on the features of each
+//     arm's tracker that lie in the pair's overlap: bearings that fall inside BOTH cameras' hybrid
+//     images (the same scene area for both arms). Matches are mutual nearest neighbours of the ORB
+//     descriptors (brute force, cross-checked), kept when epipolar-consistent (angle to the
+//     epipolar plane <= epipolar_deg under the ground-truth extrinsics), as in the paper. A match
+//     is an inlier by GROUND TRUTH (GroundTruthMatchVerdict below). The front-end's full filter
+//     chain (interview_matching.h) on the hybrid images is reported as a third column.
 // Outputs in --out: table.md, study.json (numbers, dataset seed, settings), matches_hybrid.png and
 // matches_fisheye.png (one neighbour pair of the last frame; green = inlier, red = outlier).
 
 #include "datasets/rig.h"
+#include "vo/interview_matching.h"
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -34,27 +36,36 @@ struct CliGroups;
 cv::Mat ReadDepthImage(const std::string& path);
 
 // Ground-truth verdict of an inter-view match: feature A (unit bearing in camera A and its fisheye
-// pixel) and feature B (fisheye pixel), with both cameras' depth images. 1 = inlier (A's depth
-// point reprojects within inlier_px of B and is not occluded in B), 0 = outlier, -1 = A has no
-// depth (not counted).
+// pixel) and feature B (fisheye pixel), with both cameras' depth images (ray length). For each of
+// the 3x3 depth pixels around A's pixel (a corner on an occlusion edge belongs to either side
+// within a pixel): X = c_A + depth * d_A is projected into B; the candidate passes when the pixel
+// is within inlier_px (fisheye pixels) of B's feature and not occluded in B (some depth of B's
+// 3x3 neighbourhood of the projection agrees with |X - c_B| within 3% + 0.05 m).
+// Returns 1 = inlier (some candidate passes), 0 = outlier, -1 = A has no depth at its centre pixel
+// (sky; not counted). `error_px`, when given, receives the smallest reprojection distance of the
+// candidates (infinity when none projects).
 int GroundTruthMatchVerdict(const Rig& rig, int camera_a, const Eigen::Vector3d& bearing_a_in_cam,
                             const Eigen::Vector2d& fisheye_a, int camera_b, const Eigen::Vector2d& fisheye_b,
-                            const cv::Mat& depth_a, const cv::Mat& depth_b, double inlier_px);
+                            const cv::Mat& depth_a, const cv::Mat& depth_b, double inlier_px,
+                            double* error_px = nullptr);
 
 struct ProjectionStudyOptions {
   std::string dataset_dir;
   std::string out_dir;
   int frames = 100;             // frames used from the start (fewer if the dataset is shorter)
-  int features_per_view = 600;  // tracker target per view (4 views: 2400 features)
+  int features_per_view = 500;  // tracker target per view (4 views: the paper's 2000 features)
   double epipolar_deg = 1.0;    // epipolar consistency for part (b)
   double inlier_px = 2.0;       // ground-truth reprojection tolerance, fisheye pixels
+  InterviewMatchOptions frontend_matching;  // filters of the front-end column (defaults = the front-end's)
   bool quiet = false;
 };
 
 struct ProjectionStudyResult {
   int frames = 0;
-  double hamming_fisheye = 0, hamming_hybrid = 0;  // mean Hamming distance, frame t vs t+1
-  int64_t tracked_pairs_fisheye = 0, tracked_pairs_hybrid = 0;
+  double hamming_fisheye = 0, hamming_hybrid = 0;  // mean Hamming distance, first frame vs later
+  int64_t tracked_pairs_fisheye = 0, tracked_pairs_hybrid = 0;  // (track, later frame) pairs
+  double hamming_step_fisheye = 0, hamming_step_hybrid = 0;  // mean Hamming distance, t vs t+1
+  double mean_age_fisheye = 0, mean_age_hybrid = 0;          // mean frames since the first, over the pairs
   int64_t features_fisheye = 0, features_hybrid = 0;  // distinct tracks that contributed
   int64_t matches_fisheye = 0, inliers_fisheye = 0;   // (b), epipolar-consistent matches
   int64_t matches_hybrid = 0, inliers_hybrid = 0;

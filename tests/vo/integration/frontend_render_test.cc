@@ -66,11 +66,10 @@ TEST_F(RenderedQuick, AcceptedInterViewMatchesAreCorrect) {
       inliers += verdict;
     }
   }
-  EXPECT_GT(counted, 50);
+  EXPECT_GT(counted, 50 * kFrames);  // measured 2026-11-21: about 120 per frame (178 before filter 8)
   EXPECT_GT(merged, 0);
-  // The target is 90 %; measured 2026-11-21: 643 of 821 (78 %) on these frames. Until the
-  // filters reach the target, this floor (measured value less a margin) catches regressions.
-  EXPECT_GE(inliers, 0.70 * counted) << inliers << " of " << counted;
+  // The target: at least 90 % of the accepted matches are correct by ground truth.
+  EXPECT_GE(inliers, 0.90 * counted) << inliers << " of " << counted;
 }
 
 TEST_F(RenderedQuick, ProjectionStudyWritesItsTable) {
@@ -83,14 +82,24 @@ TEST_F(RenderedQuick, ProjectionStudyWritesItsTable) {
   EXPECT_EQ(result.frames, kFrames);
   EXPECT_GT(result.tracked_pairs_hybrid, 500);
   EXPECT_GT(result.tracked_pairs_fisheye, 500);
+  // Descriptor drift along tracks: the hybrid images keep descriptors closer to their first
+  // sighting (measured 2026-11-21 on cloudy_urban quick, frames 0-7: 61.1 vs 72.2; the paper's
+  // ratio 0.28 is not reached on our scenes, see the study's table).
   EXPECT_LT(result.hamming_hybrid, result.hamming_fisheye);
-  // Table II's second row (hybrid inter-view inlier ratio > 3x the fisheye's) is NOT reproduced yet:
-  // measured 2026-11-21 on these frames, hybrid 0.67 vs fisheye 0.77 (README, known limitations).
-  // Here: both ratios are real measurements over a non-trivial number of matches.
+  EXPECT_GT(result.mean_age_hybrid, 0.5);
+  // Table II's second row (hybrid >= 80 % and >= 3x the fisheye's) is NOT reproduced on our scenes:
+  // rectified overlaps put repeated facade structure on one image row, and plain nearest-neighbour
+  // matching picks the wrong copy (measured frames 0-7: hybrid 67 %, fisheye 78 %; 100 frames at
+  // half size: 65 % vs 70 %). Asserted: real ratios over real counts, and the front-end's filters
+  // (ratio, ZNCC, epipolar uniqueness) lift the hybrid matches to the 90 % target.
+  EXPECT_GT(result.matches_hybrid, 100);
+  EXPECT_GT(result.matches_fisheye, 100);
   EXPECT_GT(result.InlierRatioHybrid(), 0.5);
-  EXPECT_GT(result.InlierRatioFisheye(), 0.0);
+  EXPECT_GT(result.InlierRatioFisheye(), 0.5);
   EXPECT_LE(result.InlierRatioFisheye(), 1.0);
-  for (const char* name : {"table.md", "study.json", "matches_hybrid.png", "matches_fisheye.png"}) {
+  EXPECT_GE(result.InlierRatioFrontend(), 0.90);
+  EXPECT_GT(result.InlierRatioFrontend(), result.InlierRatioHybrid());
+  for (const char* name : {"table.md", "study.json", "matches_hybrid.png", "matches_fisheye.png", "matches_frontend.png"}) {
     EXPECT_TRUE(std::filesystem::exists(options.out_dir + "/" + name)) << name;
   }
 }
