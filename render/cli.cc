@@ -114,8 +114,8 @@ void AddRenderCommands(CliGroups& groups) {
     auto options = std::make_shared<RenderBenchOptions>();
     CLI::App* cmd = groups.bench->add_subcommand(
         "render",
-        "Render speed: s/frame and Mrays/s at 1 spp and default quality, raw Embree cast of the same rays, "
-        "BVH build time and peak memory, on the first frames of a preset at full size");
+        "Render speed: s/frame and Mrays/s at 1 spp and default quality, raw Embree cast of the same rays "
+        "(ratio full/raw), BVH build time, peak memory, load average, optionally the Cycles ratio");
     cmd->add_option("--preset", options->preset, "Scene preset")->capture_default_str();
     cmd->add_option("--scene", options->scene_dir, "Scene folder instead of the preset");
     cmd->add_option("--seed", options->seed, "Scene seed")->capture_default_str();
@@ -124,8 +124,13 @@ void AddRenderCommands(CliGroups& groups) {
     cmd->add_option("--threads", options->threads, "Threads (default: all cores)");
     cmd->add_option("--spp", options->spp, "Default-quality spp (0 = the default)");
     cmd->add_flag("--quality", options->quality,
-                  "Also measure anti-aliasing per spp / texture LOD bias: mean error vs. a 16-spp reference and "
-                  "frame-to-frame flicker of a camera nudged by quarter-pixel steps");
+                  "Also measure anti-aliasing per spp, sample pattern and texture filter: mean error vs. a 32-spp "
+                  "reference and shimmer (frame-to-frame change not in the reference) over quarter-pixel pan steps");
+    cmd->add_flag("--breakdown", options->breakdown,
+                  "Also time the 1-spp render with bilinear (single mip level) texturing and without textures");
+    cmd->add_option("--cycles-timing", options->cycles_timing,
+                    "timing.json written by scenes/blender/time_cycles_vs_rovo.py: print the Cycles/rovo ratio "
+                    "(Cycles takes minutes per frame, so it is timed by that script, not here)");
     cmd->add_option("--write", options->write_dir, "Also time a full `rovo render` of the frames into this folder");
     cmd->callback([options] { RunRenderBenchmark(*options); });
   }

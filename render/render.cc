@@ -282,9 +282,11 @@ RenderSummary RenderDataset(const RenderOptions& options) {
     todo.push_back(f);
   }
 
-  std::vector<CameraRays> rays(rig.NumCameras());
+  std::vector<CameraRays> rays;
   arena.execute([&] {
-    for (int c = 0; c < rig.NumCameras(); ++c) rays[c] = CameraRays::Make(rig.cameras[c].camera);
+    std::vector<Camera> cameras;
+    for (const RigCamera& cam : rig.cameras) cameras.push_back(cam.camera);
+    rays = MakeCameraRays(cameras, 0, spp);
   });
 
   ShadeSettings settings;

@@ -45,8 +45,10 @@ struct RenderSummary {
 // from every shard. Images are identical for any thread count.
 RenderSummary RenderDataset(const RenderOptions& options);
 
-// Samples per pixel when RenderOptions::spp is 0 (chosen by measurement, see render/README.md).
-inline constexpr int kDefaultSpp = 4;
+// Samples per pixel when RenderOptions::spp is 0: the cheapest setting whose mean error against a
+// 32-spp reference is below one 8-bit code (fixed 2-sample diagonal pattern, trilinear textures,
+// LOD bias -0.5; measured with `rovo bench render --quality`, table in render/README.md).
+inline constexpr int kDefaultSpp = 2;
 // Shards take frames in chunks of this many consecutive frames: frame f belongs to shard
 // (f / kShardChunkFrames) % shard_count.
 inline constexpr int kShardChunkFrames = 8;
@@ -85,7 +87,9 @@ struct RenderBenchOptions {
   int threads = 0;
   int spp = 0;                 // default-quality spp (0 = kDefaultSpp)
   std::string write_dir;       // if set, also time full dataset writing into this folder
-  bool quality = false;        // also measure aliasing: error vs. a 16-spp reference and flicker
+  bool quality = false;        // also measure aliasing: error vs. a 32-spp reference and shimmer
+  bool breakdown = false;      // also time 1 spp without trilinear filtering and without textures
+  std::string cycles_timing;   // timing.json of scenes/blender/time_cycles_vs_rovo.py: print the Cycles ratio
 };
 void RunRenderBenchmark(const RenderBenchOptions& options);
 

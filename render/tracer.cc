@@ -12,6 +12,7 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -42,7 +43,31 @@ float RadicalInverse2(uint32_t i) {
   return static_cast<float>(i) * (1.0f / 4294967296.0f);
 }
 
+// Second dimension of the Sobol (0,2)-sequence (generator: Pascal's triangle mod 2).
+float Sobol2(uint32_t i) {
+  uint32_t r = 0;
+  for (uint32_t v = 1u << 31; i; i >>= 1, v ^= v >> 1)
+    if (i & 1u) r ^= v;
+  return static_cast<float>(r) * (1.0f / 4294967296.0f);
+}
+
 float Wrap01(float x) { return x - std::floor(x); }
+
+// log2(x) for x > 0: exponent plus a quadratic in the mantissa m in [1, 2),
+// log2(m) ~ (m - 1) (1.3465 - 0.3465 (m - 1)); exact at powers of two, |error| < 0.01,
+// monotonic and continuous (a level-of-detail selector, not a math library).
+float FastLog2(float x) {
+  uint32_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  const float exponent = static_cast<float>(static_cast<int>((bits >> 23) & 0xffu) - 127);
+  bits = (bits & 0x007fffffu) | 0x3f800000u;
+  float m;
+  std::memcpy(&m, &bits, sizeof m);
+  m -= 1.0f;
+  return exponent + m * (1.3465f - 0.3465f * m);
+}
+
+constexpr int kSunSamples = 64;
 
 // 65536-entry table linear [0, 1] -> 8-bit sRGB (rounded).
 const std::array<uint8_t, 65536>& SrgbTable() {
@@ -74,7 +99,14 @@ void SetFlushDenormals() {
 // ---------------------------------------------------------------------------------------------
 // CameraRays
 
-CameraRays CameraRays::Make(const Camera& camera, int threads) {
+Eigen::Vector2f CameraRays::SampleOffset(int s, int spp) {
+  if (spp <= 1) return Eigen::Vector2f::Zero();
+  const float n = static_cast<float>(spp);
+  return Eigen::Vector2f((s + 0.5f) / n - 0.5f,
+                         Wrap01(RadicalInverse2(static_cast<uint32_t>(s)) + 0.5f / n) - 0.5f);
+}
+
+CameraRays CameraRays::Make(const Camera& camera, int threads, int spp) {
   CameraRays rays;
   rays.camera = camera;
   rays.width = camera.width;
@@ -146,6 +178,47 @@ CameraRays CameraRays::Make(const Camera& camera, int threads) {
     pixel_angles();
   }
   for (uint8_t v : rays.valid) rays.num_valid += v;
+  if (spp > 1) {
+    rays.sample_spp = spp;
+    rays.sample_bearing.assign(spp, std::vector<Eigen::Vector3f>(n, Eigen::Vector3f::Zero()));
+    auto samples = [&] {
+      tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& r) {
+        for (int s = 0; s < spp; ++s) {
+          const Eigen::Vector2f offset = SampleOffset(s, spp);
+          for (int y = r.begin(); y < r.end(); ++y) {
+            for (int x = 0; x < camera.width; ++x) {
+              const size_t i = static_cast<size_t>(y) * camera.width + x;
+              if (!rays.valid[i]) continue;
+              Eigen::Vector3f b;
+              if (rays.SampleBearing(x + offset.x(), y + offset.y(), &b)) rays.sample_bearing[s][i] = b;
+            }
+          }
+        }
+      });
+    };
+    if (threads > 0) {
+      tbb::task_arena arena(threads);
+      arena.execute(samples);
+    } else {
+      samples();
+    }
+  }
+  return rays;
+}
+
+std::vector<CameraRays> MakeCameraRays(const std::vector<Camera>& cameras, int threads, int spp) {
+  std::vector<CameraRays> rays(cameras.size());
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    const Camera& c = cameras[i];
+    size_t same = i;
+    for (size_t j = 0; j < i && same == i; ++j) {
+      const Camera& o = cameras[j];
+      if (o.model == c.model && o.width == c.width && o.height == c.height && o.params == c.params &&
+          o.max_fov_deg == c.max_fov_deg)
+        same = j;
+    }
+    rays[i] = same < i ? rays[same] : CameraRays::Make(c, threads, spp);
+  }
   return rays;
 }
 
@@ -184,9 +257,19 @@ struct Tracer::Impl {
   std::vector<RTCGeometry> dynamic_instances;
   std::vector<int> dynamic_objects;
   std::vector<Eigen::Matrix3f> object_rotation;  // world_from_object rotation (static: identity)
-  std::vector<std::vector<float>> mesh_uv_scale;  // per mesh and triangle: sqrt(A_uv / A_object)
+  // Everything shading reads about a triangle, in one 32-byte record (one cache line per hit
+  // instead of loads from triangles, uvs, triangle_materials and the UV scale).
+  struct TriangleShade {
+    float uv[6];              // u0, v0, u1, v1, u2, v2 (zero without uvs)
+    float texels_per_metre;   // sqrt(A_uv / A_object) * MipTexture::TexelsPerUv; < 0: untextured
+    int32_t material;
+  };
+  std::vector<std::vector<TriangleShade>> mesh_shade;  // per mesh and triangle
+  std::vector<int> object_mesh;                        // object index -> mesh index
   std::vector<MipTexture> textures;
 
+  RTCScene trace_scene = nullptr;           // static_scene when nothing moves, else top
+  std::array<Eigen::Vector3f, kSunSamples> sun_samples;  // unit directions inside the sun disc
   Eigen::Vector3f sun_dir, sun_e1, sun_e2;
   float sun_disc_radius = 0.0f;  // tan(angular diameter / 2)
   Eigen::Vector3f sky_mean, ground_irradiance;
@@ -263,24 +346,36 @@ Tracer::Tracer(const Scene& scene) : impl_(std::make_unique<Impl>(scene)) {
   d.textures.reserve(scene.textures.size());
   for (const Texture& tex : scene.textures) d.textures.emplace_back(tex);
 
-  // Per-triangle UV-to-object area ratio (rigid transforms keep areas).
-  d.mesh_uv_scale.resize(scene.meshes.size());
+  // Per-triangle shading records; UV-to-object area ratio (rigid transforms keep areas).
+  d.mesh_shade.resize(scene.meshes.size());
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     const Mesh& mesh = scene.meshes[m];
-    if (mesh.uvs.empty()) continue;
-    std::vector<float>& scale = d.mesh_uv_scale[m];
-    scale.resize(mesh.triangles.size());
+    std::vector<Impl::TriangleShade>& shade = d.mesh_shade[m];
+    shade.resize(mesh.triangles.size());
     for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+      Impl::TriangleShade& ts = shade[i];
+      ts.material = mesh.triangle_materials.empty() ? mesh.material : mesh.triangle_materials[i];
+      std::fill(std::begin(ts.uv), std::end(ts.uv), 0.0f);
+      ts.texels_per_metre = -1.0f;
+      if (mesh.uvs.empty()) continue;
       const Eigen::Vector3i& tri = mesh.triangles[i];
+      for (int k = 0; k < 3; ++k) {
+        ts.uv[2 * k] = mesh.uvs[tri[k]].x();
+        ts.uv[2 * k + 1] = mesh.uvs[tri[k]].y();
+      }
+      const int texture = scene.materials[ts.material].texture;
+      if (texture < 0) continue;
       const float area = (mesh.positions[tri[1]] - mesh.positions[tri[0]])
                              .cross(mesh.positions[tri[2]] - mesh.positions[tri[0]])
                              .norm();
       const Eigen::Vector2f e1 = mesh.uvs[tri[1]] - mesh.uvs[tri[0]];
       const Eigen::Vector2f e2 = mesh.uvs[tri[2]] - mesh.uvs[tri[0]];
       const float uv_area = std::abs(e1.x() * e2.y() - e1.y() * e2.x());
-      scale[i] = area > 0.0f ? std::sqrt(uv_area / area) : 0.0f;
+      ts.texels_per_metre = area > 0.0f ? std::sqrt(uv_area / area) * d.textures[texture].TexelsPerUv() : 0.0f;
     }
   }
+  d.object_mesh.resize(scene.objects.size());
+  for (size_t o = 0; o < scene.objects.size(); ++o) d.object_mesh[o] = scene.objects[o].mesh;
 
   d.device = rtcNewDevice(nullptr);
   if (!d.device) throw std::runtime_error("cannot create the Embree device");
@@ -357,6 +452,15 @@ Tracer::Tracer(const Scene& scene) : impl_(std::make_unique<Impl>(scene)) {
   d.sky_mean = 0.5f * (light.sky_zenith + light.sky_horizon);
   d.ground_irradiance =
       light.ground_albedo.cwiseProduct(light.sun_radiance * std::max(0.0f, d.sun_dir.z()) * kInvPi + d.sky_mean);
+  // Sun-disc directions: point i of the (0,2)-sequence (radinv2(i), sobol2(i)) mapped to the disc
+  // of radius tan(diameter / 2) around sun_dir (uniform in area).
+  for (int i = 0; i < kSunSamples; ++i) {
+    const float radius = d.sun_disc_radius * std::sqrt(RadicalInverse2(static_cast<uint32_t>(i)));
+    const float phi = 6.2831853f * Sobol2(static_cast<uint32_t>(i));
+    d.sun_samples[i] = (d.sun_dir + radius * (std::cos(phi) * d.sun_e1 + std::sin(phi) * d.sun_e2)).normalized();
+  }
+  // The instance level only exists for moving objects: without them, trace the static BVH itself.
+  d.trace_scene = d.dynamic_objects.empty() ? d.static_scene : d.top;
 
   SetFrame(0);
 }
@@ -393,6 +497,12 @@ struct alignas(64) TileBuffers {
   Eigen::Vector3f direct[kTilePixels];   // albedo * E_sun * cos / pi of each shadow ray
   Eigen::Vector3f sum[kTilePixels];      // linear radiance sums per pixel
   int count[kTilePixels];
+  // Per primary ray, between the two shading passes.
+  Eigen::Vector3f normal[kTilePixels];   // unit, facing the ray
+  Eigen::Vector3f albedo[kTilePixels];   // material base colour
+  const MipTexture* texture[kTilePixels];  // nullptr: untextured (or a miss: see hit)
+  float tex_u[kTilePixels], tex_v[kTilePixels], tex_lod[kTilePixels];
+  bool hit[kTilePixels];
 };
 
 void InitRay(RTCRayHit* rh, const Eigen::Vector3f& origin, const Eigen::Vector3f& dir) {
@@ -420,7 +530,8 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
   const Scene& scene = d.scene;
   const int width = rays.width, height = rays.height;
   const size_t num_pixels = static_cast<size_t>(width) * height;
-  if (!settings.raw_cast_only) {
+  const bool raw = settings.raw_cast_only;
+  if (!raw) {
     image->width = width;
     image->height = height;
     image->rgb.assign(num_pixels * 3, 0);
@@ -436,16 +547,21 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
   const Lighting& light = scene.lighting;
   const auto& srgb = SrgbTable();
   const float theta_max = static_cast<float>(0.5 * rays.camera.max_fov_deg * M_PI / 180.0);
+  const bool precomputed_samples = !settings.rotate_pattern && rays.sample_spp == spp;
+  const bool soft_sun = settings.soft_shadows && d.sun_disc_radius > 0.0f && spp > 1;
+  // A pixel's sun samples: the block of `spp` consecutive points of the (0,2)-sequence starting at
+  // a hashed multiple of spp (an elementary-interval-stratified set for power-of-two spp <= 64).
+  const uint32_t spp_u = static_cast<uint32_t>(spp);
+  const Eigen::Vector3f sky_ground = light.ground_albedo.cwiseProduct(light.sky_horizon);
+  const Eigen::Vector3f sky_delta = light.sky_zenith - light.sky_horizon;
+  const Eigen::Vector3f ambient_ground = light.ambient * d.ground_irradiance;
+  const Eigen::Vector3f ambient_delta = light.ambient * (d.sky_mean - d.ground_irradiance);
+  std::array<Eigen::Vector2f, 64> offsets{};
+  for (int s = 0; s < std::min(spp, 64); ++s) offsets[s] = CameraRays::SampleOffset(s, spp);
 
   const int tiles_x = (width + kTile - 1) / kTile;
   const int tiles_y = (height + kTile - 1) / kTile;
 
-  auto sky = [&](const Eigen::Vector3f& dir) -> Eigen::Vector3f {
-    if (dir.z() >= 0.0f) return light.sky_horizon + std::sqrt(dir.z()) * (light.sky_zenith - light.sky_horizon);
-    return light.ground_albedo.cwiseProduct(light.sky_horizon);
-  };
-
-  // Trace the primary rays in tb.rayhit[0, n); returns nothing, hits in place.
   auto render_tile = [&](int tile, TileBuffers& tb) {
     const int tx0 = (tile % tiles_x) * kTile;
     const int ty0 = (tile / tiles_x) * kTile;
@@ -471,18 +587,26 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
       const bool is_centre = s < 0 || spp == 1;
       int n = 0;
       for (int ly = 0; ly < th; ++ly) {
+        const size_t row = static_cast<size_t>(ty0 + ly) * width + tx0;
         for (int lx = 0; lx < tw; ++lx) {
-          const int x = tx0 + lx, y = ty0 + ly;
-          const size_t pi = static_cast<size_t>(y) * width + x;
+          const size_t pi = row + lx;
           if (!rays.valid[pi]) continue;
           Eigen::Vector3f bearing;
           if (is_centre) {
             bearing = rays.bearing[pi];
+          } else if (precomputed_samples) {
+            bearing = rays.sample_bearing[s][pi];
+            if (bearing.x() == 0.0f && bearing.y() == 0.0f && bearing.z() == 0.0f) continue;
           } else {
-            const uint64_t h = Mix64(pi * 0x632be59bd9b4e019ull + 1);
-            const float jx = Wrap01((s + 0.5f) / spp + UnitFloat(h));
-            const float jy = Wrap01(RadicalInverse2(static_cast<uint32_t>(s)) + UnitFloat(Mix64(h)));
-            if (!rays.SampleBearing(x + jx - 0.5f, y + jy - 0.5f, &bearing)) continue;
+            Eigen::Vector2f offset;
+            if (settings.rotate_pattern) {
+              const uint64_t h = Mix64(pi * 0x632be59bd9b4e019ull + 1);
+              offset.x() = Wrap01((s + 0.5f) / spp + UnitFloat(h)) - 0.5f;
+              offset.y() = Wrap01(RadicalInverse2(static_cast<uint32_t>(s)) + UnitFloat(Mix64(h))) - 0.5f;
+            } else {
+              offset = s < 64 ? offsets[s] : CameraRays::SampleOffset(s, spp);
+            }
+            if (!rays.SampleBearing(tx0 + lx + offset.x(), ty0 + ly + offset.y(), &bearing)) continue;
           }
           InitRay(&tb.rayhit[n], origin, world_from_cam_rot * bearing);
           tb.pixel[n] = ly * kTile + lx;
@@ -490,108 +614,114 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
         }
       }
       if (n == 0) continue;
-      rtcIntersect1M(d.top, &context, tb.rayhit, static_cast<unsigned>(n), sizeof(RTCRayHit));
+      rtcIntersect1M(d.trace_scene, &context, tb.rayhit, static_cast<unsigned>(n), sizeof(RTCRayHit));
 
-      if (is_centre && !settings.raw_cast_only && centre_pass) {
+      if (is_centre && !raw && centre_pass) {
         for (int r = 0; r < n; ++r) {
           const RTCRayHit& rh = tb.rayhit[r];
           const size_t pi = static_cast<size_t>(ty0 + tb.pixel[r] / kTile) * width + tx0 + tb.pixel[r] % kTile;
           if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
           if (settings.want_depth) image->depth[pi] = rh.ray.tfar;
           if (settings.want_mask) {
-            const int inst = static_cast<int>(rh.hit.instID[0]);
-            const int obj = d.top_instance_object[inst] >= 0 ? d.top_instance_object[inst]
-                                                             : d.static_geom_object[rh.hit.geomID];
+            const unsigned inst = rh.hit.instID[0];
+            const int obj = inst != RTC_INVALID_GEOMETRY_ID && d.top_instance_object[inst] >= 0
+                                ? d.top_instance_object[inst]
+                                : d.static_geom_object[rh.hit.geomID];
             image->mask[pi] = scene.objects[obj].id;
           }
         }
       }
       if (s < 0) continue;  // the extra centre pass only feeds depth and masks
 
-      // Shade the hits and set up shadow rays.
-      int num_shadow = 0;
+      // Shade the hits and set up shadow rays, in two passes over the tile's rays: pass 1 finds
+      // the surface (normal, material, texture coordinates and level of detail), pass 2 samples
+      // the textures, adds ambient light and sets up the shadow rays (short loops keep more
+      // independent texture loads in flight). The raw cast computes the same shadow rays (it needs
+      // the normal and the sun sample) but no albedo, texture, sky or ambient term.
       for (int r = 0; r < n; ++r) {
-        RTCRayHit& rh = tb.rayhit[r];
+        const RTCRayHit& rh = tb.rayhit[r];
+        const int local = tb.pixel[r];
         const Eigen::Vector3f dir(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
-        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
-          if (!settings.raw_cast_only) {
-            tb.sum[tb.pixel[r]] += sky(dir);
-            ++tb.count[tb.pixel[r]];
+        tb.hit[r] = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+        if (!tb.hit[r]) {
+          if (!raw) {
+            // Sky: mix(horizon, zenith, sqrt(d.z)) above the horizon, ground_albedo * horizon below.
+            tb.sum[local] += dir.z() >= 0.0f ? Eigen::Vector3f(light.sky_horizon + std::sqrt(dir.z()) * sky_delta)
+                                             : sky_ground;
+            ++tb.count[local];
           }
           continue;
         }
-        const float t = rh.ray.tfar;
-        const Eigen::Vector3f hit_point = origin + t * dir;
-        if (settings.raw_cast_only) {
-          // Same shadow rays as the full render, without any shading work.
-          if (!settings.shadows) continue;
-          RTCRay& sr = tb.shadow[num_shadow++];
-          sr.org_x = hit_point.x() + 1e-3f * rh.hit.Ng_x;
-          sr.org_y = hit_point.y() + 1e-3f * rh.hit.Ng_y;
-          sr.org_z = hit_point.z() + 1e-3f * rh.hit.Ng_z;
-          sr.dir_x = d.sun_dir.x();
-          sr.dir_y = d.sun_dir.y();
-          sr.dir_z = d.sun_dir.z();
-          sr.tnear = 1e-3f;
-          sr.tfar = std::numeric_limits<float>::infinity();
-          sr.mask = 0xffffffffu;
-          sr.time = 0.0f;
-          sr.id = 0;
-          sr.flags = 0;
-          continue;
-        }
-        const int inst = static_cast<int>(rh.hit.instID[0]);
-        const int obj_index = d.top_instance_object[inst] >= 0 ? d.top_instance_object[inst]
-                                                               : d.static_geom_object[rh.hit.geomID];
-        const Object& obj = scene.objects[obj_index];
-        const Mesh& mesh = scene.meshes[obj.mesh];
-        const unsigned prim = rh.hit.primID;
-        Eigen::Vector3f normal = d.object_rotation[obj_index] * Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
-        const float nlen = normal.norm();
-        normal = nlen > 0.0f ? Eigen::Vector3f(normal / nlen) : Eigen::Vector3f(-dir);
+        const unsigned inst = rh.hit.instID[0];
+        const int obj_index = inst != RTC_INVALID_GEOMETRY_ID && d.top_instance_object[inst] >= 0
+                                  ? d.top_instance_object[inst]
+                                  : d.static_geom_object[rh.hit.geomID];
+        Eigen::Vector3f normal(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+        if (inst != RTC_INVALID_GEOMETRY_ID) normal = d.object_rotation[obj_index] * normal;
+        const float nlen2 = normal.squaredNorm();
+        normal = nlen2 > 0.0f ? Eigen::Vector3f(normal / std::sqrt(nlen2)) : Eigen::Vector3f(-dir);
         if (normal.dot(dir) > 0.0f) normal = -normal;
+        tb.normal[r] = normal;
+        tb.texture[r] = nullptr;
+        if (raw) continue;
+        const Impl::TriangleShade& ts = d.mesh_shade[d.object_mesh[obj_index]][rh.hit.primID];
+        const Material& mat = scene.materials[ts.material];
+        tb.albedo[r] = mat.base_color;
+        if (!settings.textures || ts.texels_per_metre < 0.0f) continue;
+        const float bu = rh.hit.u, bv = rh.hit.v, bw = 1.0f - bu - bv;
+        const float u = bw * ts.uv[0] + bu * ts.uv[2] + bv * ts.uv[4];
+        const float v = bw * ts.uv[1] + bu * ts.uv[3] + bv * ts.uv[5];
+        const MipTexture& tex = d.textures[mat.texture];
+        // Ray-cone footprint in metres, then in texels of level 0.
+        const size_t pi = static_cast<size_t>(ty0 + local / kTile) * width + tx0 + local % kTile;
         const float cos_view = std::max(-normal.dot(dir), 0.1f);
+        const float texels = rh.ray.tfar * rays.pixel_angle[pi] / cos_view * inv_sqrt_spp * ts.texels_per_metre;
+        const float lod = texels > 0.0f ? FastLog2(texels) + settings.lod_bias : 0.0f;
+        tb.texture[r] = &tex;
+        tb.tex_u[r] = u;
+        tb.tex_v[r] = v;
+        tb.tex_lod[r] = lod;
+      }
 
-        const int mat_index = mesh.triangle_materials.empty() ? mesh.material : mesh.triangle_materials[prim];
-        const Material& mat = scene.materials[mat_index];
-        Eigen::Vector3f albedo = mat.base_color;
-        if (settings.textures && mat.texture >= 0 && !mesh.uvs.empty()) {
-          const Eigen::Vector3i& tri = mesh.triangles[prim];
-          const float bu = rh.hit.u, bv = rh.hit.v;
-          const Eigen::Vector2f uv = (1.0f - bu - bv) * mesh.uvs[tri[0]] + bu * mesh.uvs[tri[1]] + bv * mesh.uvs[tri[2]];
-          const MipTexture& tex = d.textures[mat.texture];
-          const size_t pi = static_cast<size_t>(ty0 + tb.pixel[r] / kTile) * width + tx0 + tb.pixel[r] % kTile;
-          const float footprint_m = t * rays.pixel_angle[pi] / cos_view * inv_sqrt_spp;
-          const float texels = footprint_m * d.mesh_uv_scale[obj.mesh][prim] * tex.TexelsPerUv();
-          const float lod = texels > 0.0f ? std::log2(texels) + settings.lod_bias : 0.0f;
-          albedo = albedo.cwiseProduct(tex.Sample(uv.x(), uv.y(), lod));
+      int num_shadow = 0;
+      for (int r = 0; r < n; ++r) {
+        if (!tb.hit[r]) continue;
+        const RTCRayHit& rh = tb.rayhit[r];
+        const int local = tb.pixel[r];
+        const Eigen::Vector3f dir(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
+        const float t = rh.ray.tfar;
+        const Eigen::Vector3f& normal = tb.normal[r];
+        const size_t pi = static_cast<size_t>(ty0 + local / kTile) * width + tx0 + local % kTile;
+        Eigen::Vector3f albedo = Eigen::Vector3f::Zero();
+        if (!raw) {
+          albedo = tb.albedo[r];
+          if (const MipTexture* tex = tb.texture[r]) {
+            if (settings.trilinear) {
+              albedo = albedo.cwiseProduct(tex->Sample(tb.tex_u[r], tb.tex_v[r], tb.tex_lod[r]));
+            } else {
+              const int level = std::clamp(static_cast<int>(tb.tex_lod[r] + 0.5f), 0, tex->NumLevels() - 1);
+              albedo = albedo.cwiseProduct(tex->SampleLevel(tb.tex_u[r], tb.tex_v[r], level));
+            }
+          }
+          // Ambient: hemisphere mix of sky and ground by the normal's elevation.
+          const float up = 0.5f * (1.0f + normal.z());
+          tb.sum[local] += albedo.cwiseProduct(ambient_ground + up * ambient_delta);
+          ++tb.count[local];
         }
-        // Ambient: hemisphere mix of sky and ground by the normal's elevation.
-        const float up = 0.5f * (1.0f + normal.z());
-        const Eigen::Vector3f ambient =
-            light.ambient * (d.ground_irradiance + up * (d.sky_mean - d.ground_irradiance));
-        tb.sum[tb.pixel[r]] += albedo.cwiseProduct(ambient);
-        ++tb.count[tb.pixel[r]];
 
-        Eigen::Vector3f to_sun = d.sun_dir;
-        if (settings.soft_shadows && d.sun_disc_radius > 0.0f && spp > 1) {
-          const size_t pi = static_cast<size_t>(ty0 + tb.pixel[r] / kTile) * width + tx0 + tb.pixel[r] % kTile;
-          const uint64_t h = Mix64(pi * 0x9e3779b97f4a7c15ull + 7);
-          const float a = Wrap01(RadicalInverse2(static_cast<uint32_t>(s) * 2654435761u) + UnitFloat(h));
-          const float b = Wrap01((s + 0.5f) / spp + UnitFloat(Mix64(h)));
-          const float radius = d.sun_disc_radius * std::sqrt(a);
-          const float phi = 6.2831853f * b;
-          to_sun = (d.sun_dir + radius * (std::cos(phi) * d.sun_e1 + std::sin(phi) * d.sun_e2)).normalized();
-        }
+        const Eigen::Vector3f& to_sun =
+            soft_sun ? d.sun_samples[(static_cast<uint32_t>(Mix64(pi * 0x9e3779b97f4a7c15ull + 7)) * spp_u +
+                                      static_cast<uint32_t>(s)) &
+                                     (kSunSamples - 1)]
+                     : d.sun_dir;
         const float cos_sun = normal.dot(to_sun);
         if (cos_sun <= 0.0f) continue;
-        const Eigen::Vector3f direct = albedo.cwiseProduct(light.sun_radiance) * (cos_sun * kInvPi);
         if (!settings.shadows) {
-          tb.sum[tb.pixel[r]] += direct;
+          if (!raw) tb.sum[local] += albedo.cwiseProduct(light.sun_radiance) * (cos_sun * kInvPi);
           continue;
         }
         const float offset = 1e-4f * (1.0f + t);
-        const Eigen::Vector3f shadow_origin = hit_point + offset * normal;
+        const Eigen::Vector3f shadow_origin = origin + t * dir + offset * normal;
         RTCRay& sr = tb.shadow[num_shadow];
         sr.org_x = shadow_origin.x();
         sr.org_y = shadow_origin.y();
@@ -605,19 +735,21 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
         sr.time = 0.0f;
         sr.id = 0;
         sr.flags = 0;
-        tb.shadow_ray[num_shadow] = r;
-        tb.direct[num_shadow] = direct;
+        if (!raw) {
+          tb.shadow_ray[num_shadow] = r;
+          tb.direct[num_shadow] = albedo.cwiseProduct(light.sun_radiance) * (cos_sun * kInvPi);
+        }
         ++num_shadow;
       }
       if (num_shadow == 0) continue;
-      rtcOccluded1M(d.top, &shadow_context, tb.shadow, static_cast<unsigned>(num_shadow), sizeof(RTCRay));
-      if (settings.raw_cast_only) continue;
+      rtcOccluded1M(d.trace_scene, &shadow_context, tb.shadow, static_cast<unsigned>(num_shadow), sizeof(RTCRay));
+      if (raw) continue;
       for (int k = 0; k < num_shadow; ++k) {
         // Embree sets tfar to -inf for occluded rays.
         if (tb.shadow[k].tfar >= 0.0f) tb.sum[tb.pixel[tb.shadow_ray[k]]] += tb.direct[k];
       }
     }
-    if (settings.raw_cast_only) return;
+    if (raw) return;
 
     // Resolve: box filter, exposure, optional vignetting and noise, sRGB.
     for (int ly = 0; ly < th; ++ly) {

@@ -12,8 +12,10 @@
 //   ray origin = world_from_cam.translation, direction = world_from_cam.rotation * bearing(uv),
 // with bearing(uv) = Camera::Unproject(uv), precomputed at every pixel centre (CameraRays). A
 // sub-pixel sample bearing is the normalized bilinear interpolation of the four surrounding
-// pixel-centre bearings (exact Unproject near the image-circle edge). Pixels whose centre does not
-// unproject are black, depth 0, mask 0.
+// pixel-centre bearings (exact Unproject near the image-circle edge); for the fixed sample
+// pattern these are precomputed per camera too (CameraRays::Make with spp > 1). Pixels whose
+// centre does not unproject are black, depth 0, mask 0. Scenes without dynamic objects are traced
+// in the static scene directly (no instance level).
 //
 // Shading (linear RGB, then exposure and sRGB):
 //   L = albedo * ( E_sun * max(0, n.s) * V / pi + ambient * E_sky(n) ),
@@ -26,10 +28,15 @@
 // Texture level of detail: ray-cone footprint f = t * pixel_angle / max(|cos|, 0.1) / sqrt(spp)
 // in metres, times texels per metre of the triangle, sqrt(A_uv / A_world) * sqrt(W * H).
 //
-// Samples: `spp` jittered sub-pixel positions per pixel from a fixed per-pixel pattern (a
-// (0,2)-sequence with a per-pixel hashed rotation), box filter. With spp = 1 the sample is the
-// pixel centre. Depth and mask always come from the pixel-centre ray. Every pixel's value depends
-// only on its own pattern, so images are identical for any thread count.
+// Samples: `spp` sub-pixel positions per pixel, box filter. Default pattern: the same N-rooks
+// (Hammersley) offsets in every pixel, SampleOffset(s, spp) = ((s + 1/2) / N - 1/2,
+// frac(radinv2(s) + 1/(2N)) - 1/2) (N = 2: the two diagonal quarter points, N = 4: a rotated
+// grid). ShadeSettings::rotate_pattern instead adds a per-pixel hashed Cranley-Patterson
+// rotation (aliasing traded for noise). With spp = 1 the sample is the pixel centre. Soft-shadow
+// sun directions (spp > 1) come from a 64-point (0,2)-sequence on the sun disc: each pixel takes
+// a hashed, spp-aligned block of spp consecutive points (stratified for power-of-two spp). Depth and mask
+// always come from the pixel-centre ray. Every pixel's value depends only on its own samples, so
+// images are identical for any thread count.
 
 #include "datasets/camera.h"
 #include "datasets/rigid3.h"
@@ -54,17 +61,32 @@ struct CameraRays {
   std::vector<float> pixel_angle;        // radians between neighbouring pixel centres
   int num_valid = 0;
 
-  // Unprojects every pixel centre (parallel, `threads` 0 = all cores).
-  static CameraRays Make(const Camera& camera, int threads = 0);
+  // Bearings of the fixed sub-pixel samples: sample_bearing[s][pixel] for s < sample_spp
+  // (zero where the sample does not unproject); empty unless Make() got spp > 1.
+  int sample_spp = 0;
+  std::vector<std::vector<Eigen::Vector3f>> sample_bearing;
+
+  // Unprojects every pixel centre (parallel, `threads` 0 = all cores); with spp > 1 also the
+  // bearings of the fixed `spp`-sample pattern (12 bytes per pixel and sample).
+  static CameraRays Make(const Camera& camera, int threads = 0, int spp = 1);
   // Bearing of the continuous pixel position (u, v); false outside the field of view.
   bool SampleBearing(float u, float v, Eigen::Vector3f* bearing_out) const;
+  // Offset from the pixel centre, in pixels within [-1/2, 1/2)^2, of sample s of the fixed
+  // `spp`-sample pattern (see the file comment); (0, 0) for spp = 1.
+  static Eigen::Vector2f SampleOffset(int s, int spp);
 };
+
+// CameraRays::Make for each camera of a rig; cameras with identical intrinsics (model, size,
+// parameters, FOV) share one computation (copied).
+std::vector<CameraRays> MakeCameraRays(const std::vector<Camera>& cameras, int threads = 0, int spp = 1);
 
 struct ShadeSettings {
   int spp = 1;
   bool shadows = true;
   bool soft_shadows = true;     // sample the sun disc (Lighting::sun_angular_diameter_deg)
   bool textures = true;
+  bool trilinear = true;        // texture lookups blend two mip levels; false = bilinear on the nearest level
+  bool rotate_pattern = false;  // per-pixel hashed rotation of the sample pattern (quality study)
   float lod_bias = -0.5f;       // added to the texture level of detail (measured: render/README.md)
   bool want_depth = false;      // fill CameraImage::depth
   bool want_mask = false;       // fill CameraImage::mask
