@@ -85,9 +85,36 @@ class MeshBuilder {
     Quad(P(a.x(), a.y(), z0), P(b.x(), b.y(), z0), P(b.x(), b.y(), z1), P(a.x(), a.y(), z1), {ua, v0}, {ub, v0}, {ub, v1},
          {ua, v1}, material);
   }
-  // Axis-aligned box; per-face materials in order -x, +x, -y, +y, top (bottom omitted). UVs map each
-  // face's full extent to [0, 1] unless tile > 0 (metres per texture tile).
-  void Box(const Vec3f& lo, const Vec3f& hi, const int materials[5], float tile = 0) {
+  // Block in front of a wall: along the wall d in [d0, d1] from `origin` in direction `along` (unit),
+  // out of it n in [n0, n1] along the wall's outward normal (right of `along`), z in [z0, z1]. Five
+  // faces (no back face, it touches the wall). The front face takes uv(d, z), so a block carrying
+  // the wall's material continues the wall's texture; the side, top and bottom faces continue it
+  // around the edges (their depth coordinate stretches d or z).
+  void WallBlock(const Eigen::Vector2d& origin, const Eigen::Vector2d& along, double d0, double d1, double n0, double n1,
+                 double z0, double z1, const std::function<Vec2f(double, double)>& uv, int material) {
+    const Eigen::Vector2d normal(along.y(), -along.x());
+    auto at = [&](double d, double n, double z) {
+      const Eigen::Vector2d xy = origin + d * along + n * normal;
+      return P(xy.x(), xy.y(), z);
+    };
+    const double depth = n1 - n0;
+    // Front (outward), seen from outside: d0 left, d1 right.
+    Quad(at(d0, n1, z0), at(d1, n1, z0), at(d1, n1, z1), at(d0, n1, z1), uv(d0, z0), uv(d1, z0), uv(d1, z1), uv(d0, z1), material);
+    // Side at d0 (normal -along) and at d1 (normal +along).
+    Quad(at(d0, n0, z0), at(d0, n1, z0), at(d0, n1, z1), at(d0, n0, z1), uv(d0 - depth, z0), uv(d0, z0), uv(d0, z1),
+         uv(d0 - depth, z1), material);
+    Quad(at(d1, n1, z0), at(d1, n0, z0), at(d1, n0, z1), at(d1, n1, z1), uv(d1, z0), uv(d1 + depth, z0), uv(d1 + depth, z1),
+         uv(d1, z1), material);
+    // Top (normal +z) and bottom (normal -z).
+    Quad(at(d0, n0, z1), at(d0, n1, z1), at(d1, n1, z1), at(d1, n0, z1), uv(d0, z1 + depth), uv(d0, z1), uv(d1, z1),
+         uv(d1, z1 + depth), material);
+    Quad(at(d0, n1, z0), at(d0, n0, z0), at(d1, n0, z0), at(d1, n1, z0), uv(d0, z0), uv(d0, z0 - depth), uv(d1, z0 - depth),
+         uv(d1, z0), material);
+  }
+  // Axis-aligned box; per-face materials in order -x, +x, -y, +y, top (bottom omitted unless
+  // `bottom`, then it takes the -x material). UVs map each face's full extent to [0, 1] unless
+  // tile > 0 (metres per texture tile).
+  void Box(const Vec3f& lo, const Vec3f& hi, const int materials[5], float tile = 0, bool bottom = false) {
     auto uv = [&](float a, float b, float ext_a, float ext_b) {
       return tile > 0 ? Vec2f(a / tile, -b / tile) : Vec2f(a / ext_a, 1.0f - b / ext_b);
     };
@@ -103,6 +130,10 @@ class MeshBuilder {
          uv(0, 0, e.x(), e.z()), uv(e.x(), 0, e.x(), e.z()), uv(e.x(), e.z(), e.x(), e.z()), uv(0, e.z(), e.x(), e.z()), materials[3]);
     Quad(P(lo.x(), lo.y(), hi.z()), P(hi.x(), lo.y(), hi.z()), P(hi.x(), hi.y(), hi.z()), P(lo.x(), hi.y(), hi.z()),
          uv(0, 0, e.x(), e.y()), uv(e.x(), 0, e.x(), e.y()), uv(e.x(), e.y(), e.x(), e.y()), uv(0, e.y(), e.x(), e.y()), materials[4]);
+    if (bottom) {
+      Quad(P(lo.x(), lo.y(), lo.z()), P(lo.x(), hi.y(), lo.z()), P(hi.x(), hi.y(), lo.z()), P(hi.x(), lo.y(), lo.z()),
+           uv(0, 0, e.x(), e.y()), uv(0, e.y(), e.x(), e.y()), uv(e.x(), e.y(), e.x(), e.y()), uv(e.x(), 0, e.x(), e.y()), materials[0]);
+    }
   }
   // Vertical prism with a regular n-gon cross-section around `axis_centre`; axis along z (or along
   // y when `along_y`, for wheels). Sides tile the texture once around.
@@ -174,13 +205,19 @@ Rigid3 PlaceYaw(double x, double y, double yaw_rad, double z = 0.0) {
   return Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ())), Eigen::Vector3d(x, y, z));
 }
 
-Lighting MakeLighting(const std::string& preset, uint64_t seed) {
+// `high_sun_along_streets` (sunny only): a high sun 15-25 degrees off a street axis, so that light
+// reaches the floor of a narrow canyon in strips instead of only the upper floors.
+Lighting MakeLighting(const std::string& preset, uint64_t seed, bool high_sun_along_streets) {
   SceneRng rng(SubSeed(seed, "lighting"));
   Lighting l;
   l.preset = preset;
   double elevation_deg = 60, azimuth_deg = rng.Uniform(0, 360);
   if (preset == "sunny") {
     elevation_deg = rng.Uniform(50, 65);
+    if (high_sun_along_streets) {
+      elevation_deg = rng.Uniform(68, 76);
+      azimuth_deg = rng.UniformInt(0, 3) * 90.0 + rng.Uniform(15, 25);
+    }
     l.sun_radiance = {3.0f, 2.9f, 2.7f};
     l.sun_angular_diameter_deg = 0.53;
     l.sky_zenith = {0.25f, 0.45f, 0.9f};
@@ -391,6 +428,247 @@ std::vector<VehicleTrack> PlanTraffic(const CityLayout& L, uint64_t seed, int fr
   return accepted;
 }
 
+// ---- buildings -----------------------------------------------------------------------------------
+
+// Shared materials of the architectural details.
+struct ArchitectureMaterials {
+  int roof = -1;
+  std::vector<int> trim;        // cornices, parapets, balcony slabs, rooftop structures
+  std::vector<int> roof_tiles;  // pitched roofs
+  std::vector<int> railing;     // balcony railings (plain paint)
+  std::vector<int> awning;      // striped cloth
+  int metal = -1;
+};
+
+// One building: storefront ground floor, facade walls, roof, and real geometry that lines up with
+// the facade texture's windows (facade relief that recesses the windows, glass-wall fins,
+// balconies), awnings over the shops, a roofline (cornice, parapet or hipped roof) and rooftop
+// structures. `arch` draws every random choice, in a fixed order per building.
+void AddBuilding(MeshBuilder& b, const BuildingPlan& p, const FacadeLayout& fl, int m_facade, int m_shop,
+                 const ArchitectureMaterials& am, const CityStyle& st, SceneRng& arch) {
+  const double texel = kFacadeTileMetres / 1024.0;  // metres per facade texel (both axes)
+  // Window placement as MakeFacadeTexture paints it (integer pixel arithmetic reproduced).
+  const int bay_px = 1024 / fl.bays;
+  const int win_w_px = static_cast<int>(bay_px * fl.window_width_fraction);
+  const int win_h_px = static_cast<int>(256 * fl.window_height_fraction);
+  const int win_top_px = (256 - win_h_px) / 2 - 8;  // below the floor's top
+  const int floors = std::max(1, static_cast<int>(std::lround((p.height - 0.4 - kStorefrontHeightMetres) / kFloorHeightMetres)));
+
+  const double r_relief = arch.Uniform(), r_balcony = arch.Uniform(), r_roof = arch.Uniform(), r_awning = arch.Uniform(),
+               r_rooftop = arch.Uniform();
+  const bool hip_roof = !p.has_setback && p.height <= 17.0 && fl.style != 3 && r_roof < 0.45;
+
+  auto walls = [&](const Box2& fp, double z0, double z1, bool shops, bool roof) {
+    const Eigen::Vector2d c[4] = {fp.min, {fp.max.x(), fp.min.y()}, fp.max, {fp.min.x(), fp.max.y()}};
+    for (int e = 0; e < 4; ++e) {
+      // Counter-clockwise walk (c[e] -> c[e+1]): the outward normal is on the right and the
+      // texture's u runs left to right for a viewer outside (signs are not mirrored).
+      const Eigen::Vector2d a = c[e], bb = c[(e + 1) % 4];
+      double zs = z0;
+      if (shops) {
+        b.Wall(a, bb, 0.0, kStorefrontHeightMetres, p.u_offset, kFacadeTileMetres, 1.0, kStorefrontHeightMetres, m_shop);
+        zs = kStorefrontHeightMetres;
+      }
+      // v = 100 at z = 4 m: texture floor boundaries coincide with storey boundaries.
+      const double v0 = 100.0 - (zs - kStorefrontHeightMetres) / kFacadeTileMetres;
+      b.Wall(a, bb, zs, z1, p.u_offset, kFacadeTileMetres, v0, kFacadeTileMetres, m_facade);
+    }
+    if (roof) b.Floor(fp.min, fp.max, z1, kRoofTileMetres, am.roof);
+  };
+  walls(p.footprint, 0.0, p.height, true, !hip_roof);
+  if (p.has_setback) walls(p.upper_footprint, p.height, p.upper_height, false, true);
+
+  // The street-facing wall of the base box: origin, direction (outward normal on its right), length.
+  const Eigen::Vector2d corners[4] = {p.footprint.min, {p.footprint.max.x(), p.footprint.min.y()}, p.footprint.max,
+                                      {p.footprint.min.x(), p.footprint.max.y()}};
+  int street = 0;
+  for (int e = 0; e < 4; ++e) {
+    const Eigen::Vector2d along = (corners[(e + 1) % 4] - corners[e]).normalized();
+    if (Eigen::Vector2d(along.y(), -along.x()).dot(p.facing) > 0.5) street = e;
+  }
+  const Eigen::Vector2d origin = corners[street];
+  const Eigen::Vector2d along = (corners[(street + 1) % 4] - origin).normalized();
+  const double length = (corners[(street + 1) % 4] - origin).norm();
+  auto facade_uv = [&](double d, double z) {
+    return Vec2f(static_cast<float>((p.u_offset + d) / kFacadeTileMetres),
+                 static_cast<float>(100.0 - (z - kStorefrontHeightMetres) / kFacadeTileMetres));
+  };
+  // Wall coordinate d of texture column x (pixels, any tile).
+  auto d_of_px = [&](double x) { return x * texel - p.u_offset; };
+  const int tile_first = static_cast<int>(std::floor(p.u_offset / kFacadeTileMetres)) - 1;
+  const int tile_last = static_cast<int>(std::ceil((p.u_offset + length) / kFacadeTileMetres)) + 1;
+  std::vector<double> bay_edges, window_centres;
+  for (int t = tile_first; t <= tile_last; ++t)
+    for (int k = 0; k < fl.bays; ++k) {
+      const double x0 = 1024.0 * t + k * bay_px;
+      bay_edges.push_back(d_of_px(x0));
+      window_centres.push_back(d_of_px(x0 + (bay_px - win_w_px) / 2 + 0.5 * win_w_px));
+    }
+  const double top = p.height;  // base box top (parapet included)
+  auto floor_top = [&](int k) { return kStorefrontHeightMetres + (k + 1) * kFloorHeightMetres; };
+
+  // Facade relief: the wall between the windows steps forward, so the windows sit in recesses.
+  if (fl.style == 3) {
+    if (r_relief < 0.7) {  // glass curtain wall: thin vertical fins at the mullion lines
+      const double fin_w = std::min(0.1, 0.6 * (bay_px - win_w_px) * texel), fin_d = arch.Uniform(0.3, 0.5);
+      for (double d : bay_edges)
+        if (d - fin_w > 0.2 && d + fin_w < length - 0.2)
+          b.WallBlock(origin, along, d - 0.5 * fin_w, d + 0.5 * fin_w, 0.0, fin_d, kStorefrontHeightMetres, top, facade_uv, m_facade);
+    }
+  } else if (r_relief < 0.6) {
+    const double depth = arch.Uniform(0.12, 0.3);
+    const int kind = arch.UniformInt(0, 2);  // 0 pilasters, 1 floor bands, 2 both
+    if (kind != 1) {
+      const double w = std::min(0.45, 0.7 * (bay_px - win_w_px) * texel);
+      // Corner pilasters where no painted window column reaches the corner.
+      auto clear_of_windows = [&](double d0, double d1) {
+        for (double dc : window_centres)
+          if (d1 > dc - 0.5 * win_w_px * texel && d0 < dc + 0.5 * win_w_px * texel) return false;
+        return true;
+      };
+      if (clear_of_windows(0.0, w)) b.WallBlock(origin, along, 0.0, w, 0.0, depth, kStorefrontHeightMetres, top, facade_uv, m_facade);
+      if (clear_of_windows(length - w, length))
+        b.WallBlock(origin, along, length - w, length, 0.0, depth, kStorefrontHeightMetres, top, facade_uv, m_facade);
+      for (double d : bay_edges)
+        if (d - w > 0.3 && d + w < length - 0.3)
+          b.WallBlock(origin, along, d - 0.5 * w, d + 0.5 * w, 0.0, depth, kStorefrontHeightMetres, top, facade_uv, m_facade);
+    }
+    if (kind != 0) {
+      // From the window top of one floor to the window bottom of the next (the storefront top and
+      // the roof close the first and last band).
+      for (int k = 0; k <= floors; ++k) {
+        const double z0 = k == 0 ? kStorefrontHeightMetres : floor_top(k - 1) - win_top_px * texel;
+        const double z1 = k == floors ? top : floor_top(k) - (win_top_px + win_h_px) * texel;
+        if (z1 - z0 > 0.05) b.WallBlock(origin, along, 0.0, length, 0.0, depth, z0, z1, facade_uv, m_facade);
+      }
+    }
+  }
+
+  // Balconies under the windows of the street side: slab, front and side railing panels.
+  if (fl.style != 3 && floors >= 2 && r_balcony < 0.3) {
+    const double depth = arch.Uniform(0.9, 1.3);
+    const int stride = arch.UniformInt(1, 2), phase = arch.UniformInt(0, 1), first_floor = arch.UniformInt(0, 1);
+    const int rail = am.railing[arch.UniformInt(0, static_cast<int>(am.railing.size()) - 1)];
+    const int slab = am.trim[arch.UniformInt(0, static_cast<int>(am.trim.size()) - 1)];
+    const double half = std::min(0.5 * win_w_px * texel + 0.3, 0.5 * bay_px * texel - 0.05);
+    auto plain_uv = [](double d, double z) { return Vec2f(static_cast<float>(d / kRoofTileMetres), static_cast<float>(-z / kRoofTileMetres)); };
+    int count = 0;
+    for (size_t i = 0; i < window_centres.size(); ++i) {
+      const double dc = window_centres[i];
+      if (static_cast<int>(i) % stride != phase % stride || dc - half < 0.3 || dc + half > length - 0.3) continue;
+      for (int k = first_floor; k < floors && count < 120; ++k, ++count) {
+        const double z = kStorefrontHeightMetres + k * kFloorHeightMetres;  // floor level
+        b.WallBlock(origin, along, dc - half, dc + half, 0.0, depth, z - 0.18, z, plain_uv, slab);
+        b.WallBlock(origin, along, dc - half, dc + half, depth - 0.05, depth, z, z + 1.0, plain_uv, rail);
+        b.WallBlock(origin, along, dc - half, dc - half + 0.05, 0.0, depth - 0.05, z, z + 1.0, plain_uv, rail);
+        b.WallBlock(origin, along, dc + half - 0.05, dc + half, 0.0, depth - 0.05, z, z + 1.0, plain_uv, rail);
+      }
+    }
+  }
+
+  // Awnings over the shop windows: a sloped cloth, a front valance and closed sides.
+  if (r_awning < 0.45 && length > 3.0) {
+    const double reach = std::min(1.3, st.sidewalk_width_m - 0.8);
+    const int n = arch.UniformInt(1, 3);
+    const double part = length / n;
+    for (int i = 0; i < n; ++i) {
+      const double w = arch.Uniform(std::min(2.0, part - 0.8), part - 0.8);
+      const double d0 = i * part + 0.4 + arch.Uniform(0.0, part - 0.8 - w), d1 = d0 + w;
+      const int m = am.awning[arch.UniformInt(0, static_cast<int>(am.awning.size()) - 1)];
+      if (w < 1.0) continue;
+      const double z_wall = 3.15, z_edge = 2.6, z_low = 2.35;
+      const Eigen::Vector2d normal(along.y(), -along.x());
+      auto at = [&](double d, double nn, double z) {
+        const Eigen::Vector2d xy = origin + d * along + nn * normal;
+        return MeshBuilder::P(xy.x(), xy.y(), z);
+      };
+      const float u0 = static_cast<float>(d0 / 2.56), u1 = static_cast<float>(d1 / 2.56);
+      const float v_edge = static_cast<float>(std::hypot(reach, z_wall - z_edge) / 0.64);
+      const float v_low = v_edge + static_cast<float>((z_edge - z_low) / 0.64);
+      b.Quad(at(d0, reach, z_edge), at(d1, reach, z_edge), at(d1, 0.0, z_wall), at(d0, 0.0, z_wall), {u0, v_edge}, {u1, v_edge},
+             {u1, 0}, {u0, 0}, m);
+      b.Quad(at(d0, reach, z_low), at(d1, reach, z_low), at(d1, reach, z_edge), at(d0, reach, z_edge), {u0, v_low}, {u1, v_low},
+             {u1, v_edge}, {u0, v_edge}, m);
+      b.Tri(at(d0, 0.0, z_wall), at(d0, reach, z_low), at(d0, reach, z_edge), {0, 0}, {0.2f, v_low}, {0.2f, v_edge}, m);
+      b.Tri(at(d1, 0.0, z_wall), at(d1, reach, z_edge), at(d1, reach, z_low), {0, 0}, {0.2f, v_edge}, {0.2f, v_low}, m);
+    }
+  }
+
+  // Roofline: a hipped roof on low buildings, else a cornice or a parapet (or a plain edge).
+  const int trim = am.trim[arch.UniformInt(0, static_cast<int>(am.trim.size()) - 1)];
+  const Box2& roof_fp = p.has_setback ? p.upper_footprint : p.footprint;
+  const double roof_z = p.has_setback ? p.upper_height : p.height;
+  if (hip_roof) {
+    const double eave = arch.Uniform(0.3, 0.6), pitch = arch.Uniform(22.0, 35.0) * M_PI / 180.0;
+    const int tiles = am.roof_tiles[arch.UniformInt(0, static_cast<int>(am.roof_tiles.size()) - 1)];
+    const Eigen::Vector2d lo = roof_fp.min.array() - eave, hi = roof_fp.max.array() + eave;
+    // Local frame: a along the ridge, c across it.
+    const bool ridge_x = hi.x() - lo.x() >= hi.y() - lo.y();
+    const double a0 = ridge_x ? lo.x() : lo.y(), a1 = ridge_x ? hi.x() : hi.y();
+    const double c0 = ridge_x ? lo.y() : lo.x(), c1 = ridge_x ? hi.y() : hi.x();
+    const double half = 0.5 * (c1 - c0), cm = 0.5 * (c0 + c1), rise = half * std::tan(pitch);
+    auto P = [&](double a, double c, double z) { return ridge_x ? MeshBuilder::P(a, c, z) : MeshBuilder::P(c, a, z); };
+    auto uv = [&](double a, double c) { return Vec2f(static_cast<float>(a / kRoofTileMetres), static_cast<float>(c / kRoofTileMetres)); };
+    const double z = roof_z, zr = roof_z + rise;
+    // With ridge_x false the local frame is mirrored; the tracer shades both sides of a triangle.
+    b.Quad(P(a0, c0, z), P(a1, c0, z), P(a1 - half, cm, zr), P(a0 + half, cm, zr), uv(a0, c0), uv(a1, c0), uv(a1 - half, cm),
+           uv(a0 + half, cm), tiles);
+    b.Quad(P(a1, c1, z), P(a0, c1, z), P(a0 + half, cm, zr), P(a1 - half, cm, zr), uv(a1, c1), uv(a0, c1), uv(a0 + half, cm),
+           uv(a1 - half, cm), tiles);
+    b.Tri(P(a0, c1, z), P(a0, c0, z), P(a0 + half, cm, zr), uv(c1, a0), uv(c0, a0), uv(cm, a0 + half), tiles);
+    b.Tri(P(a1, c0, z), P(a1, c1, z), P(a1 - half, cm, zr), uv(c0, a1), uv(c1, a1), uv(cm, a1 - half), tiles);
+    b.Floor(lo, hi, z, kRoofTileMetres, trim);  // eave soffit (and ceiling under the roof)
+  } else if (r_roof < 0.75) {
+    const double over = arch.Uniform(0.25, 0.45), height = arch.Uniform(0.4, 0.7);
+    const int faces[5] = {trim, trim, trim, trim, am.roof};
+    auto cornice = [&](const Box2& fp, double z) {
+      b.Box(MeshBuilder::P(fp.min.x() - over, fp.min.y() - over, z - height), MeshBuilder::P(fp.max.x() + over, fp.max.y() + over, z + 0.05),
+            faces, static_cast<float>(kRoofTileMetres), true);
+    };
+    cornice(p.footprint, p.height);
+    if (p.has_setback) cornice(p.upper_footprint, p.upper_height);
+  } else {
+    const double h = arch.Uniform(0.6, 1.1), t = 0.25;
+    const int faces[5] = {trim, trim, trim, trim, trim};
+    const Box2& fp = roof_fp;
+    const float z0 = static_cast<float>(roof_z), z1 = static_cast<float>(roof_z + h);
+    auto box = [&](double x0, double y0, double x1, double y1) {
+      b.Box(MeshBuilder::P(x0, y0, z0), MeshBuilder::P(x1, y1, z1), faces, static_cast<float>(kRoofTileMetres));
+    };
+    box(fp.min.x(), fp.min.y(), fp.max.x(), fp.min.y() + t);
+    box(fp.min.x(), fp.max.y() - t, fp.max.x(), fp.max.y());
+    box(fp.min.x(), fp.min.y() + t, fp.min.x() + t, fp.max.y() - t);
+    box(fp.max.x() - t, fp.min.y() + t, fp.max.x(), fp.max.y() - t);
+  }
+
+  // Rooftop structures on flat roofs: stair house, air conditioners, sometimes a water tank.
+  const Eigen::Vector2d room = roof_fp.max - roof_fp.min;
+  if (!hip_roof && r_rooftop < 0.55 && room.minCoeff() > 5.0) {
+    const int faces[5] = {trim, trim, trim, trim, am.roof};
+    const float z = static_cast<float>(roof_z);
+    auto spot = [&](double sx, double sy) {
+      return Eigen::Vector2d(arch.Uniform(roof_fp.min.x() + 1.0, roof_fp.max.x() - 1.0 - sx),
+                             arch.Uniform(roof_fp.min.y() + 1.0, roof_fp.max.y() - 1.0 - sy));
+    };
+    const double sx = std::min(room.x() - 2.5, arch.Uniform(2.2, 3.5)), sy = std::min(room.y() - 2.5, arch.Uniform(2.2, 3.5));
+    const Eigen::Vector2d s0 = spot(sx, sy);
+    b.Box(MeshBuilder::P(s0.x(), s0.y(), z), MeshBuilder::P(s0.x() + sx, s0.y() + sy, z + arch.Uniform(2.4, 3.0)), faces,
+          static_cast<float>(kRoofTileMetres));
+    const int units = arch.UniformInt(0, 3);
+    const int metal[5] = {am.metal, am.metal, am.metal, am.metal, am.metal};
+    for (int i = 0; i < units; ++i) {
+      const Eigen::Vector2d u0 = spot(1.2, 0.8);
+      b.Box(MeshBuilder::P(u0.x(), u0.y(), z), MeshBuilder::P(u0.x() + 1.2, u0.y() + 0.8, z + 0.9), metal);
+    }
+    if (arch.Bernoulli(0.3)) {
+      const double r = arch.Uniform(0.8, 1.2);
+      const Eigen::Vector2d t0 = spot(2 * r, 2 * r);
+      b.Prism(MeshBuilder::P(t0.x() + r, t0.y() + r, 0), static_cast<float>(r), z, z + static_cast<float>(arch.Uniform(2.0, 3.0)), 10,
+              am.metal, am.metal);
+    }
+  }
+}
+
 }  // namespace
 
 Scene GenerateScene(const std::string& preset_name, uint64_t seed, bool quick) {
@@ -410,7 +688,7 @@ Scene GenerateScene(const std::string& preset_name, uint64_t seed, bool quick) {
   scene.frame_rate = preset.frame_rate;
   scene.rig_preset = preset.rig_preset;
   scene.rig_trajectory = L.trajectory;
-  scene.lighting = MakeLighting(preset.lighting, SubSeed(seed, preset.lighting.c_str()));
+  scene.lighting = MakeLighting(preset.lighting, SubSeed(seed, preset.lighting.c_str()), st.high_sun_along_streets);
 
   // Textures, generated in parallel (each from its own seed, so the result does not depend on threads).
   const int num_facades = quick ? std::max(4, st.facade_textures / 3) : st.facade_textures;
@@ -441,6 +719,8 @@ Scene GenerateScene(const std::string& preset_name, uint64_t seed, bool quick) {
   jobs.push_back([=] { return MakeFoliageTexture(texture_seed); });
   const int t_sign = static_cast<int>(jobs.size());
   for (int k = 0; k < kSignKinds; ++k) jobs.push_back([=] { return MakeSignTexture(texture_seed, k); });
+  const int t_awning = static_cast<int>(jobs.size()), num_awnings = quick ? 3 : 6;
+  for (int k = 0; k < num_awnings; ++k) jobs.push_back([=] { return MakeAwningTexture(texture_seed, k); });
   scene.textures.resize(jobs.size());
   tbb::parallel_for(size_t{0}, jobs.size(), [&](size_t i) { scene.textures[i] = jobs[i](); });
 
@@ -499,41 +779,35 @@ Scene GenerateScene(const std::string& preset_name, uint64_t seed, bool quick) {
     for (const Box2& blk : L.blocks) {
       b.Floor(blk.min, blk.max, kCurbHeight, kSidewalkTileMetres, m_sidewalk);
       const Eigen::Vector2d c[4] = {blk.min, {blk.max.x(), blk.min.y()}, blk.max, {blk.min.x(), blk.max.y()}};
-      // Counter-clockwise corners seen from above; the outward normal of edge a->b is to its right,
-      // so walk them clockwise for outward-facing curb faces.
+      // Corners counter-clockwise seen from above: walking them in order keeps the block on the
+      // left, so each curb face's outward normal is on the right of a->b (as Wall expects).
       for (int k = 0; k < 4; ++k) {
-        const Eigen::Vector2d a = c[(k + 1) % 4], bb = c[k];
+        const Eigen::Vector2d a = c[k], bb = c[(k + 1) % 4];
         b.Wall(a, bb, 0.0, kCurbHeight, 0.0, kRoofTileMetres, 0.0, kRoofTileMetres, m_curb);
       }
     }
     AddStatic(scene, "sidewalks", AddMesh(scene, b.Finish()), Rigid3::Identity());
   }
-  // Buildings: ground floor with shops, upper floors with the facade pattern, flat roofs.
+  // Buildings (AddBuilding): storefronts, facades, relief, balconies, awnings, rooflines.
   {
+    ArchitectureMaterials am;
+    am.roof = m_roof;
+    am.metal = AddMaterial(scene, "rooftop_metal", {0.62f, 0.64f, 0.66f}, t_concrete);
+    const Vec3f trims[] = {{0.95f, 0.93f, 0.88f}, {0.7f, 0.7f, 0.72f}, {0.85f, 0.78f, 0.65f}, {0.45f, 0.43f, 0.42f}};
+    for (size_t i = 0; i < 4; ++i) am.trim.push_back(AddMaterial(scene, "trim_" + std::to_string(i), trims[i], t_concrete));
+    am.roof_tiles.push_back(AddMaterial(scene, "roof_tiles_0", {0.62f, 0.3f, 0.2f}, t_concrete));
+    am.roof_tiles.push_back(AddMaterial(scene, "roof_tiles_1", {0.3f, 0.32f, 0.36f}, t_concrete));
+    const Vec3f rails[] = {{0.12f, 0.12f, 0.13f}, {0.85f, 0.85f, 0.83f}, {0.3f, 0.42f, 0.42f}};
+    for (size_t i = 0; i < 3; ++i) am.railing.push_back(AddMaterial(scene, "railing_" + std::to_string(i), rails[i], -1));
+    for (int i = 0; i < num_awnings; ++i) am.awning.push_back(AddMaterial(scene, "awning_" + std::to_string(i), {1, 1, 1}, t_awning + i));
+    SceneRng arch(SubSeed(layout_seed, "architecture"));
     MeshBuilder b("buildings");
     for (size_t k = 0; k < L.buildings.size(); ++k) {
       const BuildingPlan& p = L.buildings[k];
       const std::string name = "building_" + std::to_string(k);
       const int m_facade = AddMaterial(scene, name + "_facade", p.tint, p.facade);
       const int m_shop = AddMaterial(scene, name + "_shop", p.tint, num_facades + p.storefront);
-      auto walls = [&](const Box2& fp, double z0, double z1, bool shops) {
-        const Eigen::Vector2d c[4] = {fp.min, {fp.max.x(), fp.min.y()}, fp.max, {fp.min.x(), fp.max.y()}};
-        for (int e = 0; e < 4; ++e) {
-          // Clockwise walk (c[e+1] -> c[e]) puts the outward normal on the right.
-          const Eigen::Vector2d a = c[(e + 1) % 4], bb = c[e];
-          double zs = z0;
-          if (shops) {
-            b.Wall(a, bb, 0.0, kStorefrontHeightMetres, p.u_offset, kFacadeTileMetres, 1.0, kStorefrontHeightMetres, m_shop);
-            zs = kStorefrontHeightMetres;
-          }
-          // v = 100 at z = 4 m: texture floor boundaries coincide with storey boundaries.
-          const double v0 = 100.0 - (zs - kStorefrontHeightMetres) / kFacadeTileMetres;
-          b.Wall(a, bb, zs, z1, p.u_offset, kFacadeTileMetres, v0, kFacadeTileMetres, m_facade);
-        }
-        b.Floor(fp.min, fp.max, z1, kRoofTileMetres, m_roof);
-      };
-      walls(p.footprint, 0.0, p.height, true);
-      if (p.has_setback) walls(p.upper_footprint, p.height, p.upper_height, false);
+      AddBuilding(b, p, GetFacadeLayout(texture_seed, p.facade), m_facade, m_shop, am, st, arch);
     }
     AddStatic(scene, "buildings", AddMesh(scene, b.Finish()), Rigid3::Identity());
   }

@@ -58,6 +58,7 @@ CityStyle StyleForPreset(const std::string& preset) {
     s.straight_preference = 0.6;
     s.trees = false;
     s.parked_cars = false;
+    s.high_sun_along_streets = true;
   }
   return s;
 }

@@ -43,6 +43,7 @@ struct CityStyle {
   bool parked_cars = true;
   int facade_textures = 24, storefront_textures = 8;  // texture pool sizes (full form)
   int grid_streets_min = 6;                           // streets per axis at least
+  bool high_sun_along_streets = false;  // sunny: high sun near a street axis (canyons)
 };
 
 CityStyle StyleForPreset(const std::string& preset);

@@ -1,7 +1,8 @@
-// `rovo scene generate` and `rovo scene list`.
+// `rovo scene generate`, `rovo scene info` and `rovo scene list`.
 #include "datasets/cli_groups.h"
 #include "datasets/trajectory.h"
 #include "scenes/city.h"
+#include "scenes/city_layout.h"
 #include "scenes/scene.h"
 
 #include <CLI/CLI.hpp>
@@ -32,12 +33,8 @@ size_t SceneBytes(const Scene& scene, size_t* texture_bytes) {
   return tex + geo;
 }
 
-void RunGenerate(const GenerateOptions& o) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const Scene scene = GenerateScene(o.preset, o.seed, o.quick);
-  const auto t1 = std::chrono::steady_clock::now();
-  SaveScene(scene, o.out_dir);
-  const auto t2 = std::chrono::steady_clock::now();
+// Sizes, path and lighting of a scene; `nominal` is the preset it was made from, if any.
+void PrintSceneSummary(const Scene& scene, const ScenePreset* nominal, bool quick) {
   size_t triangles = 0, instanced = 0, dynamic = 0;
   for (const Mesh& m : scene.meshes) triangles += m.triangles.size();
   for (const Object& ob : scene.objects) {
@@ -46,21 +43,52 @@ void RunGenerate(const GenerateOptions& o) {
   }
   size_t texture_bytes = 0;
   const size_t bytes = SceneBytes(scene, &texture_bytes);
-  const ScenePreset& p = FindScenePreset(o.preset);
-  std::printf("scene        %s\n", o.out_dir.c_str());
-  std::printf("preset       %s%s, seed %llu, lighting %s, rig %s\n", p.name.c_str(), o.quick ? " (quick)" : "",
-              static_cast<unsigned long long>(o.seed), scene.lighting.preset.c_str(), scene.rig_preset.c_str());
+  std::printf("preset       %s%s, seed %llu, lighting %s, rig %s\n", scene.metadata.preset.c_str(), quick ? " (quick)" : "",
+              static_cast<unsigned long long>(scene.metadata.seed), scene.lighting.preset.c_str(), scene.rig_preset.c_str());
   std::printf("hash         %s\n", SceneHash(scene).c_str());
   std::printf("meshes       %zu (%zu triangles; %zu placed in the world)\n", scene.meshes.size(), triangles, instanced);
   std::printf("objects      %zu (%zu moving)\n", scene.objects.size(), dynamic);
   std::printf("textures     %zu (%.1f MB)\n", scene.textures.size(), texture_bytes / 1048576.0);
   std::printf("materials    %zu\n", scene.materials.size());
   std::printf("memory       %.1f MB\n", bytes / 1048576.0);
-  std::printf("path         %.1f m in %zu frames at %.0f Hz (preset: %.0f m, %d frames)\n", PathLength(scene.rig_trajectory),
-              scene.rig_trajectory.size(), scene.frame_rate, o.quick ? p.path_length_m * (p.quick_frames - 1) / (p.frames - 1) : p.path_length_m,
-              o.quick ? p.quick_frames : p.frames);
-  std::printf("time         %.2f s generate, %.2f s save\n", std::chrono::duration<double>(t1 - t0).count(),
-              std::chrono::duration<double>(t2 - t1).count());
+  std::printf("path         %.1f m in %zu frames at %.0f Hz", PathLength(scene.rig_trajectory), scene.rig_trajectory.size(),
+              scene.frame_rate);
+  if (nominal) {
+    std::printf(" (preset: %.0f m, %d frames)", quick ? QuickPathLength(*nominal) : nominal->path_length_m,
+                quick ? nominal->quick_frames : nominal->frames);
+  }
+  std::printf("\n");
+}
+
+const ScenePreset* PresetOf(const Scene& scene) {
+  for (const ScenePreset& p : ScenePresets())
+    if (p.name == scene.metadata.preset) return &p;
+  return nullptr;
+}
+
+double SecondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+void RunGenerate(const GenerateOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Scene scene = GenerateScene(o.preset, o.seed, o.quick);
+  const double generate_seconds = SecondsSince(t0);
+  const auto t1 = std::chrono::steady_clock::now();
+  SaveScene(scene, o.out_dir);
+  const double save_seconds = SecondsSince(t1);
+  std::printf("scene        %s\n", o.out_dir.c_str());
+  PrintSceneSummary(scene, &FindScenePreset(o.preset), o.quick);
+  std::printf("time         %.2f s generate, %.2f s save\n", generate_seconds, save_seconds);
+}
+
+void RunInfo(const std::string& dir) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Scene scene = LoadScene(dir);
+  const double load_seconds = SecondsSince(t0);
+  std::printf("scene        %s\n", dir.c_str());
+  PrintSceneSummary(scene, PresetOf(scene), scene.metadata.source == "procedural (quick form)");
+  std::printf("time         %.2f s load\n", load_seconds);
 }
 
 void RunList() {
@@ -83,6 +111,11 @@ void AddSceneCommands(CliGroups& groups) {
   gen->add_flag("--quick", opts->quick, "The preset's short form (CI-sized: a few dozen frames)");
   gen->add_option("--out", opts->out_dir, "Output scene folder (scenes/FORMAT.md)")->required();
   gen->callback([opts] { RunGenerate(*opts); });
+
+  auto info_dir = std::make_shared<std::string>();
+  CLI::App* info = groups.scene->add_subcommand("info", "Load a scene folder and print its size, path, lighting and load time");
+  info->add_option("dir", *info_dir, "Scene folder (scenes/FORMAT.md)")->required();
+  info->callback([info_dir] { RunInfo(*info_dir); });
 
   CLI::App* list = groups.scene->add_subcommand("list", "List the scene presets (the paper's Table I sequences)");
   list->callback([] { RunList(); });

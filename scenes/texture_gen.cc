@@ -205,19 +205,45 @@ void Glass(Canvas& c, SceneRng& rng, int x0, int y0, int x1, int y1, uint64_t se
 
 }  // namespace
 
-int FacadeBays(uint64_t seed, int index) {
-  SceneRng rng(SubSeed(seed, "facade", static_cast<uint64_t>(index)));
-  return rng.UniformInt(3, 6);  // the first draw of MakeFacadeTexture's stream
+namespace {
+
+// The first draws of a facade's stream: the layout (shared with the geometry through
+// GetFacadeLayout), the wall brightness and the noise seed. MakeFacadeTexture continues the stream.
+struct FacadeDraws {
+  FacadeLayout layout;
+  float base = 0;
+  uint64_t nseed = 0;
+};
+FacadeDraws DrawFacade(int index, SceneRng& rng) {
+  FacadeDraws d;
+  d.layout.style = index % 4;
+  d.layout.bays = rng.UniformInt(3, 6);
+  d.base = static_cast<float>(rng.Uniform(0.72, 0.95));
+  d.nseed = rng.Next();
+  const bool curtain = d.layout.style == 3;
+  d.layout.window_width_fraction = curtain ? rng.Uniform(0.8, 0.92) : rng.Uniform(0.42, 0.68);
+  d.layout.window_height_fraction = curtain ? rng.Uniform(0.62, 0.72) : rng.Uniform(0.42, 0.6);
+  return d;
 }
+
+}  // namespace
+
+FacadeLayout GetFacadeLayout(uint64_t seed, int index) {
+  SceneRng rng(SubSeed(seed, "facade", static_cast<uint64_t>(index)));
+  return DrawFacade(index, rng).layout;
+}
+
+int FacadeBays(uint64_t seed, int index) { return GetFacadeLayout(seed, index).bays; }
 
 Texture MakeFacadeTexture(uint64_t seed, int index) {
   SceneRng rng(SubSeed(seed, "facade", static_cast<uint64_t>(index)));
   const int W = 1024, H = 1024, floor_px = H / 4;
-  const int style = index % 4;  // 0 brick, 1 plaster, 2 panels, 3 glass curtain wall
-  const int bays = rng.UniformInt(3, 6);
-  const float base = static_cast<float>(rng.Uniform(0.72, 0.95));
+  const FacadeDraws draws = DrawFacade(index, rng);
+  const int style = draws.layout.style;  // 0 brick, 1 plaster, 2 panels, 3 glass curtain wall
+  const int bays = draws.layout.bays;
+  const float base = draws.base;
   Canvas c(W, H, Gray(base));
-  const uint64_t nseed = rng.Next();
+  const uint64_t nseed = draws.nseed;
 
   if (style == 0) {  // bricks: 52 per row, 32 courses per floor (tileable)
     const float brick_w = W / 52.0f;
@@ -252,8 +278,8 @@ Texture MakeFacadeTexture(uint64_t seed, int index) {
 
   // Windows: one per bay and floor. Layout shared by the texture, details vary per window.
   const int bay_w = W / bays;
-  const float win_wf = static_cast<float>(style == 3 ? rng.Uniform(0.8, 0.92) : rng.Uniform(0.42, 0.68));
-  const float win_hf = static_cast<float>(style == 3 ? rng.Uniform(0.62, 0.72) : rng.Uniform(0.42, 0.6));
+  const float win_wf = static_cast<float>(draws.layout.window_width_fraction);
+  const float win_hf = static_cast<float>(draws.layout.window_height_fraction);
   const int win_w = static_cast<int>(bay_w * win_wf), win_h = static_cast<int>(floor_px * win_hf);
   const int frame_t = rng.UniformInt(4, 8);
   const Color frame_color = rng.Bernoulli(0.5) ? Gray(static_cast<float>(rng.Uniform(0.85, 0.97)))
@@ -588,6 +614,25 @@ Texture MakeCarGlassTexture(uint64_t seed) {
   for (int x : {0, W / 2 - 4, W - 8}) c.Rect(x, 0, x + 8, H, Gray(0.12f));  // pillars
   c.Rect(0, 0, W, 4, Gray(0.12f));
   return c.ToTexture("car_glass");
+}
+
+Texture MakeAwningTexture(uint64_t seed, int index) {
+  SceneRng rng(SubSeed(seed, "awning", static_cast<uint64_t>(index)));
+  const int W = 256, H = 64;
+  const int stripes = 2 * rng.UniformInt(4, 8);  // even: the tile repeats seamlessly
+  const Color cloth(static_cast<float>(rng.Uniform(0.1, 0.8)), static_cast<float>(rng.Uniform(0.1, 0.6)),
+                    static_cast<float>(rng.Uniform(0.1, 0.6)));
+  const bool plain = rng.Bernoulli(0.3);
+  Canvas c(W, H, cloth);
+  const uint64_t nseed = rng.Next();
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const bool light = !plain && (x * stripes / W) % 2 == 1;
+      const float v = 0.9f + 0.1f * Hash01(x / 2, y / 2, nseed);
+      c.At(x, y) = (light ? Gray(0.92f) : cloth) * v;
+    }
+  AddGrime(c, nseed + 1, 0.08f, 0.04f, 4);
+  return c.ToTexture("awning_" + std::to_string(index));
 }
 
 Texture MakeBarkTexture(uint64_t seed) {

@@ -23,6 +23,17 @@ inline constexpr double kRoofTileMetres = 8.0;
 // near neutral so the material tint sets the building colour.
 Texture MakeFacadeTexture(uint64_t seed, int index);
 int FacadeBays(uint64_t seed, int index);
+// Where MakeFacadeTexture(seed, index) paints its windows, so geometry can line up with them. In a
+// 3.2 m floor whose top is texture row 0 of a 256 px band, the window is window_height_fraction *
+// 256 px tall and starts (256 - height) / 2 - 8 px below the top; horizontally it is centred in its
+// bay, window_width_fraction of the bay wide.
+struct FacadeLayout {
+  int style = 0;  // 0 brick, 1 plaster, 2 precast panels, 3 glass curtain wall
+  int bays = 3;   // window columns per 12.8 m tile
+  double window_width_fraction = 0.5;   // of the bay width
+  double window_height_fraction = 0.5;  // of the floor height
+};
+FacadeLayout GetFacadeLayout(uint64_t seed, int index);
 // Ground-floor shops: 1024 x 320 px for 12.8 m x 4 m (shop windows, doors, signs, plinth).
 Texture MakeStorefrontTexture(uint64_t seed, int index);
 // Road segment: square tile `road_width_m` across (v, curb to curb) and along (u). Asphalt noise,
@@ -38,6 +49,7 @@ Texture MakeCarSideTexture(uint64_t seed);    // 512 x 128: doors, handles, sill
 Texture MakeCarEndTexture(uint64_t seed);     // 256 x 128: grille, lights, plate
 Texture MakeCarGlassTexture(uint64_t seed);   // 256 x 64: dark glass with pillars
 Texture MakeBarkTexture(uint64_t seed);
+Texture MakeAwningTexture(uint64_t seed, int index);  // 256 x 64: striped or plain cloth, 1 texel ~1 cm
 // Road sign face, 256 x 256 px for a 0.6 m plate; kind in [0, kSignKinds): stop, give way, no
 // entry, speed limit, pedestrian crossing. Outside the sign shape: the grey plate.
 inline constexpr int kSignKinds = 5;

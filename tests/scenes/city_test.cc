@@ -1,6 +1,7 @@
 #include "datasets/io.h"
 #include "scenes/city.h"
 #include "scenes/city_layout.h"
+#include "scenes/rng.h"
 #include "scenes/texture_gen.h"
 
 #include "tests/scenes/scratch_dir.h"
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <set>
 #include <string>
 
@@ -243,6 +245,9 @@ TEST(GenerateScene, TexelDensity) {
         const int mat = m.triangle_materials.empty() ? m.material : m.triangle_materials[t];
         const int tex = s.materials[mat].texture;
         if (tex < 0) continue;
+        // Facade and shop textures (details such as roofs and awnings have their own scales).
+        const std::string& tex_name = s.textures[tex].name;
+        if (mesh_name == "buildings" && tex_name.rfind("facade", 0) != 0 && tex_name.rfind("storefront", 0) != 0) continue;
         const auto& tri = m.triangles[t];
         const double area = 0.5 * (m.positions[tri[1]] - m.positions[tri[0]]).cross(m.positions[tri[2]] - m.positions[tri[0]]).norm();
         Eigen::Vector2d e1 = (m.uvs[tri[1]] - m.uvs[tri[0]]).cast<double>(), e2 = (m.uvs[tri[2]] - m.uvs[tri[0]]).cast<double>();
@@ -265,6 +270,65 @@ TEST(GenerateScene, TexelDensity) {
   EXPECT_LE(hi, 0.015);
   density("sidewalks", &lo, &hi);
   EXPECT_LE(lo, 0.01);
+}
+
+// The facade relief (real geometry in front of the walls) must leave the painted windows open:
+// every point of a relief face facing the street maps to wall texture, not into a window.
+TEST(GenerateScene, FacadeReliefLinesUpWithPaintedWindows) {
+  for (const char* preset : {"static_urban", "cloudy_urban"}) {
+    const uint64_t seed = 4;
+    const Scene s = GenerateScene(preset, seed, true);
+    const CityLayout layout = MakeCityLayout(FindScenePreset(preset), seed, true);
+    const uint64_t texture_seed = SubSeed(LayoutSeed(preset, seed), "textures");
+    const Mesh* buildings = nullptr;
+    for (const Mesh& m : s.meshes)
+      if (m.name == "buildings") buildings = &m;
+    ASSERT_NE(buildings, nullptr);
+    std::map<std::string, int> kinds;  // triangles per detail material family
+    int relief_faces = 0, checked_points = 0;
+    for (size_t t = 0; t < buildings->triangles.size(); ++t) {
+      const int mat = buildings->triangle_materials.empty() ? buildings->material : buildings->triangle_materials[t];
+      const std::string& name = s.materials[mat].name;
+      for (const char* family : {"awning_", "railing_", "roof_tiles_", "trim_", "rooftop_"})
+        if (name.rfind(family, 0) == 0) ++kinds[family];
+      const size_t suffix = name.find("_facade");
+      if (suffix == std::string::npos) continue;
+      const BuildingPlan& plan = layout.buildings[std::stoul(name.substr(9, suffix - 9))];
+      const Eigen::Vector3i& tri = buildings->triangles[t];
+      const Eigen::Vector3f a = buildings->positions[tri[0]], b = buildings->positions[tri[1]], c = buildings->positions[tri[2]];
+      const Eigen::Vector3f normal = (b - a).cross(c - a).normalized();
+      if (std::abs(normal.z()) > 1e-3) continue;  // top/bottom of a relief block
+      // A front face: its plane is parallel to the street side and at least 5 cm in front of the wall.
+      const Eigen::Vector2d facing = plan.facing;
+      if (std::abs(normal.head<2>().cast<double>().dot(facing)) < 0.999) continue;
+      const Eigen::Vector2d on_wall = facing.x() + facing.y() > 0 ? plan.footprint.max : plan.footprint.min;
+      const double offset = (a.head<2>().cast<double>() - on_wall).dot(facing);
+      if (offset < 0.05) continue;
+      ++relief_faces;
+      const FacadeLayout fl = GetFacadeLayout(texture_seed, plan.facade);
+      const int bay_px = 1024 / fl.bays, win_w_px = static_cast<int>(bay_px * fl.window_width_fraction);
+      const int win_h_px = static_cast<int>(256 * fl.window_height_fraction), win_top_px = (256 - win_h_px) / 2 - 8;
+      const Eigen::Vector2f ua = buildings->uvs[tri[0]], ub = buildings->uvs[tri[1]], uc = buildings->uvs[tri[2]];
+      for (const Eigen::Vector3f& w : {Eigen::Vector3f(1.0f / 3, 1.0f / 3, 1.0f / 3), Eigen::Vector3f(0.9f, 0.05f, 0.05f),
+                                       Eigen::Vector3f(0.05f, 0.9f, 0.05f), Eigen::Vector3f(0.05f, 0.05f, 0.9f)}) {
+        const Eigen::Vector2f uv = w[0] * ua + w[1] * ub + w[2] * uc;
+        const double x = (uv.x() - std::floor(uv.x())) * 1024, y = (uv.y() - std::floor(uv.y())) * 1024;
+        const double x_in = std::fmod(x, bay_px) - (bay_px - win_w_px) / 2, y_in = std::fmod(y, 256.0) - win_top_px;
+        const bool in_window = x_in > 2 && x_in < win_w_px - 2 && y_in > 2 && y_in < win_h_px - 2;
+        EXPECT_FALSE(in_window) << preset << " " << name << " uv " << uv.transpose() << " px " << x << "," << y;
+        ++checked_points;
+      }
+    }
+    EXPECT_GT(relief_faces, 20) << preset;
+    EXPECT_GT(checked_points, 80) << preset;
+    EXPECT_GT(kinds["awning_"], 0) << preset;
+    EXPECT_GT(kinds["railing_"], 0) << preset;
+    EXPECT_GT(kinds["trim_"], 0) << preset;
+    EXPECT_GT(kinds["rooftop_"], 0) << preset;
+    if (std::string(preset) == "cloudy_urban") {
+      EXPECT_GT(kinds["roof_tiles_"], 0);  // low town houses
+    }
+  }
 }
 
 TEST(Textures, TileSeamlesslyAndHaveDetail) {
