@@ -100,6 +100,7 @@ void AddRenderCommands(CliGroups& groups) {
     cmd->add_option("--rig", args->options.rig, "Rig preset or rig.json (default: the scene's)");
     cmd->add_option("--scale", args->options.scale, "Image scale of each view")->capture_default_str();
     cmd->add_option("--spp", args->options.spp, "Samples per pixel")->capture_default_str();
+    cmd->add_option("--width", args->options.width, "Downscale the sheet to at most this many pixels wide (default: no limit)");
     cmd->add_option("--threads", args->options.threads, "Threads (default: all cores)");
     cmd->callback([args] {
       PreviewOptions options = args->options;

@@ -4,12 +4,15 @@
 #include "render/render.h"
 #include "render/tracer.h"
 
+#include <OpenImageIO/imageio.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <stdexcept>
 
 #include <sys/resource.h>
@@ -17,11 +20,67 @@
 namespace rovo {
 namespace {
 namespace fs = std::filesystem;
+
+// Area-weighted (box) downscale of an 8-bit RGB image: each output pixel averages the input area
+// it covers, partial pixels weighted by their overlap. Separable: rows first, then columns.
+std::vector<uint8_t> DownscaleRgb8(const std::vector<uint8_t>& src, int width, int height, int out_width,
+                                   int out_height) {
+  // Overlap weights of output cell o with the input pixels along one axis.
+  auto weights = [](int in, int out, int o, std::vector<std::pair<int, float>>* w) {
+    w->clear();
+    const double scale = static_cast<double>(in) / out;
+    const double a = o * scale, b = (o + 1) * scale;
+    for (int i = static_cast<int>(a); i < std::min(in, static_cast<int>(std::ceil(b))); ++i) {
+      const double overlap = std::min<double>(b, i + 1) - std::max<double>(a, i);
+      if (overlap > 0.0) w->push_back({i, static_cast<float>(overlap / scale)});
+    }
+  };
+  std::vector<float> rows(static_cast<size_t>(height) * out_width * 3, 0.0f);
+  std::vector<std::pair<int, float>> w;
+  for (int ox = 0; ox < out_width; ++ox) {
+    weights(width, out_width, ox, &w);
+    for (int y = 0; y < height; ++y)
+      for (const auto& [x, wx] : w)
+        for (int c = 0; c < 3; ++c)
+          rows[(static_cast<size_t>(y) * out_width + ox) * 3 + c] += wx * src[(static_cast<size_t>(y) * width + x) * 3 + c];
+  }
+  std::vector<uint8_t> out(static_cast<size_t>(out_height) * out_width * 3);
+  for (int oy = 0; oy < out_height; ++oy) {
+    weights(height, out_height, oy, &w);
+    for (int ox = 0; ox < out_width; ++ox)
+      for (int c = 0; c < 3; ++c) {
+        float sum = 0.0f;
+        for (const auto& [y, wy] : w) sum += wy * rows[(static_cast<size_t>(y) * out_width + ox) * 3 + c];
+        out[(static_cast<size_t>(oy) * out_width + ox) * 3 + c] =
+            static_cast<uint8_t>(std::clamp(std::lround(sum), 0L, 255L));
+      }
+  }
+  return out;
+}
+
+// A contact sheet is written once and kept: PNG at zlib level 6 (smaller than the datasets'
+// speed-oriented level 1), through a temporary sibling renamed into place.
+void WriteCompactPng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {
+  const fs::path parent = fs::path(path).parent_path();
+  if (!parent.empty()) EnsureWritableDir(parent.string());
+  const std::string tmp = TempPathFor(path);
+  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+  spec.attribute("png:compressionLevel", 6);
+  auto out = OIIO::ImageOutput::create("png");
+  if (!out || !out->open(tmp, spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) || !out->close()) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw std::runtime_error(path + ": cannot write the contact sheet PNG");
+  }
+  CommitTempFile(tmp, path);
+}
+
 }  // namespace
 
 void RenderScenePreview(const PreviewOptions& options) {
   if (options.scale <= 0.0 || options.scale > 4.0) throw std::invalid_argument("--scale: must be in (0, 4]");
   if (options.spp < 1) throw std::invalid_argument("--spp: must be >= 1");
+  if (options.width < 0) throw std::invalid_argument("--width: must be >= 0");
   const Scene scene = SceneForOptions(options.preset, true, options.seed, options.scene_dir);
   const Rig rig = RigForOptions(options.rig, scene, options.scale);
   const int num_traj = static_cast<int>(scene.rig_trajectory.size());
@@ -67,9 +126,15 @@ void RenderScenePreview(const PreviewOptions& options) {
       }
     }
   });
-  WritePngRgb8(out, sheet_w, sheet_h, sheet);
+  int out_w = sheet_w, out_h = sheet_h;
+  if (options.width > 0 && options.width < sheet_w) {
+    out_w = options.width;
+    out_h = std::max(1, static_cast<int>(std::lround(static_cast<double>(sheet_h) * out_w / sheet_w)));
+    sheet = DownscaleRgb8(sheet, sheet_w, sheet_h, out_w, out_h);
+  }
+  WriteCompactPng(out, out_w, out_h, sheet);
   std::printf("wrote %s (%d frames x %d views, %dx%d)\n", out.c_str(), static_cast<int>(frames.size()),
-              rig.NumCameras(), sheet_w, sheet_h);
+              rig.NumCameras(), out_w, out_h);
 }
 
 }  // namespace rovo

@@ -74,6 +74,7 @@ struct PreviewOptions {
   int spp = 1;
   int threads = 0;
   std::string out_png;         // default <scene_dir>/preview.png
+  int width = 0;               // > 0: the sheet is area-downscaled to at most this many pixels wide
 };
 void RenderScenePreview(const PreviewOptions& options);
 
