@@ -35,6 +35,10 @@ void WriteImage(const std::string& path, const char* format, const OIIO::ImageSp
 void WritePngRgb8(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {
   OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
   spec.attribute("png:compressionLevel", 1);
+  // libpng's "Up" filter only (PNG_FILTER_UP = 0x20) instead of its adaptive choice among all five
+  // filters per row: measured on a 1600x1532 render, 0.115 s instead of 0.243 s per view for a
+  // file 4 % larger (lossless either way).
+  spec.attribute("png:filter", 0x20);
   spec.attribute("Software", "rovo " ROVO_VERSION);
   WriteImage(path, "png", spec, rgb.data());
 }
