@@ -122,12 +122,12 @@ bool UniqueAlongEpipolarCurve(const cv::Mat& patch_image, cv::Point2f patch_cent
       !Normalise(&reference)) {
     return false;
   }
-  Eigen::Vector3d normal = (centre_moving - centre_fixed).cross(bearing_fixed);
+  // The plane through the baseline and the matched bearing: the epipolar plane of the fixed
+  // feature when the extrinsics are right, and still through the match when they are off.
+  Eigen::Vector3d normal = (centre_moving - centre_fixed).cross(bearing_moving);
   if (normal.norm() < 1e-12) return false;
   normal.normalize();
-  Eigen::Vector3d along = bearing_moving - bearing_moving.dot(normal) * normal;
-  if (along.norm() < 1e-9) return false;
-  along.normalize();
+  const Eigen::Vector3d along = bearing_moving.normalized();
   const Eigen::Vector3d across = normal.cross(along);
   const auto centre_px = view.pixel_from_direction_in_rig(along);
   if (!centre_px) return false;

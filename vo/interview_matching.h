@@ -20,8 +20,10 @@
 //                    the warped images >= min_zncc,
 //   8. uniqueness along the epipolar curve (repeated structure: identical windows of a facade lie
 //                    on one epipolar line, and the true partner may not be among b's features):
-//                    b's bearing is rotated within the epipolar plane (normal n = (c_b - c_a) x d_a)
-//                    by +-uniqueness_range_deg in steps of one warped pixel (1 / f rad), each
+//                    b's bearing is rotated within the plane n = (c_b - c_a) x d_b (the epipolar
+//                    plane when the extrinsics are right; through the match itself when loosened
+//                    filters accept a match off the assumed epipolar plane) by
+//                    +-uniqueness_range_deg in steps of one warped pixel (1 / f rad), each
 //                    direction with positive disparity is mapped into b's image, and a's patch is
 //                    correlated there (ZNCC, nearest-pixel patches). The match is rejected when a
 //                    local ZNCC maximum more than uniqueness_exclusion_px from the match (refined
