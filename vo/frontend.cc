@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -16,6 +17,9 @@ namespace {
 double MsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
+
+// Process CPU time (all threads), milliseconds.
+double CpuMs() { return 1000.0 * static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
 
 cv::Mat ToGray(const cv::Mat& image, int camera) {
   if (image.depth() != CV_8U) {
@@ -72,6 +76,8 @@ Frontend::Frontend(const Rig& rig, const FrontendOptions& options) : impl_(std::
   tracker_options.min_feature_distance_px = options.min_feature_distance_px;
   tracker_options.fast_threshold = options.fast_threshold;
   tracker_options.max_forward_backward_px = options.max_forward_backward_px;
+  tracker_options.klt_window_px = options.klt_window_px;
+  tracker_options.klt_levels = options.klt_levels;
   s.trackers.assign(rig.NumCameras(), ViewTracker(tracker_options));
   s.warped.resize(rig.NumCameras());
   s.fisheye_gray.resize(rig.NumCameras());
@@ -144,6 +150,7 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
   FrontendFrame frame;
 
   auto start = std::chrono::steady_clock::now();
+  double cpu_start = CpuMs();
   tbb::parallel_for(0, n, [&](int i) {
     s.fisheye_gray[i] = ToGray(fisheye_images[i], i);
     cv::Mat warped;
@@ -151,13 +158,17 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
     s.warped[i] = warped;
   });
   frame.ms_warp = MsSince(start);
+  frame.cpu_ms_warp = CpuMs() - cpu_start;
 
   start = std::chrono::steady_clock::now();
+  cpu_start = CpuMs();
   tbb::parallel_for(0, n, [&](int i) { s.trackers[i].Track(s.warped[i], s.projections[i].valid_mask()); });
   frame.ms_track = MsSince(start);
+  frame.cpu_ms_track = CpuMs() - cpu_start;
 
   // New points get id 0 in parallel, then ids in camera order (deterministic).
   start = std::chrono::steady_clock::now();
+  cpu_start = CpuMs();
   tbb::parallel_for(0, n, [&](int i) { s.trackers[i].DetectAndDescribe([] { return uint64_t{0}; }); });
   for (int i = 0; i < n; ++i) {
     for (TrackedPoint& p : s.trackers[i].points()) {
@@ -165,8 +176,10 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
     }
   }
   frame.ms_detect = MsSince(start);
+  frame.cpu_ms_detect = CpuMs() - cpu_start;
 
   start = std::chrono::steady_clock::now();
+  cpu_start = CpuMs();
   s.last_matches.clear();
   if (s.options.match_between_views && !s.pairs.empty()) {
     std::vector<MatchView> views(n);
@@ -231,6 +244,7 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
     }
   }
   frame.ms_match = MsSince(start);
+  frame.cpu_ms_match = CpuMs() - cpu_start;
 
   frame.features_per_camera.resize(n);
   for (int i = 0; i < n; ++i) {

@@ -37,6 +37,8 @@ struct FrontendFrame {
   std::vector<std::pair<uint64_t, uint64_t>> merged_ids;
   // Wall time per stage in milliseconds: warp, detect, track, match.
   double ms_warp = 0, ms_detect = 0, ms_track = 0, ms_match = 0;
+  // Process CPU time (all threads) per stage in milliseconds: the cost on a loaded machine.
+  double cpu_ms_warp = 0, cpu_ms_detect = 0, cpu_ms_track = 0, cpu_ms_match = 0;
 };
 
 struct FrontendOptions {
@@ -44,6 +46,8 @@ struct FrontendOptions {
   float min_feature_distance_px = 12;   // between features of one view (warped pixels)
   int fast_threshold = 12;              // FAST-9 threshold of the detector
   float max_forward_backward_px = 1.0f; // KLT forward-backward round-trip error
+  int klt_window_px = 15;               // KLT window side (warped pixels; 21 costs 30 % more CPU)
+  int klt_levels = 3;                   // KLT pyramid levels above the base
   HybridProjectionOptions projection;   // warp geometry (focal, extents, rebuild threshold)
   InterviewMatchOptions matching;       // inter-view filters
   bool match_between_views = true;      // inter-view matching on/off (ablation)

@@ -1,6 +1,7 @@
 // Front-end speed at full size (rovo4: 4 x 1600x1532 ocam views) on textured synthetic images that
 // move by one pixel per frame. Reports ms per frame by stage as counters (warp, track, detect,
-// match) and the CPU time of all threads per frame (cpu_ms). Run: build/vo/rovo_vo_benchmark --benchmark_filter=Frontend
+// match), wall (ms_*) and process CPU time of all threads (cpu_ms_*), and the CPU time per frame
+// (cpu_ms). Run: build/vo/rovo_vo_benchmark --benchmark_filter=Frontend
 #include "datasets/rig.h"
 #include "vo/frontend.h"
 
@@ -30,6 +31,9 @@ void BM_FrontendFullSize(benchmark::State& state) {
   const Rig rig = MakeRigPreset("rovo4");
   FrontendOptions options;
   options.target_features_per_view = static_cast<int>(state.range(0));
+  options.klt_window_px = static_cast<int>(state.range(1));
+  options.klt_levels = static_cast<int>(state.range(2));
+  options.projection.focal_scale = 0.01 * static_cast<double>(state.range(3));
   Frontend frontend(rig, options);
   std::vector<std::vector<cv::Mat>> frames(2);
   for (int i = 0; i < rig.NumCameras(); ++i) {
@@ -40,6 +44,7 @@ void BM_FrontendFullSize(benchmark::State& state) {
   }
   frontend.Process(frames[0]);
   double warp = 0, track = 0, detect = 0, match = 0;
+  double cpu_warp = 0, cpu_track = 0, cpu_detect = 0, cpu_match = 0;
   int64_t iterations = 0, features = 0;
   const std::clock_t cpu_start = std::clock();  // process CPU time, all threads
   for (auto _ : state) {
@@ -48,6 +53,10 @@ void BM_FrontendFullSize(benchmark::State& state) {
     track += frame.ms_track;
     detect += frame.ms_detect;
     match += frame.ms_match;
+    cpu_warp += frame.cpu_ms_warp;
+    cpu_track += frame.cpu_ms_track;
+    cpu_detect += frame.cpu_ms_detect;
+    cpu_match += frame.cpu_ms_match;
     for (const auto& f : frame.features_per_camera) features += static_cast<int64_t>(f.size());
     ++iterations;
   }
@@ -58,9 +67,24 @@ void BM_FrontendFullSize(benchmark::State& state) {
   state.counters["ms_track"] = track / iterations;
   state.counters["ms_detect"] = detect / iterations;
   state.counters["ms_match"] = match / iterations;
+  state.counters["cpu_ms_warp"] = cpu_warp / iterations;
+  state.counters["cpu_ms_track"] = cpu_track / iterations;
+  state.counters["cpu_ms_detect"] = cpu_detect / iterations;
+  state.counters["cpu_ms_match"] = cpu_match / iterations;
   state.counters["features"] = static_cast<double>(features) / iterations;
+  state.counters["warped_width"] = frontend.projection(0).width();
 }
-BENCHMARK(BM_FrontendFullSize)->Arg(600)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+// Args: features per view, KLT window, KLT levels, focal scale in percent.
+BENCHMARK(BM_FrontendFullSize)
+    ->ArgNames({"features", "window", "levels", "focal_pct"})
+    ->Args({600, 21, 3, 100})
+    ->Args({600, 15, 3, 100})
+    ->Args({600, 21, 3, 75})
+    ->Args({600, 15, 3, 75})
+    ->Args({600, 15, 2, 75})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
 
 void BM_HybridWarpOneView(benchmark::State& state) {
   const Rig rig = MakeRigPreset("rovo4");

@@ -5,6 +5,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -71,21 +72,41 @@ cv::Mat DetectionMask(const cv::Mat& mask, int border) {
 }  // namespace
 
 float IntensityCentroidAngleDeg(const cv::Mat& image, cv::Point2f px) {
+  // Half-width of the disc per row offset, computed once.
+  static const std::array<int, kOrbPatchRadius + 1> kHalf = [] {
+    std::array<int, kOrbPatchRadius + 1> half{};
+    for (int dy = 0; dy <= kOrbPatchRadius; ++dy) {
+      half[dy] = static_cast<int>(std::sqrt(double(kOrbPatchRadius * kOrbPatchRadius - dy * dy)));
+    }
+    return half;
+  }();
   const int cx = static_cast<int>(std::lround(px.x)), cy = static_cast<int>(std::lround(px.y));
-  double m01 = 0, m10 = 0;
+  const bool inside = cx >= kOrbPatchRadius && cy >= kOrbPatchRadius && cx + kOrbPatchRadius < image.cols &&
+                      cy + kOrbPatchRadius < image.rows;
+  int64_t m01 = 0, m10 = 0;
   for (int dy = -kOrbPatchRadius; dy <= kOrbPatchRadius; ++dy) {
     const int y = cy + dy;
     if (y < 0 || y >= image.rows) continue;
     const uint8_t* row = image.ptr<uint8_t>(y);
-    const int half = static_cast<int>(std::sqrt(double(kOrbPatchRadius * kOrbPatchRadius - dy * dy)));
-    for (int dx = -half; dx <= half; ++dx) {
-      const int x = cx + dx;
-      if (x < 0 || x >= image.cols) continue;
-      m10 += dx * row[x];
-      m01 += dy * row[x];
+    const int half = kHalf[std::abs(dy)];
+    int64_t row_sum = 0, row_moment = 0;
+    if (inside) {
+      for (int dx = -half; dx <= half; ++dx) {
+        row_sum += row[cx + dx];
+        row_moment += dx * row[cx + dx];
+      }
+    } else {
+      for (int dx = -half; dx <= half; ++dx) {
+        const int x = cx + dx;
+        if (x < 0 || x >= image.cols) continue;
+        row_sum += row[x];
+        row_moment += dx * row[x];
+      }
     }
+    m10 += row_moment;
+    m01 += dy * row_sum;
   }
-  float angle = static_cast<float>(std::atan2(m01, m10) * 180.0 / M_PI);
+  float angle = static_cast<float>(std::atan2(static_cast<double>(m01), static_cast<double>(m10)) * 180.0 / M_PI);
   if (angle < 0) angle += 360.0f;
   return angle;
 }
