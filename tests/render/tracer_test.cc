@@ -301,5 +301,61 @@ TEST(CameraRaysTest, SubPixelBearingsMatchUnproject) {
   EXPECT_LT(max_angle, 1e-4);
 }
 
+// The fixed pattern is N-rooks: for spp = N, every one of the N columns and N rows of the
+// pixel's N x N grid holds exactly one sample, and all offsets lie in [-1/2, 1/2).
+TEST(CameraRaysTest, SampleOffsetsAreNRooks) {
+  EXPECT_EQ(CameraRays::SampleOffset(0, 1), Eigen::Vector2f::Zero());
+  for (int spp : {2, 4, 8, 16}) {
+    std::vector<int> columns(spp, 0), rows(spp, 0);
+    for (int s = 0; s < spp; ++s) {
+      const Eigen::Vector2f o = CameraRays::SampleOffset(s, spp);
+      ASSERT_GE(o.x(), -0.5f);
+      ASSERT_LT(o.x(), 0.5f);
+      ASSERT_GE(o.y(), -0.5f);
+      ASSERT_LT(o.y(), 0.5f);
+      ++columns[static_cast<int>((o.x() + 0.5f) * spp)];
+      ++rows[static_cast<int>((o.y() + 0.5f) * spp)];
+    }
+    for (int k = 0; k < spp; ++k) {
+      EXPECT_EQ(columns[k], 1) << "spp " << spp << " column " << k;
+      EXPECT_EQ(rows[k], 1) << "spp " << spp << " row " << k;
+    }
+  }
+  // spp 2: the two diagonal quarter points.
+  EXPECT_LT((CameraRays::SampleOffset(0, 2) - Eigen::Vector2f(-0.25f, -0.25f)).norm(), 1e-6f);
+  EXPECT_LT((CameraRays::SampleOffset(1, 2) - Eigen::Vector2f(0.25f, 0.25f)).norm(), 1e-6f);
+}
+
+// Sample bearings precomputed by Make(camera, threads, spp) give the same image as bearings
+// interpolated during the render, and MakeCameraRays shares tables between identical cameras.
+TEST(CameraRaysTest, PrecomputedSamplesRenderTheSameImage) {
+  const Scene scene = MakeBoxScene(2, true);
+  const Camera camera = TestCamera(CameraModelId::kEquidistant);
+  const CameraRays plain = CameraRays::Make(camera);
+  EXPECT_EQ(plain.sample_spp, 0);
+  Camera other = camera;
+  other.params[0] *= 1.01;
+  const std::vector<CameraRays> rays = MakeCameraRays({camera, other, camera}, 0, 2);
+  ASSERT_EQ(rays.size(), 3u);
+  ASSERT_EQ(rays[0].sample_spp, 2);
+  ASSERT_EQ(rays[0].sample_bearing.size(), 2u);
+  EXPECT_EQ(rays[2].bearing, rays[0].bearing);
+  EXPECT_EQ(rays[2].sample_bearing, rays[0].sample_bearing);
+  EXPECT_NE(rays[1].bearing, rays[0].bearing);
+  Tracer tracer(scene);
+  tracer.SetFrame(1);
+  ShadeSettings settings;
+  settings.spp = 2;
+  CameraImage precomputed, on_the_fly;
+  tracer.Render(rays[0], WorldFromCam(scene, 1, 0), settings, &precomputed);
+  tracer.Render(plain, WorldFromCam(scene, 1, 0), settings, &on_the_fly);
+  EXPECT_EQ(precomputed.rgb, on_the_fly.rgb);
+  // And 2 spp differs from the pixel centres (the samples are really off-centre).
+  settings.spp = 1;
+  CameraImage centres;
+  tracer.Render(plain, WorldFromCam(scene, 1, 0), settings, &centres);
+  EXPECT_NE(centres.rgb, precomputed.rgb);
+}
+
 }  // namespace
 }  // namespace rovo
