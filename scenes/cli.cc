@@ -17,7 +17,7 @@ namespace {
 
 struct GenerateOptions {
   std::string preset;
-  uint64_t seed = 1;
+  uint64_t seed = 0;  // the default of `rovo render --seed` and `rovo scene preview --seed`
   bool quick = false;
   std::string out_dir;
 };

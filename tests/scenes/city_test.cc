@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -329,6 +330,64 @@ TEST(GenerateScene, FacadeReliefLinesUpWithPaintedWindows) {
       EXPECT_GT(kinds["roof_tiles_"], 0);  // low town houses
     }
   }
+}
+
+// canyon_multifov is a narrow urban canyon: facades close to both sides of the rig and tall
+// compared with the street's width (static_urban, for contrast, is a wide street).
+TEST(CityLayout, CanyonIsNarrowAndTall) {
+  struct Profile {
+    double median_width = 0, median_height = 0, both_sides_fraction = 0;
+  };
+  auto profile = [](const char* preset) {
+    const CityLayout L = MakeCityLayout(FindScenePreset(preset), 2, false);
+    std::vector<double> widths, heights;
+    int samples = 0, both = 0;
+    for (size_t f = 0; f < L.trajectory.size(); f += 10) {
+      const Eigen::Vector2d p = L.trajectory[f].world_from_rig.translation.head<2>();
+      const double yaw = L.rig_path.Heading(L.drive.s[f]);
+      const Eigen::Vector2d left(-std::sin(yaw), std::cos(yaw));
+      double width = 0;
+      int hits = 0;
+      for (double side : {1.0, -1.0}) {
+        for (double d = 0.25; d < 25.0; d += 0.25) {
+          const Eigen::Vector2d q = p + side * d * left;
+          const BuildingPlan* hit = nullptr;
+          for (const BuildingPlan& b : L.buildings)
+            if (b.footprint.Contains(q)) hit = &b;
+          if (!hit) continue;
+          width += d;
+          heights.push_back(hit->height);
+          ++hits;
+          break;
+        }
+      }
+      ++samples;
+      if (hits == 2) {
+        ++both;
+        widths.push_back(width);
+      }
+    }
+    auto median = [](std::vector<double> v) {
+      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+      return v[v.size() / 2];
+    };
+    Profile out;
+    out.both_sides_fraction = static_cast<double>(both) / samples;
+    if (!widths.empty()) out.median_width = median(widths);
+    if (!heights.empty()) out.median_height = median(heights);
+    return out;
+  };
+  const Profile canyon = profile("canyon_multifov"), wide = profile("static_urban");
+  // Facade to facade: 7 m road + 2 x 2 m sidewalks = 11 m.
+  EXPECT_GT(canyon.both_sides_fraction, 0.6);
+  EXPECT_LE(canyon.median_width, 12.0);
+  EXPECT_GE(canyon.median_height / canyon.median_width, 2.5);
+  EXPECT_GE(wide.median_width, 15.0);
+  EXPECT_LT(wide.median_height / wide.median_width, 1.5);
+  std::printf("canyon: facade-to-facade %.1f m, building height %.1f m (H/W %.1f), both sides within 25 m %.0f%%\n"
+              "static_urban: %.1f m, %.1f m (H/W %.1f)\n",
+              canyon.median_width, canyon.median_height, canyon.median_height / canyon.median_width,
+              100 * canyon.both_sides_fraction, wide.median_width, wide.median_height, wide.median_height / wide.median_width);
 }
 
 TEST(Textures, TileSeamlesslyAndHaveDetail) {
