@@ -64,6 +64,42 @@ struct PoseParams {
 PoseParams ToParams(const Rigid3& x) { return {x.AxisAngle(), x.translation}; }
 Rigid3 FromParams(const PoseParams& p) { return Rigid3::FromAxisAngle(p.aa, p.t); }
 
+// Random-walk prior of online extrinsics between BA runs:
+//   r = [ log(R * R0^T) / sigma_rot ; (c - c0) / sigma_centre ],  c = -R^T t,
+// with (R0, c0) the extrinsics before this solve.
+struct ExtrinsicPriorCost {
+  ExtrinsicPriorCost(const Rigid3& cam_from_rig0, double sigma_rot_rad, double sigma_centre_m)
+      : q0_inverse{cam_from_rig0.rotation.w(), -cam_from_rig0.rotation.x(), -cam_from_rig0.rotation.y(),
+                   -cam_from_rig0.rotation.z()},
+        centre0(cam_from_rig0.Inverse().translation),
+        inv_sigma_rot(1.0 / sigma_rot_rad),
+        inv_sigma_centre(1.0 / sigma_centre_m) {}
+
+  template <typename T>
+  bool operator()(const T* aa, const T* t, T* residual) const {
+    T q[4], q0i[4], dq[4];
+    ceres::AngleAxisToQuaternion(aa, q);
+    for (int k = 0; k < 4; ++k) q0i[k] = T(q0_inverse[k]);
+    ceres::QuaternionProduct(q, q0i, dq);
+    ceres::QuaternionToAngleAxis(dq, residual);
+    for (int k = 0; k < 3; ++k) residual[k] *= T(inv_sigma_rot);
+    T centre[3];
+    const T minus_aa[3] = {-aa[0], -aa[1], -aa[2]};
+    ceres::AngleAxisRotatePoint(minus_aa, t, centre);
+    for (int k = 0; k < 3; ++k) residual[3 + k] = T(inv_sigma_centre) * (-centre[k] - T(centre0[k]));
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const Rigid3& cam_from_rig0, double sigma_rot_rad, double sigma_centre_m) {
+    return new ceres::AutoDiffCostFunction<ExtrinsicPriorCost, 6, 3, 3>(
+        new ExtrinsicPriorCost(cam_from_rig0, sigma_rot_rad, sigma_centre_m));
+  }
+
+  double q0_inverse[4];  // w, x, y, z (Ceres' quaternion order)
+  Eigen::Vector3d centre0;
+  double inv_sigma_rot, inv_sigma_centre;
+};
+
 }  // namespace
 
 void LocalBaOptions::Check() const {
@@ -71,6 +107,9 @@ void LocalBaOptions::Check() const {
   if (!(multi_camera_weight > 0.0)) throw std::invalid_argument("LocalBaOptions.multi_camera_weight must be > 0");
   if (!(baseline_weight >= 0.0)) throw std::invalid_argument("LocalBaOptions.baseline_weight must be >= 0");
   if (max_iterations < 1) throw std::invalid_argument("LocalBaOptions.max_iterations must be >= 1");
+  if (!(extrinsic_prior_deg >= 0.0) || !(extrinsic_prior_m > 0.0)) {
+    throw std::invalid_argument("LocalBaOptions.extrinsic_prior_deg must be >= 0 and extrinsic_prior_m > 0");
+  }
   if (num_threads < 1) throw std::invalid_argument("LocalBaOptions.num_threads must be >= 1");
 }
 
@@ -137,6 +176,17 @@ LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& option
       if (!cam_used[a] || !cam_used[b]) continue;
       ceres_problem.AddResidualBlock(BaselineCost::Create(baselines[p], options.baseline_weight), nullptr,
                                      cams[a].aa.data(), cams[a].t.data(), cams[b].aa.data(), cams[b].t.data());
+    }
+  }
+
+  if (options.optimize_extrinsics && options.extrinsic_prior_deg > 0.0) {
+    for (int j = 1; j < num_cams; ++j) {
+      if (!cam_used[j]) continue;
+      ceres_problem.AddResidualBlock(
+          ExtrinsicPriorCost::Create(problem.cam_from_rig[j],
+                                     options.extrinsic_prior_deg * M_PI / 180.0 / options.observation_sigma_rad,
+                                     options.extrinsic_prior_m / options.observation_sigma_rad),
+          nullptr, cams[j].aa.data(), cams[j].t.data());
     }
   }
 

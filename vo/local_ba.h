@@ -2,6 +2,7 @@
 // Local bundle adjustment with online extrinsic calibration (ROVO paper, Sec. IV-D):
 //     min sum_t sum_j sum_i w_ij rho( | b_ijt - pi0(cam_from_rig_j * rig_from_world_t * X_i) |^2 )
 //         + sum_{(i,j) neighbours} ( s * ( |c_j - c_i| - L0_ij ) )^2
+//         + sum_{j >= 1} |log(R_j R_j0^T)|^2 / sigma_r^2 + |c_j - c_j0|^2 / sigma_c^2   (optional prior)
 // over the rig poses rig_from_world_t of the window, the landmarks X_i (point_in_world) and, in
 // online mode, cam_from_rig_j of cameras 1..N-1. pi0(p) = p/|p|, rho = Cauchy, w_ij =
 // multi_camera_weight for points seen by >= 2 cameras (they carry the metric scale), else 1.
@@ -23,9 +24,18 @@ namespace rovo {
 
 struct LocalBaOptions {
   bool optimize_extrinsics = false;  // online extrinsic calibration
-  double cauchy_scale_rad = 0.005;   // Cauchy scale on the bearing chord
+  double cauchy_scale_rad = 0.002;   // Cauchy scale on the bearing chord (0.11 deg)
   double multi_camera_weight = 2.0;  // w for points seen by >= 2 cameras
   double baseline_weight = 1000.0;   // s, per metre of baseline change
+  // Online mode: a random-walk prior pulls each free cam_from_rig towards its value before the solve,
+  // with these standard deviations per solve (rotation, camera centre); 0 deg = no prior. The rig
+  // is rigid, so one window's evidence should move the extrinsics only a little: this averages the
+  // windows' estimates instead of letting each window's errors through.
+  double extrinsic_prior_deg = 0.0;
+  double extrinsic_prior_m = 0.005;
+  // The bearing residuals are chords in radians, unweighted: the prior is scaled by this assumed
+  // bearing noise so that both terms are in units of standard deviations.
+  double observation_sigma_rad = 0.001;
   int max_iterations = 10;
   double max_time_s = 0.0;           // 0: no wall-time limit (deterministic)
   int num_threads = 1;

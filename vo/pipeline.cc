@@ -500,6 +500,9 @@ VoSummary RunVo(const VoOptions& options) {
   backend_options.ransac.sampling = ViewSamplingFromName(options.sampling);
   backend_options.ransac.views = RansacViewsFromName(options.ransac);
   backend_options.ba.optimize_extrinsics = options.mode == ExtrinsicsMode::kOnline;
+  // Online: each keyframe BA may move an extrinsic by about this much (random-walk prior, local_ba.h):
+  // measured on cloudy_urban quick, it halves the wander of the estimate between windows.
+  backend_options.ba.extrinsic_prior_deg = 0.005;
   if (options.mode == ExtrinsicsMode::kOnline && options.online_prior_deg > 0.0) {
     cam_from_rig = BootstrapExtrinsics(options, info.rig, cam_from_rig);
   }
@@ -588,6 +591,7 @@ VoSummary RunVo(const VoOptions& options) {
                   {"ba_cauchy_scale_deg", backend_options.ba.cauchy_scale_rad * 180.0 / M_PI},
                   {"ba_max_iterations", backend_options.ba.max_iterations},
                   {"ba_online_extrinsics", backend_options.ba.optimize_extrinsics},
+                  {"ba_extrinsic_prior_deg", backend_options.ba.extrinsic_prior_deg},
                   {"window_keyframes", backend_options.window_keyframes}};
   j["summary"] = {{"frames", summary.frames},
                   {"frames_ok", summary.frames_ok},
