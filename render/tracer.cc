@@ -178,7 +178,7 @@ CameraRays CameraRays::Make(const Camera& camera, int threads, int spp) {
     pixel_angles();
   }
   for (uint8_t v : rays.valid) rays.num_valid += v;
-  if (spp > 1) {
+  if (spp > 1 && spp <= kMaxPrecomputedSpp) {
     rays.sample_spp = spp;
     rays.sample_bearing.assign(spp, std::vector<Eigen::Vector3f>(n, Eigen::Vector3f::Zero()));
     auto samples = [&] {

@@ -62,12 +62,13 @@ struct CameraRays {
   int num_valid = 0;
 
   // Bearings of the fixed sub-pixel samples: sample_bearing[s][pixel] for s < sample_spp
-  // (zero where the sample does not unproject); empty unless Make() got spp > 1.
+  // (zero where the sample does not unproject); empty unless Make() got 1 < spp <= kMaxPrecomputedSpp.
+  static constexpr int kMaxPrecomputedSpp = 4;  // 12 bytes per pixel and sample; more are interpolated per render
   int sample_spp = 0;
   std::vector<std::vector<Eigen::Vector3f>> sample_bearing;
 
-  // Unprojects every pixel centre (parallel, `threads` 0 = all cores); with spp > 1 also the
-  // bearings of the fixed `spp`-sample pattern (12 bytes per pixel and sample).
+  // Unprojects every pixel centre (parallel, `threads` 0 = all cores); with 1 < spp <=
+  // kMaxPrecomputedSpp also the bearings of the fixed `spp`-sample pattern.
   static CameraRays Make(const Camera& camera, int threads = 0, int spp = 1);
   // Bearing of the continuous pixel position (u, v); false outside the field of view.
   bool SampleBearing(float u, float v, Eigen::Vector3f* bearing_out) const;

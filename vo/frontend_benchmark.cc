@@ -100,5 +100,16 @@ void BM_HybridWarpOneView(benchmark::State& state) {
 }
 BENCHMARK(BM_HybridWarpOneView)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// Cost of (re)building one full-size camera's warp maps, as after an extrinsic update.
+void BM_HybridMapsOneView(benchmark::State& state) {
+  const Rig rig = MakeRigPreset("rovo4");
+  const std::vector<HybridLayout> layouts = ComputeHybridLayouts(rig);
+  for (auto _ : state) {
+    const HybridProjection projection(rig.cameras[0].camera, rig.cameras[0].cam_from_rig, layouts[0]);
+    benchmark::DoNotOptimize(projection.map_x().data);
+  }
+}
+BENCHMARK(BM_HybridMapsOneView)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 }  // namespace
 }  // namespace rovo

@@ -260,6 +260,39 @@ std::optional<Eigen::Vector2d> HybridProjection::WarpedFromFisheye(const Eigen::
 }
 
 void HybridProjection::BuildMaps() {
+  // Exact fisheye pixel of a warped pixel, or nullopt when outside the FOV or (with one pixel of
+  // margin for bilinear interpolation) outside the fisheye image.
+  const auto exact = [&](int u, int v) -> std::optional<Eigen::Vector2d> {
+    const auto uv = FisheyeFromWarped(Eigen::Vector2d(u, v));
+    if (!uv || uv->x() < 0 || uv->y() < 0 || uv->x() > camera_.width - 1 || uv->y() > camera_.height - 1) {
+      return std::nullopt;
+    }
+    return uv;
+  };
+  // Nodes every kMapStep pixels (the last row/column included).
+  const int node_cols = (width_ - 1 + kMapStep - 1) / kMapStep + 1;
+  const int node_rows = (height_ - 1 + kMapStep - 1) / kMapStep + 1;
+  const auto node_u = [&](int k) { return std::min(k * kMapStep, width_ - 1); };
+  const auto node_v = [&](int k) { return std::min(k * kMapStep, height_ - 1); };
+  std::vector<Eigen::Vector2d> node_uv(static_cast<size_t>(node_cols) * node_rows);
+  std::vector<uint8_t> node_ok(node_uv.size(), 0);
+  tbb::parallel_for(0, node_rows, [&](int r) {
+    for (int c = 0; c < node_cols; ++c) {
+      const auto uv = exact(node_u(c), node_v(r));
+      const size_t i = static_cast<size_t>(r) * node_cols + c;
+      if (uv) node_uv[i] = *uv, node_ok[i] = 1;
+    }
+  });
+  // A cell is interpolated when the 4x4 nodes around it are valid (one cell of margin to the
+  // valid area's border, which is then computed exactly).
+  const auto interior = [&](int r, int c) {
+    for (int y = std::max(0, r - 1); y <= std::min(node_rows - 1, r + 2); ++y) {
+      for (int x = std::max(0, c - 1); x <= std::min(node_cols - 1, c + 2); ++x) {
+        if (!node_ok[static_cast<size_t>(y) * node_cols + x]) return false;
+      }
+    }
+    return r + 1 < node_rows && c + 1 < node_cols;
+  };
   map_x_.create(height_, width_, CV_32FC1);
   map_y_.create(height_, width_, CV_32FC1);
   valid_mask_.create(height_, width_, CV_8UC1);
@@ -267,10 +300,20 @@ void HybridProjection::BuildMaps() {
     float* mx = map_x_.ptr<float>(v);
     float* my = map_y_.ptr<float>(v);
     uint8_t* valid = valid_mask_.ptr<uint8_t>(v);
+    const int r = std::min(v / kMapStep, node_rows - 2);
+    const double ty = node_v(r + 1) > node_v(r) ? double(v - node_v(r)) / (node_v(r + 1) - node_v(r)) : 0.0;
     for (int u = 0; u < width_; ++u) {
-      const auto uv = FisheyeFromWarped(Eigen::Vector2d(u, v));
-      // One pixel of margin so that bilinear interpolation stays inside the fisheye image.
-      if (uv && uv->x() >= 0 && uv->y() >= 0 && uv->x() <= camera_.width - 1 && uv->y() <= camera_.height - 1) {
+      const int c = std::min(u / kMapStep, node_cols - 2);
+      std::optional<Eigen::Vector2d> uv;
+      if (interior(r, c)) {
+        const double tx = node_u(c + 1) > node_u(c) ? double(u - node_u(c)) / (node_u(c + 1) - node_u(c)) : 0.0;
+        const size_t i = static_cast<size_t>(r) * node_cols + c;
+        uv = (1 - ty) * ((1 - tx) * node_uv[i] + tx * node_uv[i + 1]) +
+             ty * ((1 - tx) * node_uv[i + node_cols] + tx * node_uv[i + node_cols + 1]);
+      } else {
+        uv = exact(u, v);
+      }
+      if (uv) {
         mx[u] = static_cast<float>(uv->x());
         my[u] = static_cast<float>(uv->y());
         valid[u] = 255;

@@ -342,6 +342,8 @@ TEST(CameraRaysTest, PrecomputedSamplesRenderTheSameImage) {
   EXPECT_EQ(rays[2].bearing, rays[0].bearing);
   EXPECT_EQ(rays[2].sample_bearing, rays[0].sample_bearing);
   EXPECT_NE(rays[1].bearing, rays[0].bearing);
+  // Many samples are not stored (memory), they are interpolated during the render.
+  EXPECT_EQ(CameraRays::Make(camera, 0, CameraRays::kMaxPrecomputedSpp + 1).sample_spp, 0);
   Tracer tracer(scene);
   tracer.SetFrame(1);
   ShadeSettings settings;

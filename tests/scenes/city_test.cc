@@ -435,6 +435,13 @@ TEST(SceneCli, GenerateAndList) {
   EXPECT_NE(log.find("path"), std::string::npos) << log;
   const Scene loaded = LoadScene(out + "/s");
   EXPECT_EQ(SceneHash(loaded), SceneHash(GenerateScene("cloudy_urban", 5, true)));
+  // `scene info` loads the folder and reports the same content hash, the path and the load time.
+  const std::string info = std::string(ROVO_BINARY) + " scene info " + out + "/s > " + out + "/info.txt 2>&1";
+  ASSERT_EQ(std::system(info.c_str()), 0) << ReadFile(out + "/info.txt");
+  const std::string info_log = ReadFile(out + "/info.txt");
+  EXPECT_NE(info_log.find(SceneHash(loaded)), std::string::npos) << info_log;
+  EXPECT_NE(info_log.find("(preset: 69 m, 60 frames)"), std::string::npos) << info_log;
+  EXPECT_NE(info_log.find("s load"), std::string::npos) << info_log;
   const std::string list = std::string(ROVO_BINARY) + " scene list > " + out + "/list.txt 2>&1";
   ASSERT_EQ(std::system(list.c_str()), 0);
   EXPECT_NE(ReadFile(out + "/list.txt").find("canyon_multifov"), std::string::npos);
