@@ -594,7 +594,7 @@ void AddBuilding(MeshBuilder& b, const BuildingPlan& p, const FacadeLayout& fl, 
     }
   }
 
-  // Roofline: a hipped roof on low buildings, else a cornice or a parapet (or a plain edge).
+  // Roofline: a hipped roof on some low buildings, else a cornice or a parapet.
   const int trim = am.trim[arch.UniformInt(0, static_cast<int>(am.trim.size()) - 1)];
   const Box2& roof_fp = p.has_setback ? p.upper_footprint : p.footprint;
   const double roof_z = p.has_setback ? p.upper_height : p.height;

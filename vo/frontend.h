@@ -46,7 +46,7 @@ struct FrontendOptions {
   float min_feature_distance_px = 12;   // between features of one view (warped pixels)
   int fast_threshold = 12;              // FAST-9 threshold of the detector
   float max_forward_backward_px = 1.0f; // KLT forward-backward round-trip error
-  int klt_window_px = 15;               // KLT window side (warped pixels; 21 costs 30 % more CPU)
+  int klt_window_px = 21;               // KLT window side (warped pixels; 15 saves ~20 % CPU)
   int klt_levels = 3;                   // KLT pyramid levels above the base
   HybridProjectionOptions projection;   // warp geometry (focal, extents, rebuild threshold)
   InterviewMatchOptions matching;       // inter-view filters

@@ -16,8 +16,10 @@
 //     epipolar plane <= epipolar_deg under the ground-truth extrinsics), as in the paper. A match
 //     is an inlier by GROUND TRUTH (GroundTruthMatchVerdict below). The front-end's full filter
 //     chain (interview_matching.h) on the hybrid images is reported as a third column.
-// Outputs in --out: table.md, study.json (numbers, dataset seed, settings), matches_hybrid.png and
-// matches_fisheye.png (one neighbour pair of the last frame; green = inlier, red = outlier).
+// Outputs in --out: table.md (with a histogram of the ground-truth reprojection distances),
+// study.json (numbers, dataset seed, settings), matches_fisheye.png, matches_hybrid.png (the NN
+// matches of part (b)) and matches_frontend.png (the front-end's accepted matches), each one
+// neighbour pair of the last frame (green = inlier, red = outlier).
 
 #include "datasets/rig.h"
 #include "vo/interview_matching.h"
