@@ -50,9 +50,11 @@ ExtrinsicBootstrapReport CalibrateExtrinsicsFromFrame(const FrontendFrame& frame
     if (features.size() < 2) continue;
     std::vector<Ray> rays;
     std::vector<int> cams;
+    std::vector<const Feature*> used;  // one feature per camera
     for (const Feature* f : features) {
-      if (std::find(cams.begin(), cams.end(), f->camera) != cams.end()) continue;  // one per camera
+      if (std::find(cams.begin(), cams.end(), f->camera) != cams.end()) continue;
       cams.push_back(f->camera);
+      used.push_back(f);
       rays.push_back({rig_from_cam[f->camera].translation, rig_from_cam[f->camera].rotation * f->bearing_in_cam});
     }
     if (rays.size() < 2) continue;
@@ -84,16 +86,9 @@ ExtrinsicBootstrapReport CalibrateExtrinsicsFromFrame(const FrontendFrame& frame
     problem.points_in_world.push_back(point);
     problem.point_num_cameras.push_back(static_cast<int>(cams.size()));
     cameras_of_point.push_back(cams);
-    for (size_t k = 0; k < cams.size(); ++k) {
-      const Feature* f = nullptr;
-      for (const Feature* g : features) {
-        if (g->camera == cams[k]) {
-          f = g;
-          break;
-        }
-      }
-      problem.observations.push_back({0, cams[k], point_index, f->bearing_in_cam});
-      errors_before.push_back(AngleBetween(f->bearing_in_cam, cam_from_rig[cams[k]] * point) * 180.0 / M_PI);
+    for (const Feature* f : used) {
+      problem.observations.push_back({0, f->camera, point_index, f->bearing_in_cam});
+      errors_before.push_back(AngleBetween(f->bearing_in_cam, cam_from_rig[f->camera] * point) * 180.0 / M_PI);
     }
   }
   report.num_points = static_cast<int>(problem.points_in_world.size());

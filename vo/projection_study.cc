@@ -105,6 +105,19 @@ int GroundTruthMatchVerdict(const Rig& rig, int camera_a, const Eigen::Vector3d&
   return verdict;
 }
 
+int FrontendMatchVerdict(const Frontend& frontend, const Rig& rig, const Frontend::ViewMatch& match,
+                         const std::vector<cv::Mat>& depths, double inlier_px, double* error_px) {
+  const cv::Point2f pa = frontend.tracker(match.camera_a).points()[match.index_a].px;
+  const cv::Point2f pb = frontend.tracker(match.camera_b).points()[match.index_b].px;
+  const HybridProjection& a = frontend.projection(match.camera_a);
+  const auto bearing_a = a.BearingFromWarped(Eigen::Vector2d(pa.x, pa.y));
+  const auto fa = a.FisheyeFromWarped(Eigen::Vector2d(pa.x, pa.y));
+  const auto fb = frontend.projection(match.camera_b).FisheyeFromWarped(Eigen::Vector2d(pb.x, pb.y));
+  if (!bearing_a || !fa || !fb) return -2;
+  return GroundTruthMatchVerdict(rig, match.camera_a, *bearing_a, *fa, match.camera_b, *fb, depths[match.camera_a],
+                                 depths[match.camera_b], inlier_px, error_px);
+}
+
 namespace {
 
 struct DrawnMatch {
@@ -348,16 +361,11 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
     // The front-end's own accepted matches (all filters), same verification.
     if (last) drawn_frontend.clear();
     for (const Frontend::ViewMatch& m : frontend.last_matches()) {
+      double error = 0;
+      const int verdict = FrontendMatchVerdict(frontend, rig, m, depths, options.inlier_px, &error);
+      if (verdict < 0) continue;
       const cv::Point2f pa = frontend.tracker(m.camera_a).points()[m.index_a].px;
       const cv::Point2f pb = frontend.tracker(m.camera_b).points()[m.index_b].px;
-      const auto bearing_a = frontend.projection(m.camera_a).BearingFromWarped(Eigen::Vector2d(pa.x, pa.y));
-      const auto fa = frontend.projection(m.camera_a).FisheyeFromWarped(Eigen::Vector2d(pa.x, pa.y));
-      const auto fb = frontend.projection(m.camera_b).FisheyeFromWarped(Eigen::Vector2d(pb.x, pb.y));
-      if (!bearing_a || !fa || !fb) continue;
-      double error = 0;
-      const int verdict = GroundTruthMatchVerdict(rig, m.camera_a, *bearing_a, *fa, m.camera_b, *fb, depths[m.camera_a],
-                                                  depths[m.camera_b], options.inlier_px, &error);
-      if (verdict < 0) continue;
       ++result.matches_frontend;
       result.inliers_frontend += verdict;
       ++frontend_error_bins[ErrorBin(error)];

@@ -22,6 +22,7 @@
 // neighbour pair of the last frame (green = inlier, red = outlier).
 
 #include "datasets/rig.h"
+#include "vo/frontend.h"
 #include "vo/interview_matching.h"
 
 #include <Eigen/Core>
@@ -29,6 +30,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace rovo {
 
@@ -50,6 +52,12 @@ int GroundTruthMatchVerdict(const Rig& rig, int camera_a, const Eigen::Vector3d&
                             const Eigen::Vector2d& fisheye_a, int camera_b, const Eigen::Vector2d& fisheye_b,
                             const cv::Mat& depth_a, const cv::Mat& depth_b, double inlier_px,
                             double* error_px = nullptr);
+
+// GroundTruthMatchVerdict of one of the front-end's accepted inter-view matches (from
+// Frontend::last_matches), its warped pixels mapped to the bearing and fisheye pixels; `depths`
+// holds one depth image per camera. Returns -2 when a warped pixel has no bearing or fisheye pixel.
+int FrontendMatchVerdict(const Frontend& frontend, const Rig& rig, const Frontend::ViewMatch& match,
+                         const std::vector<cv::Mat>& depths, double inlier_px, double* error_px = nullptr);
 
 struct ProjectionStudyOptions {
   std::string dataset_dir;

@@ -53,14 +53,8 @@ TEST_F(RenderedQuick, AcceptedInterViewMatchesAreCorrect) {
     merged += static_cast<int64_t>(frame.merged_ids.size());
     for (int c = 0; c < rig.NumCameras(); ++c) EXPECT_GT(frame.features_per_camera[c].size(), 200u);
     for (const Frontend::ViewMatch& m : frontend.last_matches()) {
-      const cv::Point2f pa = frontend.tracker(m.camera_a).points()[m.index_a].px;
-      const cv::Point2f pb = frontend.tracker(m.camera_b).points()[m.index_b].px;
-      const auto bearing = frontend.projection(m.camera_a).BearingFromWarped(Eigen::Vector2d(pa.x, pa.y));
-      const auto fa = frontend.projection(m.camera_a).FisheyeFromWarped(Eigen::Vector2d(pa.x, pa.y));
-      const auto fb = frontend.projection(m.camera_b).FisheyeFromWarped(Eigen::Vector2d(pb.x, pb.y));
-      ASSERT_TRUE(bearing && fa && fb);
-      const int verdict = GroundTruthMatchVerdict(rig, m.camera_a, *bearing, *fa, m.camera_b, *fb, depths[m.camera_a],
-                                                  depths[m.camera_b], 2.0);
+      const int verdict = FrontendMatchVerdict(frontend, rig, m, depths, 2.0);
+      ASSERT_NE(verdict, -2) << "an accepted match has a pixel without bearing or fisheye pixel";
       if (verdict < 0) continue;
       ++counted;
       inliers += verdict;
