@@ -81,7 +81,7 @@ void BM_TriangulateThreeRays(benchmark::State& state) {
 }
 BENCHMARK(BM_TriangulateThreeRays);
 
-// 6 poses, state.range(0) points, online extrinsics, 10 iterations.
+// 6 poses, state.range(0) points, 10 iterations; online extrinsics if state.range(1) != 0.
 void BM_LocalBa(benchmark::State& state) {
   std::mt19937_64 rng(4);
   LocalBaProblem base;
@@ -104,13 +104,13 @@ void BM_LocalBa(benchmark::State& state) {
     base.point_num_cameras.push_back(cams);
   }
   LocalBaOptions options;
-  options.optimize_extrinsics = true;
+  options.optimize_extrinsics = state.range(1) != 0;
   for (auto _ : state) {
     LocalBaProblem p = base;
     benchmark::DoNotOptimize(SolveLocalBa(p, options));
   }
 }
-BENCHMARK(BM_LocalBa)->Arg(500)->Arg(1500)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LocalBa)->ArgNames({"points", "online"})->ArgsProduct({{800, 1500}, {0, 1}})->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace rovo

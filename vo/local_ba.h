@@ -20,6 +20,10 @@
 
 #include <vector>
 
+namespace ceres {
+class CostFunction;
+}
+
 namespace rovo {
 
 struct LocalBaOptions {
@@ -69,6 +73,11 @@ struct LocalBaReport {
 
 // Centre distances of ring neighbours (j, j+1 mod N) of a set of extrinsics.
 std::vector<double> RingBaselineLengths(const std::vector<Rigid3>& cam_from_rig);
+
+// The bearing residual r = b - pi0(cam_from_rig * rig_from_world * X) (3 values) over the blocks
+// rig_from_world (angle-axis, translation), cam_from_rig (angle-axis, translation), point_in_world,
+// with analytic Jacobians (local_ba.cc). The caller owns the returned object.
+ceres::CostFunction* CreateBearingResidual(const Eigen::Vector3d& bearing_in_cam);
 
 // Optimises `problem` in place.
 LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& options);
