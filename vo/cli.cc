@@ -47,6 +47,13 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
                   "BA only)")
       ->check(CLI::Range(0.0, 45.0))
       ->capture_default_str();
+  cmd->add_option("--tau", args->options.ransac_tau_deg,
+                  "RANSAC inlier threshold in degrees (angle between observed and predicted bearing; 0: the default, "
+                  "recorded in run.json)")
+      ->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--keyframe-distance", args->options.keyframe_distance_m,
+                  "Rig travel in metres that makes a keyframe (and a local BA); 0: the default, recorded in run.json")
+      ->check(CLI::Range(0.0, 100.0));
   cmd->add_flag("--quiet", args->options.quiet, "No progress output");
 }
 
@@ -90,7 +97,7 @@ void AddVoCommands(CliGroups& groups) {
                 ExtrinsicsModeName(options.mode).c_str(), s.frames, options.threads);
     std::printf("| stage                     | ms/frame |\n|---------------------------|---------:|\n");
     const std::pair<const char*, double> rows[] = {
-        {"load images", t.load},        {"front-end: warp", t.warp},   {"front-end: detect", t.detect},
+        {"load images (wait)", t.load},        {"front-end: warp", t.warp},   {"front-end: detect", t.detect},
         {"front-end: track", t.track},  {"front-end: match", t.match}, {"back-end: RANSAC", t.ransac},
         {"back-end: refine", t.refine}, {"back-end: triangulate", t.triangulate}, {"back-end: local BA", t.ba},
         {"back-end: total", t.backend_total}, {"whole frame", t.total}};

@@ -7,6 +7,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 #include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -14,6 +15,7 @@
 #include <memory>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <stdexcept>
 
 namespace rovo {
@@ -388,24 +390,69 @@ namespace {
 
 // The images of one frame; a missing or unreadable file becomes a black image (the frame is then
 // reported lost by the back-end) and is named in `problems`.
+// The views are decoded in parallel.
 std::vector<cv::Mat> LoadFrameImages(const std::string& dataset_dir, const Rig& rig, int frame,
                                      std::string* problems) {
-  std::vector<cv::Mat> images;
-  for (const RigCamera& cam : rig.cameras) {
+  const int n = rig.NumCameras();
+  std::vector<cv::Mat> images(n);
+  std::vector<std::string> missing(n), wrong_size(n);
+  tbb::parallel_for(0, n, [&](int j) {
+    const RigCamera& cam = rig.cameras[j];
     const std::string path = ImagePath(dataset_dir, cam.name, frame);
-    cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
-    if (image.empty()) {
-      *problems += (problems->empty() ? "" : "; ") + path + ": missing or unreadable";
-      image = cv::Mat::zeros(cam.camera.height, cam.camera.width, CV_8UC1);
-    } else if (image.cols != cam.camera.width || image.rows != cam.camera.height) {
-      throw std::runtime_error(path + ": image is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
-                               " but dataset.json rig.cameras[" + cam.name + "] says " +
-                               std::to_string(cam.camera.width) + "x" + std::to_string(cam.camera.height));
+    images[j] = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    if (images[j].empty()) {
+      missing[j] = path + ": missing or unreadable";
+      images[j] = cv::Mat::zeros(cam.camera.height, cam.camera.width, CV_8UC1);
+    } else if (images[j].cols != cam.camera.width || images[j].rows != cam.camera.height) {
+      wrong_size[j] = path + ": image is " + std::to_string(images[j].cols) + "x" + std::to_string(images[j].rows) +
+                      " but dataset.json rig.cameras[" + cam.name + "] says " + std::to_string(cam.camera.width) +
+                      "x" + std::to_string(cam.camera.height);
     }
-    images.push_back(image);
+  });
+  for (int j = 0; j < n; ++j) {
+    if (!wrong_size[j].empty()) throw std::runtime_error(wrong_size[j]);
+    if (!missing[j].empty()) *problems += (problems->empty() ? "" : "; ") + missing[j];
   }
   return images;
 }
+
+struct LoadedFrame {
+  std::vector<cv::Mat> images;
+  std::string problems;
+};
+
+// Reads frame f+1's images on a second thread while frame f is processed (PNG decoding is the
+// largest single cost of a frame; the back-end's BA is single-threaded, so a core is usually free).
+class ImagePrefetcher {
+ public:
+  ImagePrefetcher(const std::string& dataset_dir, const Rig& rig, int begin, int end)
+      : dataset_dir_(dataset_dir), rig_(rig), end_(end) {
+    Start(begin);
+  }
+  ~ImagePrefetcher() {
+    if (next_.valid()) next_.wait();
+  }
+  // The images of `frame` (the frames must be requested in order); starts reading the next one.
+  LoadedFrame Get(int frame) {
+    LoadedFrame loaded = next_.get();  // rethrows a read error
+    Start(frame + 1);
+    return loaded;
+  }
+
+ private:
+  void Start(int frame) {
+    if (frame >= end_) return;
+    next_ = std::async(std::launch::async, [this, frame] {
+      LoadedFrame loaded;
+      loaded.images = LoadFrameImages(dataset_dir_, rig_, frame, &loaded.problems);
+      return loaded;
+    });
+  }
+  std::string dataset_dir_;
+  const Rig& rig_;
+  int end_;
+  std::future<LoadedFrame> next_;
+};
 
 // Inter-view filters loosened for an extrinsic rotation uncertainty of `uncertainty_deg`: the
 // epipolar angle grows with it, the rectified y-distance by the warped focal length times its tangent.
@@ -500,6 +547,8 @@ VoSummary RunVo(const VoOptions& options) {
   backend_options.ransac.sampling = ViewSamplingFromName(options.sampling);
   backend_options.ransac.views = RansacViewsFromName(options.ransac);
   backend_options.ba.optimize_extrinsics = options.mode == ExtrinsicsMode::kOnline;
+  if (options.ransac_tau_deg > 0.0) backend_options.ransac.tau_rad = options.ransac_tau_deg * M_PI / 180.0;
+  if (options.keyframe_distance_m > 0.0) backend_options.keyframes.min_translation_m = options.keyframe_distance_m;
   // Online: each keyframe BA may move an extrinsic by about this much (random-walk prior, local_ba.h):
   // measured on cloudy_urban quick, it halves the wander of the estimate between windows.
   backend_options.ba.extrinsic_prior_deg = 0.005;
@@ -515,10 +564,12 @@ VoSummary RunVo(const VoOptions& options) {
   int total_hypotheses = 0;
   double ok_ratio_sum = 0.0, ok_error_sum = 0.0;
   Progress progress("vo " + ExtrinsicsModeName(options.mode), end - begin, "frames", options.quiet);
+  ImagePrefetcher prefetcher(options.dataset_dir, info.rig, begin, end);
   for (int frame = begin; frame < end; ++frame) {
     const auto frame_start = Clock::now();
-    std::string problems;
-    const std::vector<cv::Mat> images = LoadFrameImages(options.dataset_dir, info.rig, frame, &problems);
+    const LoadedFrame loaded = prefetcher.Get(frame);
+    const std::vector<cv::Mat>& images = loaded.images;
+    const std::string& problems = loaded.problems;
     ms.load += MsSince(frame_start);
     if (!problems.empty() && !options.quiet) std::fprintf(stderr, "vo: frame %d: %s\n", frame, problems.c_str());
     const FrontendFrame features = frontend.Process(images);
@@ -592,7 +643,9 @@ VoSummary RunVo(const VoOptions& options) {
                   {"ba_max_iterations", backend_options.ba.max_iterations},
                   {"ba_online_extrinsics", backend_options.ba.optimize_extrinsics},
                   {"ba_extrinsic_prior_deg", backend_options.ba.extrinsic_prior_deg},
-                  {"window_keyframes", backend_options.window_keyframes}};
+                  {"window_keyframes", backend_options.window_keyframes},
+                  {"keyframe_distance_m", backend_options.keyframes.min_translation_m},
+                  {"keyframe_max_frame_gap", backend_options.keyframes.max_frame_gap}};
   j["summary"] = {{"frames", summary.frames},
                   {"frames_ok", summary.frames_ok},
                   {"frames_init", summary.frames_init},

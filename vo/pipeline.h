@@ -49,12 +49,15 @@ struct VoOptions {
   // loosens the inter-view filters for the start-up calibration (extrinsic_bootstrap.h); 0 = none.
   double online_prior_deg = 15.0;
   int online_bootstrap_rounds = 6;
+  // Back-end settings exposed on the command line; <= 0 keeps BackendOptions' default.
+  double ransac_tau_deg = 0.0;           // RANSAC inlier threshold (MultiViewRansacOptions::tau_rad)
+  double keyframe_distance_m = 0.0;      // KeyframeOptions::min_translation_m
 };
 
 // Mean wall time per processed frame, by stage, in milliseconds.
 struct VoStageTimes {
   double warp = 0, detect = 0, track = 0, match = 0;  // front-end (FrontendFrame::ms_*)
-  double load = 0;                                      // image reading
+  double load = 0;  // waiting for the images (read on a second thread while the previous frame runs)
   double ransac = 0, refine = 0, triangulate = 0, ba = 0, backend_total = 0;
   double ransac_us_per_hypothesis = 0;
   double total = 0;                                     // whole frame incl. loading
