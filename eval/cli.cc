@@ -85,6 +85,11 @@ void AddSuiteCommand(CLI::App& root) {
       "Resumes: complete runs and datasets are not redone.");
   cmd->add_option("--presets", *presets, "Comma-separated presets (default: all: " + preset_names + ")");
   cmd->add_flag("--quick", options->quick, "Use the presets' quick forms (fewer frames, smaller images)");
+  cmd->add_option("--frames", options->frames,
+                  "Only the first N frames of each preset: rendered, run and scored on that span (0: all; e.g. a "
+                  "full-size check of the 3000-frame static_urban in minutes)")
+      ->default_val(0)
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--seeds", options->noise_sets, "Number K of extrinsic noise sets (noise_set 0..K-1)")
       ->default_val(1)
       ->check(CLI::Range(1, 1000));

@@ -238,8 +238,20 @@ double GtPathLength(const Trajectory& gt) {
 
 }  // namespace
 
-RunEvaluation EvaluateRun(const Trajectory& gt, const std::vector<Rigid3>& gt_cam_from_rig, const RunData& run,
+RunEvaluation EvaluateRun(const Trajectory& full_gt, const std::vector<Rigid3>& gt_cam_from_rig, const RunData& run,
                           const std::string& label, const EvalOptions& options) {
+  // A run over frames [a, b) of the dataset (run.json "frames") is scored against that span of the
+  // ground truth: its path length, missing frames and drift segments.
+  size_t span_begin = 0, span_end = full_gt.size();
+  if (run.info.contains("frames") && run.info["frames"].is_array() && run.info["frames"].size() == 2 &&
+      run.info["frames"][0].is_number_integer() && run.info["frames"][1].is_number_integer()) {
+    const long a = run.info["frames"][0].get<long>(), b = run.info["frames"][1].get<long>();
+    if (a >= 0 && a < b && b <= static_cast<long>(full_gt.size())) {
+      span_begin = static_cast<size_t>(a);
+      span_end = static_cast<size_t>(b);
+    }
+  }
+  const Trajectory gt(full_gt.begin() + static_cast<long>(span_begin), full_gt.begin() + static_cast<long>(span_end));
   RunEvaluation out;
   RunMetrics& m = out.metrics;
   m.label = label;
@@ -274,7 +286,7 @@ RunEvaluation EvaluateRun(const Trajectory& gt, const std::vector<Rigid3>& gt_ca
     }
     for (const auto& [i, j] : association.pairs) {
       FrameError fe;
-      fe.gt_index = i;
+      fe.gt_index = static_cast<int>(i + span_begin);  // index in the full ground truth
       fe.estimate_index = j;
       fe.timestamp = gt[i].timestamp;
       fe.gt_position = gt[i].world_from_rig.translation;

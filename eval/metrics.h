@@ -97,12 +97,12 @@ struct RunMetrics {
   std::string label;
   std::string mode;           // gt | noisy | online
   int noise_set = -1;         // -1 for GTExt or when run.json does not say
-  int gt_frames = 0;
+  int gt_frames = 0;          // of the span the run covers (run.json "frames"), else all
   int estimated_frames = 0;
   int associated_frames = 0;
   int missing_frames = 0;     // gt frames without an estimate
   int lost_frames = 0;        // frames.csv status "lost"
-  double path_length_m = 0.0;  // gt path length over the whole gt trajectory
+  double path_length_m = 0.0;  // gt path length over the span the run covers
   std::optional<double> rmse_se3_m;     // empty when alignment is impossible (too few/degenerate)
   std::optional<double> rmse_origin_m;
   std::optional<double> relative_rmse_pct;  // 100 * rmse_se3 / path length

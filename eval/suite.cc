@@ -36,12 +36,14 @@ std::string FmtStat(const std::optional<Stat>& stat, const char* format, double 
   return s;
 }
 
-bool RunComplete(const std::string& run_dir) {
+// `frame_end`: the run must cover frames [0, frame_end).
+bool RunComplete(const std::string& run_dir, int frame_end) {
   std::error_code ec;
   if (!fs::is_regular_file(RunInfoPath(run_dir), ec)) return false;
   try {
     const nlohmann::json info = ReadJsonFile(RunInfoPath(run_dir));
     return info.is_object() && info.contains("mode") && info.contains("dataset") && info.contains("seed") &&
+           info.contains("frames") && info["frames"] == nlohmann::json::array({0, frame_end}) &&
            fs::is_regular_file(RunTrajectoryPath(run_dir), ec) && fs::is_regular_file(RunFramesPath(run_dir), ec) &&
            fs::is_regular_file(RunExtrinsicsPath(run_dir), ec);
   } catch (const std::exception&) {
@@ -49,14 +51,16 @@ bool RunComplete(const std::string& run_dir) {
   }
 }
 
-bool DatasetComplete(const std::string& dataset_dir) {
+// Complete: the first `max_frames` frames (all when <= 0) have every camera's image.
+bool DatasetComplete(const std::string& dataset_dir, int max_frames) {
   std::error_code ec;
   if (!fs::is_regular_file(DatasetJsonPath(dataset_dir), ec) || !fs::is_regular_file(GroundTruthPath(dataset_dir), ec)) {
     return false;
   }
   try {
     const DatasetInfo info = ReadDatasetInfo(dataset_dir);
-    for (int f = 0; f < info.frame_count; ++f) {
+    const int frames = max_frames > 0 ? std::min(max_frames, info.frame_count) : info.frame_count;
+    for (int f = 0; f < frames; ++f) {
       for (const RigCamera& cam : info.rig.cameras) {
         if (!fs::is_regular_file(ImagePath(dataset_dir, cam.name, f), ec)) return false;
       }
@@ -73,6 +77,7 @@ struct VoJob {
   std::string run_dir;
   ExtrinsicsMode mode;
   int noise_set;
+  int frame_end;  // the run covers frames [0, frame_end)
 };
 
 }  // namespace
@@ -193,7 +198,10 @@ std::string SuiteTableMarkdown(const std::vector<PresetSummary>& presets, bool q
     }
     const std::string name = (paper ? paper->sequence + " (`" + p.preset + "`)" : "`" + p.preset + "`") +
                              (quick ? " quick" : "");
-    md += "| " + name + " | " + std::to_string(p.frames) + " | " + Fmt("%.1f", p.path_length_m) + " | " +
+    const std::string frames = std::to_string(p.frames) + (p.dataset_frames > p.frames
+                                                               ? " of " + std::to_string(p.dataset_frames)
+                                                               : std::string());
+    md += "| " + name + " | " + frames + " | " + Fmt("%.1f", p.path_length_m) + " | " +
           FmtStat(stat("noisy", "rmse_se3_m"), "%.3f") + " | " + FmtStat(stat("online", "rmse_se3_m"), "%.3f") + " | " +
           FmtStat(stat("gt", "rmse_se3_m"), "%.3f") + " | " + mean("noisy", "relative_rmse_pct", "%.2f") + " / " +
           mean("online", "relative_rmse_pct", "%.3f") + " / " + mean("gt", "relative_rmse_pct", "%.3f") + " | " +
@@ -216,6 +224,7 @@ nlohmann::json SuiteToJson(const std::vector<PresetSummary>& presets, const Suit
   j["generator"] = "rovo suite";
   j["generator_version"] = ROVO_VERSION;
   j["quick"] = options.quick;
+  j["frames"] = options.frames;
   j["noise_sets"] = options.noise_sets;
   j["scene_seed"] = options.scene_seed;
   j["vo_seed"] = options.vo_seed;
@@ -224,6 +233,7 @@ nlohmann::json SuiteToJson(const std::vector<PresetSummary>& presets, const Suit
     nlohmann::json pj;
     pj["dataset"] = p.dataset_dir;
     pj["frames"] = p.frames;
+    pj["dataset_frames"] = p.dataset_frames;
     pj["path_length_m"] = p.path_length_m;
     for (const ModeSummary& m : p.modes) {
       nlohmann::json mj;
@@ -258,7 +268,7 @@ std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
                                                    std::to_string(options.scene_seed)))
                                 .string();
     dataset_dirs.push_back(dir);
-    if (DatasetComplete(dir)) {
+    if (DatasetComplete(dir, options.frames)) {
       if (!options.quiet) std::fprintf(stderr, "rovo suite: dataset %s is complete, not rendering\n", dir.c_str());
       continue;
     }
@@ -269,6 +279,10 @@ std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
     render.quick = options.quick;
     render.out_dir = dir;
     render.seed = options.scene_seed;
+    if (options.frames > 0) {
+      const ScenePreset& p = FindScenePreset(preset);
+      render.frame_end = std::min(options.frames, options.quick ? p.quick_frames : p.frames);
+    }
     render.threads = cores;
     render.depth = false;
     render.quiet = options.quiet;
@@ -277,25 +291,28 @@ std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
 
   // 2. VO runs.
   std::vector<VoJob> jobs;
+  std::vector<int> frame_ends;  // per preset: runs cover frames [0, end)
   for (size_t i = 0; i < presets.size(); ++i) {
     const DatasetInfo info = ReadDatasetInfo(dataset_dirs[i]);
+    frame_ends.push_back(options.frames > 0 ? std::min(options.frames, info.frame_count) : info.frame_count);
     if (static_cast<int>(info.perturbed.size()) < options.noise_sets) {
       throw std::runtime_error(DatasetJsonPath(dataset_dirs[i]) + ": field \"perturbed\" holds " +
                                std::to_string(info.perturbed.size()) + " noise sets, --seeds asks for " +
                                std::to_string(options.noise_sets));
     }
     const fs::path runs = fs::path(options.out_dir) / "runs" / presets[i];
-    jobs.push_back({presets[i], dataset_dirs[i], (runs / "gt").string(), ExtrinsicsMode::kGroundTruth, 0});
+    const int end = frame_ends[i];
+    jobs.push_back({presets[i], dataset_dirs[i], (runs / "gt").string(), ExtrinsicsMode::kGroundTruth, 0, end});
     for (int k = 0; k < options.noise_sets; ++k) {
       jobs.push_back({presets[i], dataset_dirs[i], (runs / ("noisy_" + std::to_string(k))).string(),
-                      ExtrinsicsMode::kNoisy, k});
+                      ExtrinsicsMode::kNoisy, k, end});
       jobs.push_back({presets[i], dataset_dirs[i], (runs / ("online_" + std::to_string(k))).string(),
-                      ExtrinsicsMode::kOnline, k});
+                      ExtrinsicsMode::kOnline, k, end});
     }
   }
   std::vector<const VoJob*> todo;
   for (const VoJob& job : jobs) {
-    if (RunComplete(job.run_dir)) {
+    if (RunComplete(job.run_dir, job.frame_end)) {
       if (!options.quiet) std::fprintf(stderr, "rovo suite: run %s is complete, skipping\n", job.run_dir.c_str());
     } else {
       todo.push_back(&job);
@@ -326,6 +343,7 @@ std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
           vo.seed = options.vo_seed;
           vo.threads = threads_per_job;
           vo.quiet = options.quiet || parallel > 1;
+          vo.frame_end = job.frame_end;
           RunVo(vo);
         } catch (...) {
           std::lock_guard<std::mutex> lock(error_mutex);
@@ -362,7 +380,8 @@ std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
     PresetSummary summary;
     summary.preset = presets[i];
     summary.dataset_dir = fs::absolute(dataset_dirs[i]).lexically_normal().string();
-    summary.frames = ReadDatasetInfo(dataset_dirs[i]).frame_count;
+    summary.frames = frame_ends[i];
+    summary.dataset_frames = ReadDatasetInfo(dataset_dirs[i]).frame_count;
     std::vector<RunMetrics> metrics;
     for (size_t r = 0; r < evaluations.size(); ++r) {
       RunMetrics m = evaluations[r].metrics;

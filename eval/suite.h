@@ -9,8 +9,8 @@
 //   <out>/suite.json                                   aggregated metrics per preset and mode
 //   <out>/table.md, <out>/report.html                  Table I layout with the paper's figures
 // Datasets go to <data>/<preset>[_quick]_s<seed>/ (default <data> = <out>/data).
-// Resume: a run folder whose run.json is complete is not run again; a dataset whose frames all
-// exist is not rendered again.
+// Resume: a run folder whose run.json is complete (and covers the frames asked for) is not run
+// again; a dataset whose frames (all, or the first --frames) exist is not rendered again.
 
 #include "eval/metrics.h"
 
@@ -26,6 +26,7 @@ namespace rovo {
 struct SuiteOptions {
   std::vector<std::string> presets;  // empty = all presets (ScenePresets order)
   bool quick = false;                // the presets' quick forms
+  int frames = 0;                    // > 0: only the first N frames of each preset (rendered and run)
   int noise_sets = 1;                // K: NoisyExt/OnlineExt runs per preset (noise_set 0..K-1)
   int jobs = 1;                      // VO runs in parallel; each gets cores / jobs threads
   int threads = 0;                   // cores to use; 0 = all
@@ -58,8 +59,9 @@ struct ModeSummary {
 struct PresetSummary {
   std::string preset;
   std::string dataset_dir;
-  int frames = 0;
-  double path_length_m = 0.0;
+  int frames = 0;                 // frames the runs cover (the first N of the dataset)
+  int dataset_frames = 0;         // frames of the preset's trajectory; > frames for a --frames suite
+  double path_length_m = 0.0;     // ground-truth length of the frames the runs cover
   std::vector<ModeSummary> modes;  // gt, noisy, online (those that ran)
   const ModeSummary* Find(const std::string& mode) const;
 };

@@ -306,5 +306,29 @@ TEST(EvaluateRun, SummarisesFramesAndExtrinsics) {
   EXPECT_EQ(e.frame_errors.size(), 19u);
 }
 
+TEST(EvaluateRun, PartialRunIsScoredOnItsFrameSpan) {
+  // Ground truth of 30 frames, 1 m apart; a run over frames 10..19 (run.json "frames": [10, 20]).
+  std::vector<Eigen::Vector3d> positions;
+  for (int i = 0; i < 30; ++i) positions.emplace_back(i, 0.0, 0.0);
+  const Trajectory gt = FromPositions(positions);
+  RunData run;
+  run.info = {{"mode", "gt"}, {"dataset", "x"}, {"seed", 0}, {"frames", {10, 20}}};
+  for (int i = 10; i < 20; ++i) {
+    run.trajectory.push_back(gt[static_cast<size_t>(i)]);
+    run.trajectory.back().world_from_rig.translation.y() += (i % 2 ? 0.1 : -0.1);
+  }
+  const RunEvaluation e = EvaluateRun(gt, {Rigid3()}, run, "partial");
+  EXPECT_EQ(e.metrics.gt_frames, 10);
+  EXPECT_EQ(e.metrics.missing_frames, 0);
+  EXPECT_NEAR(e.metrics.path_length_m, 9.0, 1e-12);  // not the whole 29 m
+  ASSERT_TRUE(e.metrics.relative_rmse_pct.has_value());
+  EXPECT_NEAR(*e.metrics.relative_rmse_pct, 100.0 * *e.metrics.rmse_se3_m / 9.0, 1e-12);
+  ASSERT_EQ(e.frame_errors.size(), 10u);
+  EXPECT_EQ(e.frame_errors.front().gt_index, 10);  // indices into the full ground truth
+  // Without "frames" the whole ground truth counts.
+  run.info.erase("frames");
+  EXPECT_EQ(EvaluateRun(gt, {Rigid3()}, run, "whole").metrics.missing_frames, 20);
+}
+
 }  // namespace
 }  // namespace rovo
