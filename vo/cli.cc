@@ -49,11 +49,14 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
       ->capture_default_str();
   cmd->add_option("--tau", args->options.ransac_tau_deg,
                   "RANSAC inlier threshold in degrees (angle between observed and predicted bearing; 0: the default, "
-                  "recorded in run.json)")
+                  "2 pixels at the image centre, i.e. 0.29 deg for the full-size rovo4 lenses; recorded in run.json)")
       ->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--keyframe-distance", args->options.keyframe_distance_m,
                   "Rig travel in metres that makes a keyframe (and a local BA); 0: the default, recorded in run.json")
       ->check(CLI::Range(0.0, 100.0));
+  cmd->add_flag("--sync-ba", [args](int64_t) { args->options.async_ba = false; },
+                "Run each keyframe BA before the next frame's front-end instead of beside it (same GTExt/NoisyExt "
+                "result, slower; OnlineExt's front-end then sees the calibration one frame earlier)");
   cmd->add_flag("--quiet", args->options.quiet, "No progress output");
 }
 
@@ -99,7 +102,8 @@ void AddVoCommands(CliGroups& groups) {
     const std::pair<const char*, double> rows[] = {
         {"load images (wait)", t.load},        {"front-end: warp", t.warp},   {"front-end: detect", t.detect},
         {"front-end: track", t.track},  {"front-end: match", t.match}, {"back-end: RANSAC", t.ransac},
-        {"back-end: refine", t.refine}, {"back-end: triangulate", t.triangulate}, {"back-end: local BA", t.ba},
+        {"back-end: refine", t.refine}, {"back-end: triangulate", t.triangulate}, {"back-end: local BA (solve)", t.ba},
+        {"back-end: wait for async BA", t.ba_wait},
         {"back-end: total", t.backend_total}, {"whole frame", t.total}};
     for (const auto& [name, value] : rows) std::printf("| %-25s | %8.2f |\n", name, value);
     std::printf("RANSAC: %.2f us per hypothesis\n", t.ransac_us_per_hypothesis);

@@ -163,12 +163,27 @@ int VoBackend::TriangulateNew(int frame) {
   return created;
 }
 
-double VoBackend::RunLocalBa(int frame) {
-  const auto start = Clock::now();
+struct VoBackend::PendingBa {
+  int frame = 0;
   LocalBaProblem problem;
-  std::map<int, int> pose_index;
+  LocalBaOptions options;
+  std::map<int, int> pose_index;  // keyframe -> index in problem.rig_from_world
+  std::vector<uint64_t> ids;      // landmark of each problem point
+  LocalBaReport report;
+  double ms_solve = 0;
+  std::future<void> solve;        // async_ba: the running solve
+};
+
+VoBackend::~VoBackend() {
+  if (pending_ba_ && pending_ba_->solve.valid()) pending_ba_->solve.wait();
+}
+
+std::unique_ptr<VoBackend::PendingBa> VoBackend::PrepareLocalBa(int frame) const {
+  auto pending = std::make_unique<PendingBa>();
+  pending->frame = frame;
+  LocalBaProblem& problem = pending->problem;
   for (int kf : keyframes_) {
-    pose_index[kf] = static_cast<int>(problem.rig_from_world.size());
+    pending->pose_index[kf] = static_cast<int>(problem.rig_from_world.size());
     problem.rig_from_world.push_back(rig_from_world_.at(kf));
   }
   problem.cam_from_rig = cam_from_rig_;
@@ -178,37 +193,48 @@ double VoBackend::RunLocalBa(int frame) {
   for (const auto& [id, lm] : map_.landmarks()) {
     if (!lm.has_point) continue;
     int n = 0;
-    for (const Observation& o : lm.observations) n += pose_index.count(o.frame) ? 1 : 0;
+    for (const Observation& o : lm.observations) n += pending->pose_index.count(o.frame) ? 1 : 0;
     if (n >= 2) candidates.push_back({-n, id});
   }
   std::sort(candidates.begin(), candidates.end());
   if (static_cast<int>(candidates.size()) > options_.max_ba_landmarks) candidates.resize(options_.max_ba_landmarks);
-  std::vector<uint64_t> ids;
   for (const auto& [neg_n, id] : candidates) {
     const Landmark& lm = *map_.Find(id);
     const int point_index = static_cast<int>(problem.points_in_world.size());
     problem.points_in_world.push_back(lm.point_in_world);
     problem.point_num_cameras.push_back(lm.NumCameras());
-    ids.push_back(id);
+    pending->ids.push_back(id);
     for (const Observation& o : lm.observations) {
-      auto it = pose_index.find(o.frame);
-      if (it == pose_index.end()) continue;
+      auto it = pending->pose_index.find(o.frame);
+      if (it == pending->pose_index.end()) continue;
       problem.observations.push_back({it->second, o.camera, point_index, o.bearing_in_cam});
     }
   }
-  if (problem.observations.empty()) return MsSince(start);
-  LocalBaOptions ba = options_.ba;
-  if (keyframes_.size() < 3) ba.optimize_extrinsics = false;  // too little motion to calibrate
-  const LocalBaReport report = SolveLocalBa(problem, ba);
-  if (!report.usable) return MsSince(start);
-  for (const auto& [kf, index] : pose_index) rig_from_world_[kf] = problem.rig_from_world[index];
-  if (ba.optimize_extrinsics) cam_from_rig_ = problem.cam_from_rig;
+  pending->options = options_.ba;
+  if (keyframes_.size() < 3) pending->options.optimize_extrinsics = false;  // too little motion to calibrate
+  return pending;
+}
+
+namespace {
+void SolvePending(LocalBaProblem* problem, const LocalBaOptions& options, LocalBaReport* report, double* ms) {
+  const auto start = Clock::now();
+  if (!problem->observations.empty()) *report = SolveLocalBa(*problem, options);
+  *ms = MsSince(start);
+}
+}  // namespace
+
+void VoBackend::ApplyLocalBa(PendingBa& pending) {
+  const int frame = pending.frame;
+  const LocalBaProblem& problem = pending.problem;
+  if (!pending.report.usable) return;
+  for (const auto& [kf, index] : pending.pose_index) rig_from_world_[kf] = problem.rig_from_world[index];
+  if (pending.options.optimize_extrinsics) cam_from_rig_ = problem.cam_from_rig;
   const double max_error_rad =
       (options_.ba.optimize_extrinsics ? std::max(options_.max_landmark_error_deg, options_.online_max_error_deg)
                                        : options_.max_landmark_error_deg) *
       M_PI / 180.0;
-  for (size_t k = 0; k < ids.size(); ++k) {
-    Landmark& lm = *map_.Find(ids[k]);
+  for (size_t k = 0; k < pending.ids.size(); ++k) {
+    Landmark& lm = *map_.Find(pending.ids[k]);
     lm.point_in_world = problem.points_in_world[k];
     // Drop observations that BA could not explain; a point left with a bad current observation is
     // re-triangulated later.
@@ -223,11 +249,35 @@ double VoBackend::RunLocalBa(int frame) {
               obs.end());
     if (lm.NumCamerasAtFrame(frame) == 0 && lm.last_seen_frame == frame) lm.has_point = false;
   }
-  return MsSince(start);
+}
+
+// Culling: landmarks not seen recently; observations and poses older than the window.
+void VoBackend::Cull(int frame) {
+  const int oldest = std::min(keyframes_.front(), previous_good_frame_ < 0 ? frame : previous_good_frame_);
+  map_.Cull(frame - options_.max_unseen_frames, keyframes_.front());
+  for (auto it = rig_from_world_.begin(); it != rig_from_world_.end();) {
+    it = it->first < oldest ? rig_from_world_.erase(it) : std::next(it);
+  }
+}
+
+std::optional<VoBackend::BaUpdate> VoBackend::FinishPendingBa() {
+  if (!pending_ba_) return std::nullopt;
+  const auto start = Clock::now();
+  if (pending_ba_->solve.valid()) pending_ba_->solve.get();  // rethrows a solver exception
+  BaUpdate update;
+  update.ms_wait = MsSince(start);
+  update.frame = pending_ba_->frame;
+  update.ms_solve = pending_ba_->ms_solve;
+  ApplyLocalBa(*pending_ba_);
+  Cull(pending_ba_->frame);
+  update.world_from_rig = rig_from_world_.at(pending_ba_->frame).Inverse();
+  pending_ba_.reset();
+  return update;
 }
 
 BackendFrameResult VoBackend::ProcessFrame(int frame, const FrontendFrame& frontend) {
   BackendFrameResult result;
+  if (auto update = FinishPendingBa()) result.ms_ba_wait = update->ms_wait;
   FrameRecord& rec = result.record;
   rec.frame = frame;
   for (const auto& [from, into] : frontend.merged_ids) map_.Merge(from, into);
@@ -370,17 +420,28 @@ BackendFrameResult VoBackend::ProcessFrame(int frame, const FrontendFrame& front
     keyframes_.push_back(frame);
     while (static_cast<int>(keyframes_.size()) > options_.window_keyframes) keyframes_.erase(keyframes_.begin());
     if (options_.local_ba && keyframes_.size() >= 2) {
-      result.ms_ba = RunLocalBa(frame);
-      rig_from_world = rig_from_world_.at(frame);
+      pending_ba_ = PrepareLocalBa(frame);
+      PendingBa* pending = pending_ba_.get();
+      if (options_.async_ba) {
+        // The map and poses stay untouched until FinishPendingBa (the solve owns only `pending`).
+        pending->solve = std::async(std::launch::async, [pending] {
+          SolvePending(&pending->problem, pending->options, &pending->report, &pending->ms_solve);
+        });
+        result.world_from_rig = rig_from_world.Inverse();  // before BA: see FinishPendingBa
+        result.num_landmarks = static_cast<int>(map_.NumWithPoint());
+        result.ba_pending = true;
+        return result;
+      }
+      SolvePending(&pending->problem, pending->options, &pending->report, &pending->ms_solve);
+      result.ms_ba = pending->ms_solve;
+      FinishPendingBa();
+      result.world_from_rig = rig_from_world_.at(frame).Inverse();
+      result.num_landmarks = static_cast<int>(map_.NumWithPoint());
+      return result;
     }
   }
 
-  // Culling: landmarks not seen recently; observations and poses older than the window.
-  const int oldest = std::min(keyframes_.front(), previous_good_frame_ < 0 ? frame : previous_good_frame_);
-  map_.Cull(frame - options_.max_unseen_frames, keyframes_.front());
-  for (auto it = rig_from_world_.begin(); it != rig_from_world_.end();) {
-    it = it->first < oldest ? rig_from_world_.erase(it) : std::next(it);
-  }
+  Cull(frame);
   result.world_from_rig = rig_from_world.Inverse();
   result.num_landmarks = static_cast<int>(map_.NumWithPoint());
   return result;
@@ -493,6 +554,24 @@ std::vector<Rigid3> BootstrapExtrinsics(const VoOptions& options, const Rig& rig
   return cam_from_rig;
 }
 
+// Mean over the cameras of the angle between the optical axis and the bearing one pixel to its right:
+// the angular size of a pixel at the image centre.
+double CentralPixelAngleRad(const Rig& rig) {
+  double sum = 0.0;
+  int n = 0;
+  for (const RigCamera& cam : rig.cameras) {
+    const Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+    const std::optional<Eigen::Vector2d> centre = cam.camera.Project(axis);
+    if (!centre) continue;
+    const std::optional<Eigen::Vector3d> right = cam.camera.Unproject(*centre + Eigen::Vector2d(1.0, 0.0));
+    if (!right) continue;
+    sum += AngleBetween(axis, *right);
+    ++n;
+  }
+  if (n == 0) throw std::invalid_argument("vo: no camera of the rig projects its optical axis (dataset.json rig.cameras)");
+  return sum / n;
+}
+
 nlohmann::json PoseJson(const Rigid3& x) {
   return {{"translation", {x.translation.x(), x.translation.y(), x.translation.z()}},
           {"rotation_xyzw", {x.rotation.x(), x.rotation.y(), x.rotation.z(), x.rotation.w()}}};
@@ -547,7 +626,10 @@ VoSummary RunVo(const VoOptions& options) {
   backend_options.ransac.sampling = ViewSamplingFromName(options.sampling);
   backend_options.ransac.views = RansacViewsFromName(options.ransac);
   backend_options.ba.optimize_extrinsics = options.mode == ExtrinsicsMode::kOnline;
-  if (options.ransac_tau_deg > 0.0) backend_options.ransac.tau_rad = options.ransac_tau_deg * M_PI / 180.0;
+  backend_options.async_ba = options.async_ba;
+  backend_options.ransac.tau_rad = options.ransac_tau_deg > 0.0
+                                       ? options.ransac_tau_deg * M_PI / 180.0
+                                       : options.ransac_tau_px * CentralPixelAngleRad(info.rig);
   if (options.keyframe_distance_m > 0.0) backend_options.keyframes.min_translation_m = options.keyframe_distance_m;
   // Online: each keyframe BA may move an extrinsic by about this much (random-walk prior, local_ba.h):
   // measured on cloudy_urban quick, it halves the wander of the estimate between windows.
@@ -565,6 +647,17 @@ VoSummary RunVo(const VoOptions& options) {
   double ok_ratio_sum = 0.0, ok_error_sum = 0.0;
   Progress progress("vo " + ExtrinsicsModeName(options.mode), end - begin, "frames", options.quiet);
   ImagePrefetcher prefetcher(options.dataset_dir, info.rig, begin, end);
+  // Async BA: the records of a keyframe get its BA-refined pose and extrinsics when the BA is joined.
+  auto apply_ba_update = [&](const VoBackend::BaUpdate& update) {
+    ms.ba += update.ms_solve;
+    ms.ba_wait += update.ms_wait;
+    for (size_t i = run.frames.size(); i-- > 0;) {
+      if (run.frames[i].frame != update.frame) continue;
+      run.trajectory[i].world_from_rig = update.world_from_rig;
+      for (int j = 0; j < num_cams; ++j) run.extrinsics[i * num_cams + j].cam_from_rig = backend.cam_from_rig()[j];
+      break;
+    }
+  };
   for (int frame = begin; frame < end; ++frame) {
     const auto frame_start = Clock::now();
     const LoadedFrame loaded = prefetcher.Get(frame);
@@ -572,8 +665,9 @@ VoSummary RunVo(const VoOptions& options) {
     const std::string& problems = loaded.problems;
     ms.load += MsSince(frame_start);
     if (!problems.empty() && !options.quiet) std::fprintf(stderr, "vo: frame %d: %s\n", frame, problems.c_str());
-    const FrontendFrame features = frontend.Process(images);
+    const FrontendFrame features = frontend.Process(images);  // beside the previous keyframe's BA
     const auto backend_start = Clock::now();
+    if (auto update = backend.FinishPendingBa()) apply_ba_update(*update);
     BackendFrameResult result = backend.ProcessFrame(frame, features);
     ms.backend_total += MsSince(backend_start);
     if (options.mode == ExtrinsicsMode::kOnline) frontend.SetExtrinsics(backend.cam_from_rig());
@@ -584,7 +678,7 @@ VoSummary RunVo(const VoOptions& options) {
     ms.ransac += result.ms_ransac;
     ms.refine += result.ms_refine;
     ms.triangulate += result.ms_triangulate;
-    ms.ba += result.ms_ba;
+    ms.ba += result.ms_ba;  // synchronous BA; async BA is counted in apply_ba_update
     total_hypotheses += result.ransac_hypotheses;
 
     FrameRecord rec = result.record;
@@ -607,10 +701,11 @@ VoSummary RunVo(const VoOptions& options) {
     for (int j = 0; j < num_cams; ++j) run.extrinsics.push_back({frame, rec.timestamp, j, backend.cam_from_rig()[j]});
     progress.Add();
   }
+  if (auto update = backend.FinishPendingBa()) apply_ba_update(*update);
   progress.Finish();
   const double n = std::max(1, summary.frames);
   for (double* v : {&ms.warp, &ms.detect, &ms.track, &ms.match, &ms.load, &ms.ransac, &ms.refine, &ms.triangulate,
-                    &ms.ba, &ms.backend_total, &ms.total}) {
+                    &ms.ba, &ms.ba_wait, &ms.backend_total, &ms.total}) {
     *v /= n;
   }
   ms.ransac_us_per_hypothesis = total_hypotheses > 0 ? ms.ransac * n * 1000.0 / total_hypotheses : 0.0;
@@ -644,6 +739,7 @@ VoSummary RunVo(const VoOptions& options) {
                   {"ba_online_extrinsics", backend_options.ba.optimize_extrinsics},
                   {"ba_extrinsic_prior_deg", backend_options.ba.extrinsic_prior_deg},
                   {"window_keyframes", backend_options.window_keyframes},
+                  {"async_ba", backend_options.async_ba},
                   {"keyframe_distance_m", backend_options.keyframes.min_translation_m},
                   {"keyframe_max_frame_gap", backend_options.keyframes.max_frame_gap}};
   j["summary"] = {{"frames", summary.frames},
