@@ -61,6 +61,7 @@ struct VoOptions {
   double ransac_tau_px = 2.0;
   double keyframe_distance_m = 0.0;      // KeyframeOptions::min_translation_m
   bool async_ba = true;                  // BackendOptions::async_ba (same trajectory in GTExt/NoisyExt)
+  bool preload_images = false;           // decode all frames before the loop (timing without PNG decoding)
 };
 
 // Mean wall time per processed frame, by stage, in milliseconds.
