@@ -73,6 +73,7 @@ MipTexture::MipTexture(const Texture& texture) {
     l.fwidth = static_cast<float>(l.width);
     l.fheight = static_cast<float>(l.height);
   }
+  last_level_ = static_cast<int>(levels_.size()) - 1;
 }
 
 Eigen::Vector3f MipTexture::Texel(int level, int x, int y) const {
@@ -190,23 +191,18 @@ struct MipTexture::Footprint4 {
 };
 
 void MipTexture::Address4(const Level* const level[4], __m128 u01, __m128 v01, Footprint4* fp) {
-  alignas(16) int32_t width[4], height[4], blocks_x[4];
-  alignas(16) float fwidth[4], fheight[4];
-  for (int k = 0; k < 4; ++k) {
-    width[k] = level[k]->width;
-    height[k] = level[k]->height;
-    blocks_x[k] = level[k]->blocks_x;
-    fwidth[k] = level[k]->fwidth;
-    fheight[k] = level[k]->fheight;
-    fp->texels[k] = level[k]->texels.data();
-  }
-  const __m128i w = _mm_load_si128(reinterpret_cast<const __m128i*>(width));
-  const __m128i h = _mm_load_si128(reinterpret_cast<const __m128i*>(height));
+  // Transpose the lanes' (fwidth, fheight, width, height) into one register per field.
+  __m128 fw = _mm_loadu_ps(&level[0]->fwidth), fh = _mm_loadu_ps(&level[1]->fwidth);
+  __m128 wf = _mm_loadu_ps(&level[2]->fwidth), hf = _mm_loadu_ps(&level[3]->fwidth);
+  _MM_TRANSPOSE4_PS(fw, fh, wf, hf);
+  const __m128i w = _mm_castps_si128(wf), h = _mm_castps_si128(hf);
+  const __m128i bx = _mm_setr_epi32(level[0]->blocks_x, level[1]->blocks_x, level[2]->blocks_x, level[3]->blocks_x);
+  for (int k = 0; k < 4; ++k) fp->texels[k] = level[k]->texels.data();
   const __m128i one = _mm_set1_epi32(1), three = _mm_set1_epi32(3), zero = _mm_setzero_si128();
   const __m128 half = _mm_set1_ps(0.5f);
   // As SampleWrapped: texel centres at (i + 0.5) / width; wrap the lower neighbour to the last texel.
-  const __m128 fu = _mm_sub_ps(_mm_mul_ps(u01, _mm_load_ps(fwidth)), half);
-  const __m128 fv = _mm_sub_ps(_mm_mul_ps(v01, _mm_load_ps(fheight)), half);
+  const __m128 fu = _mm_sub_ps(_mm_mul_ps(u01, fw), half);
+  const __m128 fv = _mm_sub_ps(_mm_mul_ps(v01, fh), half);
   __m128i xa = FloorInt4(fu), ya = FloorInt4(fv);
   _mm_store_ps(fp->ax, _mm_sub_ps(fu, _mm_cvtepi32_ps(xa)));
   _mm_store_ps(fp->ay, _mm_sub_ps(fv, _mm_cvtepi32_ps(ya)));
@@ -221,7 +217,6 @@ void MipTexture::Address4(const Level* const level[4], __m128 u01, __m128 v01, F
   auto column = [&](__m128i x) {
     return _mm_or_si128(_mm_slli_epi32(_mm_srli_epi32(x, 2), 4), _mm_and_si128(x, three));
   };
-  const __m128i bx = _mm_load_si128(reinterpret_cast<const __m128i*>(blocks_x));
   auto row = [&](__m128i y) {
     return _mm_or_si128(_mm_slli_epi32(MulLo32(_mm_srli_epi32(y, 2), bx), 4), _mm_slli_epi32(_mm_and_si128(y, three), 2));
   };
@@ -267,31 +262,51 @@ void MipTexture::SampleBatch(const MipTexture* const* textures, const float* u, 
   for (int c0 = 0; c0 < n; c0 += kChunk) {
     const int chunk = std::min(kChunk, n - c0);
     for (int g = 0; g * 4 < chunk; ++g) {
-      alignas(16) float lu[4], lv[4];
+      // Four lookups (the tail repeats the last one).
+      const MipTexture* tex[4];
+      __m128 lu, lv, l;
+      if (g * 4 + 4 <= chunk) {
+        const int k = c0 + g * 4;
+        for (int j = 0; j < 4; ++j) tex[j] = textures[k + j];
+        lu = _mm_loadu_ps(u + k);
+        lv = _mm_loadu_ps(v + k);
+        l = _mm_loadu_ps(lod + k);
+      } else {
+        alignas(16) float tu[4], tv[4], tl[4];
+        for (int j = 0; j < 4; ++j) {
+          const int k = c0 + std::min(g * 4 + j, chunk - 1);
+          tex[j] = textures[k];
+          tu[j] = u[k];
+          tv[j] = v[k];
+          tl[j] = lod[k];
+        }
+        lu = _mm_load_ps(tu);
+        lv = _mm_load_ps(tv);
+        l = _mm_load_ps(tl);
+      }
+      // As Sample4: level 0 for lod <= 0 or NaN, the last level from lod >= last on, else the two
+      // levels around lod with weight lod - floor(lod) on the coarser one.
+      const __m128i last =
+          _mm_setr_epi32(tex[0]->last_level_, tex[1]->last_level_, tex[2]->last_level_, tex[3]->last_level_);
+      const __m128 positive = _mm_cmpgt_ps(l, _mm_setzero_ps());
+      const __m128 inside = _mm_and_ps(positive, _mm_cmplt_ps(l, _mm_cvtepi32_ps(last)));
+      const __m128i floor_l = _mm_cvttps_epi32(l);
+      const __m128i l0 = Select(_mm_castps_si128(inside), floor_l, _mm_and_si128(_mm_castps_si128(positive), last));
+      const __m128 a = _mm_and_ps(inside, _mm_sub_ps(l, _mm_cvtepi32_ps(floor_l)));
+      __m128i l1 = _mm_add_epi32(l0, _mm_set1_epi32(1));
+      l1 = Select(_mm_cmpgt_epi32(l1, last), last, l1);
+      _mm_store_ps(blend + g * 4, a);
+      any_blend[g] = _mm_movemask_ps(_mm_cmpgt_ps(a, _mm_setzero_ps())) != 0;
+      alignas(16) int32_t level_index0[4], level_index1[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(level_index0), l0);
+      _mm_store_si128(reinterpret_cast<__m128i*>(level_index1), l1);
       const Level* level0[4];
       const Level* level1[4];
-      any_blend[g] = false;
       for (int j = 0; j < 4; ++j) {
-        const int k = c0 + std::min(g * 4 + j, chunk - 1);  // the tail repeats the last lookup
-        const MipTexture& tex = *textures[k];
-        const int last = tex.NumLevels() - 1;
-        const float l = lod[k];
-        int l0 = last;
-        float a = 0.0f;
-        if (!(l > 0.0f)) {  // also catches NaN
-          l0 = 0;
-        } else if (l < static_cast<float>(last)) {
-          l0 = static_cast<int>(l);
-          a = l - static_cast<float>(l0);
-        }
-        blend[g * 4 + j] = a;
-        any_blend[g] |= a > 0.0f;
-        level0[j] = &tex.levels_[l0];
-        level1[j] = &tex.levels_[std::min(l0 + 1, last)];
-        lu[j] = u[k];
-        lv[j] = v[k];
+        level0[j] = tex[j]->levels_.data() + level_index0[j];
+        level1[j] = tex[j]->levels_.data() + level_index1[j];
       }
-      const __m128 u01 = Wrap01x4(_mm_load_ps(lu)), v01 = Wrap01x4(_mm_load_ps(lv));
+      const __m128 u01 = Wrap01x4(lu), v01 = Wrap01x4(lv);
       const uint32_t* const index0[4] = {fp0[g].index[0], fp0[g].index[1], fp0[g].index[2], fp0[g].index[3]};
       Address4(level0, u01, v01, &fp0[g]);
       for (int j = 0; j < 4; ++j) Prefetch(fp0[g].texels[j], index0, j);

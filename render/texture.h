@@ -54,11 +54,12 @@ class MipTexture {
   __m128 SampleLevel4(float u, float v, int level) const;
 
  private:
-  struct Level {
-    int width = 0;
-    int height = 0;
+  // The first 16 bytes (fwidth, fheight, width, height) load as one SSE register (Address4).
+  struct alignas(16) Level {
     float fwidth = 0.0f, fheight = 0.0f;
-    int blocks_x = 0;              // ceil(width / 4)
+    int32_t width = 0;
+    int32_t height = 0;
+    int32_t blocks_x = 0;          // ceil(width / 4)
     std::vector<uint64_t> texels;  // linear r, g, b, 0 as uint16 (x 1/65535), in 4x4-texel blocks
     // Texel (x, y) lives at Index(x, y): blocks row-major, texels row-major inside a block.
     size_t Index(int x, int y) const { return RowOffset(y) + ColumnOffset(x); }
@@ -82,6 +83,7 @@ class MipTexture {
   __m128 SampleWrapped(float u01, float v01, int level) const;
 
   std::vector<Level> levels_;
+  int last_level_ = 0;  // NumLevels() - 1
   float texels_per_uv_ = 1.0f;
 };
 
