@@ -229,10 +229,11 @@ void MipTexture::Address4(const Level* const level[4], __m128 u01, __m128 v01, F
 
 namespace {
 
-// Requests the cache lines of a footprint's texels (00 and 11 span the 2x2 neighbourhood: a 4x4
-// block is two lines, texel rows 0-1 and 2-3).
+// Requests the cache lines of a footprint's texels 00 and 11 (a 4x4 block is two lines, texel rows
+// 0-1 and 2-3: the two cover the 2x2 neighbourhood unless it straddles blocks both ways).
 inline void Prefetch(const uint64_t* texels, const uint32_t* const index[4], int lane) {
-  for (int c = 0; c < 4; ++c) _mm_prefetch(reinterpret_cast<const char*>(texels + index[c][lane]), _MM_HINT_T0);
+  _mm_prefetch(reinterpret_cast<const char*>(texels + index[0][lane]), _MM_HINT_T0);
+  _mm_prefetch(reinterpret_cast<const char*>(texels + index[3][lane]), _MM_HINT_T0);
 }
 
 }  // namespace

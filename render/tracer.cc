@@ -16,6 +16,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace rovo {
 namespace {
@@ -560,7 +561,8 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
   if (!raw) {
     image->width = width;
     image->height = height;
-    image->rgb.assign(num_pixels * 3, 0);
+    // The resolve writes every pixel (black outside the image circle): no clearing needed.
+    if (image->rgb.size() != num_pixels * 3) image->rgb.assign(num_pixels * 3, 0);
     if (settings.want_depth) image->depth.assign(num_pixels, 0.0f);
     else image->depth.clear();
     if (settings.want_mask) image->mask.assign(num_pixels, 0);
@@ -585,6 +587,9 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
   const __m128 ambient_ground = Load3(light.ambient * d.ground_irradiance);
   const __m128 ambient_delta = Load3(light.ambient * (d.sky_mean - d.ground_irradiance));
   const __m128 sun_radiance = Load3(light.sun_radiance);
+  // exposure / (samples of a pixel): a pixel has at most spp samples.
+  std::vector<float> exposure_over_count(spp + 1, 0.0f);
+  for (int c = 1; c <= spp; ++c) exposure_over_count[c] = light.exposure / static_cast<float>(c);
   std::array<Eigen::Vector2f, 64> offsets{};
   for (int s = 0; s < std::min(spp, 64); ++s) offsets[s] = CameraRays::SampleOffset(s, spp);
 
@@ -800,9 +805,12 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
       uint8_t* out = image->rgb.data() + (static_cast<size_t>(ty0 + ly) * width + tx0) * 3;
       for (int lx = 0; lx < tw; ++lx, out += 3) {
         const int local = ly * kTile + lx;
-        if (tb.count[local] == 0) continue;
+        if (tb.count[local] == 0) {
+          out[0] = out[1] = out[2] = 0;
+          continue;
+        }
         const size_t pi = static_cast<size_t>(ty0 + ly) * width + tx0 + lx;
-        float gain = light.exposure / static_cast<float>(tb.count[local]);
+        float gain = exposure_over_count[tb.count[local]];
         if (settings.vignetting > 0.0f) {
           const Eigen::Vector3f& b = rays.bearing[pi];
           const float theta = std::atan2(std::hypot(b.x(), b.y()), b.z());
@@ -810,8 +818,9 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
           gain *= std::max(0.0f, 1.0f - settings.vignetting * rel * rel);
         }
         const __m128 c = _mm_min_ps(_mm_max_ps(_mm_mul_ps(tb.sum[local], _mm_set1_ps(gain)), _mm_setzero_ps()), one);
-        alignas(16) int32_t index[4];
-        _mm_store_si128(reinterpret_cast<__m128i*>(index), _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(c, scale), half)));
+        const __m128i i4 = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(c, scale), half));
+        const int index[3] = {_mm_cvtsi128_si32(i4), _mm_cvtsi128_si32(_mm_shuffle_epi32(i4, 1)),
+                              _mm_cvtsi128_si32(_mm_shuffle_epi32(i4, 2))};
         for (int k = 0; k < 3; ++k) {
           uint8_t value = srgb[index[k]];
           if (settings.noise_sigma > 0.0f) {
