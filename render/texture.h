@@ -40,10 +40,12 @@ class MipTexture {
   // Linear RGB at (u, v) with trilinear filtering at level of detail `lod` (clamped to the pyramid).
   Eigen::Vector3f Sample(float u, float v, float lod) const;
   // Batch of Sample4 lookups, out[k] = textures[k]->Sample4(u[k], v[k], lod[k]) for k < n, bit for
-  // bit; the address arithmetic of four lookups runs in SSE lanes (each lookup may use its own
-  // texture and level).
+  // bit; with trilinear = false instead SampleLevel4(u[k], v[k], clamp(int(lod[k] + 1/2), 0, last))
+  // (bilinear on the nearest level). Four lookups at a time share SSE registers for the level
+  // choice and the texel addresses (each may use its own texture and level); all addresses of up
+  // to 64 lookups are computed, and their texels prefetched, before the first texel is read.
   static void SampleBatch(const MipTexture* const* textures, const float* u, const float* v, const float* lod, int n,
-                          __m128* out);
+                          __m128* out, bool trilinear = true);
   // Bilinear lookup in one level.
   Eigen::Vector3f SampleLevel(float u, float v, int level) const;
   // Texel of one level (wrapped coordinates), linear RGB.

@@ -723,18 +723,11 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
         tb.tex_lod[k] = texels > 0.0f ? FastLog2(texels) + settings.lod_bias : 0.0f;
       }
 
-      if (settings.trilinear) {
-        MipTexture::SampleBatch(tb.texture, tb.tex_u, tb.tex_v, tb.tex_lod, num_textured, tb.texel);
+      if (num_textured > 0) {
+        MipTexture::SampleBatch(tb.texture, tb.tex_u, tb.tex_v, tb.tex_lod, num_textured, tb.texel, settings.trilinear);
         for (int k = 0; k < num_textured; ++k) {
           const int h = tb.textured_hit[k];
           tb.albedo[h] = _mm_mul_ps(tb.albedo[h], tb.texel[k]);
-        }
-      } else {
-        for (int k = 0; k < num_textured; ++k) {
-          const int h = tb.textured_hit[k];
-          const MipTexture& tex = *tb.texture[k];
-          const int level = std::clamp(static_cast<int>(tb.tex_lod[k] + 0.5f), 0, tex.NumLevels() - 1);
-          tb.albedo[h] = _mm_mul_ps(tb.albedo[h], tex.SampleLevel4(tb.tex_u[k], tb.tex_v[k], level));
         }
       }
 

@@ -123,16 +123,21 @@ TEST(MipTextureTest, BatchLookupsEqualSingleLookupsBitForBit) {
     v[k] = k % 13 == 0 ? specials[(k / 13) % 10] : 6.0f * next() - 3.0f;
     lod[k] = k % 3 == 0 ? lods[(k / 3) % 10] : 6.0f * next() - 1.0f;
   }
-  __m128 out[kN];
-  MipTexture::SampleBatch(tex.data(), u.data(), v.data(), lod.data(), kN, out);
-  for (int k = 0; k < kN; ++k) {
-    alignas(16) float batch[4], single[4];
-    _mm_store_ps(batch, out[k]);
-    _mm_store_ps(single, tex[k]->Sample4(u[k], v[k], lod[k]));
-    for (int c = 0; c < 3; ++c)
-      EXPECT_EQ(std::memcmp(&batch[c], &single[c], sizeof(float)), 0)
-          << "lookup " << k << " channel " << c << ": " << batch[c] << " vs " << single[c] << " (u " << u[k]
-          << ", v " << v[k] << ", lod " << lod[k] << ")";
+  for (const bool trilinear : {true, false}) {
+    __m128 out[kN];
+    MipTexture::SampleBatch(tex.data(), u.data(), v.data(), lod.data(), kN, out, trilinear);
+    for (int k = 0; k < kN; ++k) {
+      alignas(16) float batch[4], single[4];
+      _mm_store_ps(batch, out[k]);
+      const int nearest = std::isnan(lod[k]) || lod[k] + 0.5f < 0.0f
+                              ? 0
+                              : std::min(static_cast<int>(std::min(lod[k] + 0.5f, 1e6f)), tex[k]->NumLevels() - 1);
+      _mm_store_ps(single, trilinear ? tex[k]->Sample4(u[k], v[k], lod[k]) : tex[k]->SampleLevel4(u[k], v[k], nearest));
+      for (int c = 0; c < 3; ++c)
+        EXPECT_EQ(std::memcmp(&batch[c], &single[c], sizeof(float)), 0)
+            << (trilinear ? "trilinear" : "nearest level") << " lookup " << k << " channel " << c << ": " << batch[c]
+            << " vs " << single[c] << " (u " << u[k] << ", v " << v[k] << ", lod " << lod[k] << ")";
+    }
   }
 }
 
