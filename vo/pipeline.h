@@ -54,6 +54,7 @@ struct VoOptions {
 // Mean wall time per processed frame, by stage, in milliseconds.
 struct VoStageTimes {
   double warp = 0, detect = 0, track = 0, match = 0;  // front-end (FrontendFrame::ms_*)
+  double cpu_warp = 0, cpu_detect = 0, cpu_track = 0, cpu_match = 0;  // front-end CPU, all threads (cpu_ms_*)
   double load = 0;                                      // image reading
   double ransac = 0, refine = 0, triangulate = 0, ba = 0, backend_total = 0;
   double ransac_us_per_hypothesis = 0;
