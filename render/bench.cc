@@ -208,30 +208,33 @@ void RunRenderBenchmark(const RenderBenchOptions& options) {
     rows.push_back({"full render, bilinear on the nearest mip level", 1, false, true, false});
     rows.push_back({"full render, no textures", 1, false, false, true});
   }
-  for (Row& row : rows) {
+  // Rows interleaved frame by frame (one untimed warm-up frame per row first), so that every row
+  // sees the same load on a shared machine and the ratios between rows are robust to it.
+  std::vector<CameraImage> images(rig.NumCameras());
+  auto settings_for = [](const Row& row) {
     ShadeSettings settings;
     settings.spp = row.spp;
     settings.raw_cast_only = row.raw;
     settings.textures = row.textures;
     settings.trilinear = row.trilinear;
-    std::vector<CameraImage> images(rig.NumCameras());
-    // One untimed warm-up frame, then the timed frames.
-    for (int pass = 0; pass < 2; ++pass) {
+    return settings;
+  };
+  auto render_frame = [&](const ShadeSettings& settings, int f) {
+    arena.execute([&] {
+      tracer->SetFrame(f);
+      const Rigid3& world_from_rig = scene.rig_trajectory[f].world_from_rig;
+      for (int c = 0; c < rig.NumCameras(); ++c)
+        tracer->Render(rays[c], world_from_rig * rig.cameras[c].cam_from_rig.Inverse(), settings, &images[c]);
+    });
+  };
+  for (const Row& row : rows) render_frame(settings_for(row), 0);
+  for (int f = 0; f < frames; ++f) {
+    for (Row& row : rows) {
       const auto t = std::chrono::steady_clock::now();
       const double cpu0 = CpuSeconds();
-      const int n = pass == 0 ? 1 : frames;
-      for (int f = 0; f < n; ++f) {
-        arena.execute([&] {
-          tracer->SetFrame(f);
-          const Rigid3& world_from_rig = scene.rig_trajectory[f].world_from_rig;
-          for (int c = 0; c < rig.NumCameras(); ++c)
-            tracer->Render(rays[c], world_from_rig * rig.cameras[c].cam_from_rig.Inverse(), settings, &images[c]);
-        });
-      }
-      if (pass == 1) {
-        row.seconds_per_frame = Seconds(t) / frames;
-        row.cpu_seconds_per_frame = (CpuSeconds() - cpu0) / frames;
-      }
+      render_frame(settings_for(row), f);
+      row.seconds_per_frame += Seconds(t) / frames;
+      row.cpu_seconds_per_frame += (CpuSeconds() - cpu0) / frames;
     }
   }
 

@@ -23,6 +23,8 @@ MipTexture::MipTexture(const Texture& texture) {
                                 std::to_string(texture.height) + " does not match its " +
                                 std::to_string(texture.rgb.size()) + " bytes of RGB data");
   }
+  if (static_cast<double>(texture.width) * texture.height >= 2147483648.0)
+    throw std::invalid_argument("texture '" + texture.name + "': more than 2^31 texels (lookups use 32-bit indices)");
   float to_linear[256];
   for (int i = 0; i < 256; ++i) to_linear[i] = SrgbToLinear(i / 255.0f);
   auto pack = [](float r, float g, float b) -> uint64_t {
@@ -71,6 +73,7 @@ MipTexture::MipTexture(const Texture& texture) {
     l.fwidth = static_cast<float>(l.width);
     l.fheight = static_cast<float>(l.height);
   }
+  last_level_ = static_cast<int>(levels_.size()) - 1;
 }
 
 Eigen::Vector3f MipTexture::Texel(int level, int x, int y) const {
@@ -114,13 +117,16 @@ __m128 MipTexture::SampleWrapped(float u01, float v01, int level) const {
   if (ya >= l.height) ya = l.height - 1;
   const int xb = xa + 1 == l.width ? 0 : xa + 1;
   const int yb = ya + 1 == l.height ? 0 : ya + 1;
-  const uint64_t* texels = l.texels.data();
+  // Index(x, y) = RowOffset(y) + ColumnOffset(x): the two parts never share a bit below 16 and add.
+  const size_t col_a = l.ColumnOffset(xa), col_b = l.ColumnOffset(xb);
+  const uint64_t* row_a = l.texels.data() + l.RowOffset(ya);
+  const uint64_t* row_b = l.texels.data() + l.RowOffset(yb);
   const __m128i zero = _mm_setzero_si128();
-  auto load = [&](size_t i) {
-    return _mm_cvtepi32_ps(_mm_unpacklo_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(texels + i)), zero));
+  auto load = [&](const uint64_t* p) {
+    return _mm_cvtepi32_ps(_mm_unpacklo_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)), zero));
   };
-  const __m128 t00 = load(l.Index(xa, ya)), t10 = load(l.Index(xb, ya));
-  const __m128 t01 = load(l.Index(xa, yb)), t11 = load(l.Index(xb, yb));
+  const __m128 t00 = load(row_a + col_a), t10 = load(row_a + col_b);
+  const __m128 t01 = load(row_b + col_a), t11 = load(row_b + col_b);
   const __m128 vax = _mm_set1_ps(ax), vay = _mm_set1_ps(ay);
   const __m128 top = _mm_add_ps(t00, _mm_mul_ps(vax, _mm_sub_ps(t10, t00)));
   const __m128 bottom = _mm_add_ps(t01, _mm_mul_ps(vax, _mm_sub_ps(t11, t01)));
@@ -137,22 +143,203 @@ Eigen::Vector3f MipTexture::SampleLevel(float u, float v, int level) const {
   return Eigen::Vector3f(out[0], out[1], out[2]);
 }
 
-Eigen::Vector3f MipTexture::Sample(float u, float v, float lod) const {
+__m128 MipTexture::Sample4(float u, float v, float lod) const {
   const int last = NumLevels() - 1;
   const float u01 = Wrap01(u), v01 = Wrap01(v);
-  __m128 c;
-  if (!(lod > 0.0f)) {  // also catches NaN
-    c = SampleWrapped(u01, v01, 0);
-  } else if (lod >= static_cast<float>(last)) {
-    c = SampleWrapped(u01, v01, last);
-  } else {
-    const int l0 = static_cast<int>(lod);
-    const float a = lod - static_cast<float>(l0);
-    c = SampleWrapped(u01, v01, l0);
-    if (a > 0.0f) c = _mm_add_ps(c, _mm_mul_ps(_mm_set1_ps(a), _mm_sub_ps(SampleWrapped(u01, v01, l0 + 1), c)));
+  if (!(lod > 0.0f)) return SampleWrapped(u01, v01, 0);  // also catches NaN
+  if (lod >= static_cast<float>(last)) return SampleWrapped(u01, v01, last);
+  const int l0 = static_cast<int>(lod);
+  const float a = lod - static_cast<float>(l0);
+  const __m128 c = SampleWrapped(u01, v01, l0);
+  if (!(a > 0.0f)) return c;
+  return _mm_add_ps(c, _mm_mul_ps(_mm_set1_ps(a), _mm_sub_ps(SampleWrapped(u01, v01, l0 + 1), c)));
+}
+
+namespace {
+
+// FloorInt and Wrap01 on four lanes, with the scalar versions' exact arithmetic.
+inline __m128i FloorInt4(__m128 x) {
+  const __m128i i = _mm_cvttps_epi32(x);
+  return _mm_add_epi32(i, _mm_castps_si128(_mm_cmplt_ps(x, _mm_cvtepi32_ps(i))));
+}
+
+inline __m128 Wrap01x4(__m128 x) {
+  const __m128 finite = _mm_cmplt_ps(_mm_andnot_ps(_mm_set1_ps(-0.0f), x), _mm_set1_ps(1e9f));
+  const __m128 w = _mm_sub_ps(x, _mm_cvtepi32_ps(FloorInt4(x)));
+  return _mm_and_ps(_mm_and_ps(w, _mm_cmplt_ps(w, _mm_set1_ps(1.0f))), finite);
+}
+
+// Low 32 bits of the lane-wise product (SSE2 has no pmulld).
+inline __m128i MulLo32(__m128i a, __m128i b) {
+  const __m128i even = _mm_mul_epu32(a, b);
+  const __m128i odd = _mm_mul_epu32(_mm_srli_epi64(a, 32), _mm_srli_epi64(b, 32));
+  return _mm_unpacklo_epi32(_mm_shuffle_epi32(even, _MM_SHUFFLE(0, 0, 2, 0)),
+                            _mm_shuffle_epi32(odd, _MM_SHUFFLE(0, 0, 2, 0)));
+}
+
+// a ? b : c per lane (a all-ones or all-zeros).
+inline __m128i Select(__m128i a, __m128i b, __m128i c) { return _mm_or_si128(_mm_and_si128(a, b), _mm_andnot_si128(a, c)); }
+
+}  // namespace
+
+// Where the bilinear lookups of four lanes read: per lane the level's texels, the four texel
+// indices (00, 10, 01, 11) and the weights ax, ay.
+struct MipTexture::Footprint4 {
+  const uint64_t* texels[4];
+  alignas(16) uint32_t index[4][4];  // [corner][lane]
+  alignas(16) float ax[4], ay[4];
+};
+
+void MipTexture::Address4(const Level* const level[4], __m128 u01, __m128 v01, Footprint4* fp) {
+  // Transpose the lanes' (fwidth, fheight, width, height) into one register per field.
+  __m128 fw = _mm_loadu_ps(&level[0]->fwidth), fh = _mm_loadu_ps(&level[1]->fwidth);
+  __m128 wf = _mm_loadu_ps(&level[2]->fwidth), hf = _mm_loadu_ps(&level[3]->fwidth);
+  _MM_TRANSPOSE4_PS(fw, fh, wf, hf);
+  const __m128i w = _mm_castps_si128(wf), h = _mm_castps_si128(hf);
+  const __m128i bx = _mm_setr_epi32(level[0]->blocks_x, level[1]->blocks_x, level[2]->blocks_x, level[3]->blocks_x);
+  for (int k = 0; k < 4; ++k) fp->texels[k] = level[k]->texels.data();
+  const __m128i one = _mm_set1_epi32(1), three = _mm_set1_epi32(3), zero = _mm_setzero_si128();
+  const __m128 half = _mm_set1_ps(0.5f);
+  // As SampleWrapped: texel centres at (i + 0.5) / width; wrap the lower neighbour to the last texel.
+  const __m128 fu = _mm_sub_ps(_mm_mul_ps(u01, fw), half);
+  const __m128 fv = _mm_sub_ps(_mm_mul_ps(v01, fh), half);
+  __m128i xa = FloorInt4(fu), ya = FloorInt4(fv);
+  _mm_store_ps(fp->ax, _mm_sub_ps(fu, _mm_cvtepi32_ps(xa)));
+  _mm_store_ps(fp->ay, _mm_sub_ps(fv, _mm_cvtepi32_ps(ya)));
+  const __m128i w1 = _mm_sub_epi32(w, one), h1 = _mm_sub_epi32(h, one);
+  xa = Select(_mm_cmplt_epi32(xa, zero), w1, xa);
+  ya = Select(_mm_cmplt_epi32(ya, zero), h1, ya);
+  xa = Select(_mm_cmpgt_epi32(xa, w1), w1, xa);  // rounding guard
+  ya = Select(_mm_cmpgt_epi32(ya, h1), h1, ya);
+  const __m128i xb = _mm_andnot_si128(_mm_cmpeq_epi32(xa, w1), _mm_add_epi32(xa, one));
+  const __m128i yb = _mm_andnot_si128(_mm_cmpeq_epi32(ya, h1), _mm_add_epi32(ya, one));
+  // Level::Index: ColumnOffset(x) = (x >> 2) << 4 | (x & 3), RowOffset(y) = (y >> 2) * blocks_x << 4 | (y & 3) << 2.
+  auto column = [&](__m128i x) {
+    return _mm_or_si128(_mm_slli_epi32(_mm_srli_epi32(x, 2), 4), _mm_and_si128(x, three));
+  };
+  auto row = [&](__m128i y) {
+    return _mm_or_si128(_mm_slli_epi32(MulLo32(_mm_srli_epi32(y, 2), bx), 4), _mm_slli_epi32(_mm_and_si128(y, three), 2));
+  };
+  const __m128i col_a = column(xa), col_b = column(xb), row_a = row(ya), row_b = row(yb);
+  _mm_store_si128(reinterpret_cast<__m128i*>(fp->index[0]), _mm_add_epi32(row_a, col_a));
+  _mm_store_si128(reinterpret_cast<__m128i*>(fp->index[1]), _mm_add_epi32(row_a, col_b));
+  _mm_store_si128(reinterpret_cast<__m128i*>(fp->index[2]), _mm_add_epi32(row_b, col_a));
+  _mm_store_si128(reinterpret_cast<__m128i*>(fp->index[3]), _mm_add_epi32(row_b, col_b));
+}
+
+namespace {
+
+// Requests the cache lines of a footprint's texels 00 and 11 (a 4x4 block is two lines, texel rows
+// 0-1 and 2-3: the two cover the 2x2 neighbourhood unless it straddles blocks both ways).
+inline void Prefetch(const uint64_t* texels, const uint32_t* const index[4], int lane) {
+  _mm_prefetch(reinterpret_cast<const char*>(texels + index[0][lane]), _MM_HINT_T0);
+  _mm_prefetch(reinterpret_cast<const char*>(texels + index[3][lane]), _MM_HINT_T0);
+}
+
+}  // namespace
+
+__m128 MipTexture::Filter(const Footprint4& fp, int lane) {
+  const uint64_t* texels = fp.texels[lane];
+  const __m128i zero = _mm_setzero_si128();
+  auto load = [&](int corner) {
+    return _mm_cvtepi32_ps(_mm_unpacklo_epi16(
+        _mm_loadl_epi64(reinterpret_cast<const __m128i*>(texels + fp.index[corner][lane])), zero));
+  };
+  const __m128 t00 = load(0), t10 = load(1), t01 = load(2), t11 = load(3);
+  const __m128 vax = _mm_set1_ps(fp.ax[lane]), vay = _mm_set1_ps(fp.ay[lane]);
+  const __m128 top = _mm_add_ps(t00, _mm_mul_ps(vax, _mm_sub_ps(t10, t00)));
+  const __m128 bottom = _mm_add_ps(t01, _mm_mul_ps(vax, _mm_sub_ps(t11, t01)));
+  return _mm_mul_ps(_mm_add_ps(top, _mm_mul_ps(vay, _mm_sub_ps(bottom, top))), _mm_set1_ps(1.0f / 65535.0f));
+}
+
+void MipTexture::SampleBatch(const MipTexture* const* textures, const float* u, const float* v, const float* lod,
+                             int n, __m128* out, bool trilinear) {
+  // Chunks of up to kChunk lookups: first every address (four lanes at a time) with a prefetch of
+  // its texels, then the loads and filters, so that many cache misses overlap.
+  constexpr int kChunk = 64;
+  Footprint4 fp0[kChunk / 4], fp1[kChunk / 4];
+  alignas(16) float blend[kChunk];
+  bool any_blend[kChunk / 4];
+  for (int c0 = 0; c0 < n; c0 += kChunk) {
+    const int chunk = std::min(kChunk, n - c0);
+    for (int g = 0; g * 4 < chunk; ++g) {
+      // Four lookups (the tail repeats the last one).
+      const MipTexture* tex[4];
+      __m128 lu, lv, l;
+      if (g * 4 + 4 <= chunk) {
+        const int k = c0 + g * 4;
+        for (int j = 0; j < 4; ++j) tex[j] = textures[k + j];
+        lu = _mm_loadu_ps(u + k);
+        lv = _mm_loadu_ps(v + k);
+        l = _mm_loadu_ps(lod + k);
+      } else {
+        alignas(16) float tu[4], tv[4], tl[4];
+        for (int j = 0; j < 4; ++j) {
+          const int k = c0 + std::min(g * 4 + j, chunk - 1);
+          tex[j] = textures[k];
+          tu[j] = u[k];
+          tv[j] = v[k];
+          tl[j] = lod[k];
+        }
+        lu = _mm_load_ps(tu);
+        lv = _mm_load_ps(tv);
+        l = _mm_load_ps(tl);
+      }
+      // As Sample4: level 0 for lod <= 0 or NaN, the last level from lod >= last on, else the two
+      // levels around lod with weight lod - floor(lod) on the coarser one.
+      const __m128i last =
+          _mm_setr_epi32(tex[0]->last_level_, tex[1]->last_level_, tex[2]->last_level_, tex[3]->last_level_);
+      __m128i l0;
+      __m128 a;
+      if (trilinear) {
+        const __m128 positive = _mm_cmpgt_ps(l, _mm_setzero_ps());
+        const __m128 inside = _mm_and_ps(positive, _mm_cmplt_ps(l, _mm_cvtepi32_ps(last)));
+        const __m128i floor_l = _mm_cvttps_epi32(l);
+        l0 = Select(_mm_castps_si128(inside), floor_l, _mm_and_si128(_mm_castps_si128(positive), last));
+        a = _mm_and_ps(inside, _mm_sub_ps(l, _mm_cvtepi32_ps(floor_l)));
+      } else {
+        // The nearest level, clamp(int(lod + 1/2), 0, last) (a NaN converts to INT_MIN: level 0).
+        l0 = _mm_cvttps_epi32(_mm_add_ps(l, _mm_set1_ps(0.5f)));
+        l0 = _mm_andnot_si128(_mm_cmplt_epi32(l0, _mm_setzero_si128()), l0);
+        l0 = Select(_mm_cmpgt_epi32(l0, last), last, l0);
+        a = _mm_setzero_ps();
+      }
+      __m128i l1 = _mm_add_epi32(l0, _mm_set1_epi32(1));
+      l1 = Select(_mm_cmpgt_epi32(l1, last), last, l1);
+      _mm_store_ps(blend + g * 4, a);
+      any_blend[g] = _mm_movemask_ps(_mm_cmpgt_ps(a, _mm_setzero_ps())) != 0;
+      alignas(16) int32_t level_index0[4], level_index1[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(level_index0), l0);
+      _mm_store_si128(reinterpret_cast<__m128i*>(level_index1), l1);
+      const Level* level0[4];
+      const Level* level1[4];
+      for (int j = 0; j < 4; ++j) {
+        level0[j] = tex[j]->levels_.data() + level_index0[j];
+        level1[j] = tex[j]->levels_.data() + level_index1[j];
+      }
+      const __m128 u01 = Wrap01x4(lu), v01 = Wrap01x4(lv);
+      const uint32_t* const index0[4] = {fp0[g].index[0], fp0[g].index[1], fp0[g].index[2], fp0[g].index[3]};
+      Address4(level0, u01, v01, &fp0[g]);
+      for (int j = 0; j < 4; ++j) Prefetch(fp0[g].texels[j], index0, j);
+      if (any_blend[g]) {
+        const uint32_t* const index1[4] = {fp1[g].index[0], fp1[g].index[1], fp1[g].index[2], fp1[g].index[3]};
+        Address4(level1, u01, v01, &fp1[g]);
+        for (int j = 0; j < 4; ++j) Prefetch(fp1[g].texels[j], index1, j);
+      }
+    }
+    for (int i = 0; i < chunk; ++i) {
+      const int g = i / 4, j = i % 4;
+      const __m128 c = Filter(fp0[g], j);
+      // As Sample4: c + a (c1 - c) where the level of detail lies strictly between two levels.
+      const float a = blend[i];
+      out[c0 + i] = a > 0.0f ? _mm_add_ps(c, _mm_mul_ps(_mm_set1_ps(a), _mm_sub_ps(Filter(fp1[g], j), c))) : c;
+    }
   }
+}
+
+Eigen::Vector3f MipTexture::Sample(float u, float v, float lod) const {
   alignas(16) float out[4];
-  _mm_store_ps(out, c);
+  _mm_store_ps(out, Sample4(u, v, lod));
   return Eigen::Vector3f(out[0], out[1], out[2]);
 }
 

@@ -39,25 +39,36 @@ class MipTexture {
 
   // Linear RGB at (u, v) with trilinear filtering at level of detail `lod` (clamped to the pyramid).
   Eigen::Vector3f Sample(float u, float v, float lod) const;
+  // Batch of Sample4 lookups, out[k] = textures[k]->Sample4(u[k], v[k], lod[k]) for k < n, bit for
+  // bit; with trilinear = false instead SampleLevel4(u[k], v[k], clamp(int(lod[k] + 1/2), 0, last))
+  // (bilinear on the nearest level). Four lookups at a time share SSE registers for the level
+  // choice and the texel addresses (each may use its own texture and level); all addresses of up
+  // to 64 lookups are computed, and their texels prefetched, before the first texel is read.
+  static void SampleBatch(const MipTexture* const* textures, const float* u, const float* v, const float* lod, int n,
+                          __m128* out, bool trilinear = true);
   // Bilinear lookup in one level.
   Eigen::Vector3f SampleLevel(float u, float v, int level) const;
   // Texel of one level (wrapped coordinates), linear RGB.
   Eigen::Vector3f Texel(int level, int x, int y) const;
+  // Sample() as an SSE register (r, g, b, 0).
+  __m128 Sample4(float u, float v, float lod) const;
   // Bilinear lookup as an SSE register (r, g, b, 0).
   __m128 SampleLevel4(float u, float v, int level) const;
 
  private:
-  struct Level {
-    int width = 0;
-    int height = 0;
+  // The first 16 bytes (fwidth, fheight, width, height) load as one SSE register (Address4).
+  struct alignas(16) Level {
     float fwidth = 0.0f, fheight = 0.0f;
-    int blocks_x = 0;              // ceil(width / 4)
+    int32_t width = 0;
+    int32_t height = 0;
+    int32_t blocks_x = 0;          // ceil(width / 4)
     std::vector<uint64_t> texels;  // linear r, g, b, 0 as uint16 (x 1/65535), in 4x4-texel blocks
     // Texel (x, y) lives at Index(x, y): blocks row-major, texels row-major inside a block.
-    size_t Index(int x, int y) const {
-      return ((static_cast<size_t>(y >> 2) * blocks_x + static_cast<size_t>(x >> 2)) << 4) |
-             static_cast<size_t>(((y & 3) << 2) | (x & 3));
+    size_t Index(int x, int y) const { return RowOffset(y) + ColumnOffset(x); }
+    size_t RowOffset(int y) const {
+      return ((static_cast<size_t>(y >> 2) * blocks_x) << 4) | static_cast<size_t>((y & 3) << 2);
     }
+    static size_t ColumnOffset(int x) { return (static_cast<size_t>(x >> 2) << 4) | static_cast<size_t>(x & 3); }
     void Allocate(int w, int h) {
       width = w;
       height = h;
@@ -65,10 +76,16 @@ class MipTexture {
       texels.assign(static_cast<size_t>(blocks_x) * ((h + 3) / 4) * 16, 0ull);
     }
   };
+  // Bilinear lookups in four levels (one per lane) at coordinates already wrapped into [0, 1):
+  // Address4 finds the texels and weights, Filter reads and blends one lane's.
+  struct Footprint4;
+  static void Address4(const Level* const level[4], __m128 u01, __m128 v01, Footprint4* fp);
+  static __m128 Filter(const Footprint4& fp, int lane);
   // Bilinear lookup in one level at coordinates already wrapped into [0, 1).
   __m128 SampleWrapped(float u01, float v01, int level) const;
 
   std::vector<Level> levels_;
+  int last_level_ = 0;  // NumLevels() - 1
   float texels_per_uv_ = 1.0f;
 };
 

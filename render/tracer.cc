@@ -16,6 +16,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace rovo {
 namespace {
@@ -81,11 +82,6 @@ const std::array<uint8_t, 65536>& SrgbTable() {
   return table;
 }
 
-uint8_t EncodeSrgb(float linear, const std::array<uint8_t, 65536>& table) {
-  if (!(linear > 0.0f)) return 0;
-  if (linear >= 1.0f) return 255;
-  return table[static_cast<int>(linear * 65535.0f + 0.5f)];
-}
 
 Eigen::Vector3f ToF(const Eigen::Vector3d& v) { return v.cast<float>(); }
 
@@ -267,6 +263,15 @@ struct Tracer::Impl {
   std::vector<std::vector<TriangleShade>> mesh_shade;  // per mesh and triangle
   std::vector<int> object_mesh;                        // object index -> mesh index
   std::vector<MipTexture> textures;
+  // Shading records of a hit in one load: per static geomID and per object, its mesh's records.
+  std::vector<const TriangleShade*> static_geom_shade;
+  std::vector<const TriangleShade*> object_shade;
+  // What shading needs of a material, 32 bytes (Material also carries its name).
+  struct ShadeMaterial {
+    alignas(16) float base_color[4];  // linear r, g, b, 0
+    const MipTexture* texture;        // nullptr: untextured
+  };
+  std::vector<ShadeMaterial> shade_materials;
 
   RTCScene trace_scene = nullptr;           // static_scene when nothing moves, else top
   std::array<Eigen::Vector3f, kSunSamples> sun_samples;  // unit directions inside the sun disc
@@ -375,7 +380,19 @@ Tracer::Tracer(const Scene& scene) : impl_(std::make_unique<Impl>(scene)) {
     }
   }
   d.object_mesh.resize(scene.objects.size());
-  for (size_t o = 0; o < scene.objects.size(); ++o) d.object_mesh[o] = scene.objects[o].mesh;
+  d.object_shade.resize(scene.objects.size());
+  for (size_t o = 0; o < scene.objects.size(); ++o) {
+    d.object_mesh[o] = scene.objects[o].mesh;
+    d.object_shade[o] = d.mesh_shade[scene.objects[o].mesh].data();
+  }
+  d.shade_materials.resize(scene.materials.size());
+  for (size_t m = 0; m < scene.materials.size(); ++m) {
+    const Material& mat = scene.materials[m];
+    Impl::ShadeMaterial& sm = d.shade_materials[m];
+    for (int k = 0; k < 3; ++k) sm.base_color[k] = mat.base_color[k];
+    sm.base_color[3] = 0.0f;
+    sm.texture = mat.texture >= 0 ? &d.textures[mat.texture] : nullptr;
+  }
 
   d.device = rtcNewDevice(nullptr);
   if (!d.device) throw std::runtime_error("cannot create the Embree device");
@@ -414,6 +431,9 @@ Tracer::Tracer(const Scene& scene) : impl_(std::make_unique<Impl>(scene)) {
     num_static_triangles_ += mesh.triangles.size();
   }
   rtcCommitScene(d.static_scene);
+  d.static_geom_shade.assign(d.static_geom_object.size(), nullptr);
+  for (size_t id = 0; id < d.static_geom_object.size(); ++id)
+    if (d.static_geom_object[id] >= 0) d.static_geom_shade[id] = d.object_shade[d.static_geom_object[id]];
   static_build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   d.CheckDevice("building the static scene");
 
@@ -489,20 +509,25 @@ void Tracer::SetFrame(int frame) {
 
 namespace {
 
+// A tile's rays and the shading state between its passes (structures of arrays; colours are SSE
+// registers (r, g, b, 0): every lane operation is the scalar one, so results do not depend on it).
 struct alignas(64) TileBuffers {
   RTCRayHit rayhit[kTilePixels];
   RTCRay shadow[kTilePixels];
-  int pixel[kTilePixels];        // tile-local pixel index of each ray
-  int shadow_ray[kTilePixels];   // primary ray index of each shadow ray
-  Eigen::Vector3f direct[kTilePixels];   // albedo * E_sun * cos / pi of each shadow ray
-  Eigen::Vector3f sum[kTilePixels];      // linear radiance sums per pixel
+  int pixel[kTilePixels];         // tile-local pixel index of each ray
+  int shadow_pixel[kTilePixels];  // tile-local pixel index of each shadow ray
+  __m128 direct[kTilePixels];     // albedo * E_sun * cos / pi of each shadow ray
+  __m128 sum[kTilePixels];        // linear radiance sums per pixel
   int count[kTilePixels];
-  // Per primary ray, between the two shading passes.
-  Eigen::Vector3f normal[kTilePixels];   // unit, facing the ray
-  Eigen::Vector3f albedo[kTilePixels];   // material base colour
-  const MipTexture* texture[kTilePixels];  // nullptr: untextured (or a miss: see hit)
+  // The hits of the current sample pass, compacted.
+  int hit_ray[kTilePixels];
+  Eigen::Vector3f normal[kTilePixels];  // unit, facing the ray
+  __m128 albedo[kTilePixels];           // base colour, then times the texture
+  // The hits with a texture lookup, compacted (index into the hit arrays).
+  int textured_hit[kTilePixels];
+  const MipTexture* texture[kTilePixels];
   float tex_u[kTilePixels], tex_v[kTilePixels], tex_lod[kTilePixels];
-  bool hit[kTilePixels];
+  __m128 texel[kTilePixels];  // the filtered texture colour
 };
 
 void InitRay(RTCRayHit* rh, const Eigen::Vector3f& origin, const Eigen::Vector3f& dir) {
@@ -522,6 +547,8 @@ void InitRay(RTCRayHit* rh, const Eigen::Vector3f& origin, const Eigen::Vector3f
   rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
 }
 
+__m128 Load3(const Eigen::Vector3f& v) { return _mm_setr_ps(v.x(), v.y(), v.z(), 0.0f); }
+
 }  // namespace
 
 void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const ShadeSettings& settings,
@@ -534,7 +561,8 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
   if (!raw) {
     image->width = width;
     image->height = height;
-    image->rgb.assign(num_pixels * 3, 0);
+    // The resolve writes every pixel (black outside the image circle): no clearing needed.
+    if (image->rgb.size() != num_pixels * 3) image->rgb.assign(num_pixels * 3, 0);
     if (settings.want_depth) image->depth.assign(num_pixels, 0.0f);
     else image->depth.clear();
     if (settings.want_mask) image->mask.assign(num_pixels, 0);
@@ -549,13 +577,19 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
   const float theta_max = static_cast<float>(0.5 * rays.camera.max_fov_deg * M_PI / 180.0);
   const bool precomputed_samples = !settings.rotate_pattern && rays.sample_spp == spp;
   const bool soft_sun = settings.soft_shadows && d.sun_disc_radius > 0.0f && spp > 1;
+  const bool textures = settings.textures;
   // A pixel's sun samples: the block of `spp` consecutive points of the (0,2)-sequence starting at
   // a hashed multiple of spp (an elementary-interval-stratified set for power-of-two spp <= 64).
   const uint32_t spp_u = static_cast<uint32_t>(spp);
-  const Eigen::Vector3f sky_ground = light.ground_albedo.cwiseProduct(light.sky_horizon);
-  const Eigen::Vector3f sky_delta = light.sky_zenith - light.sky_horizon;
-  const Eigen::Vector3f ambient_ground = light.ambient * d.ground_irradiance;
-  const Eigen::Vector3f ambient_delta = light.ambient * (d.sky_mean - d.ground_irradiance);
+  const __m128 sky_horizon = Load3(light.sky_horizon);
+  const __m128 sky_delta = Load3(light.sky_zenith - light.sky_horizon);
+  const __m128 sky_ground = Load3(light.ground_albedo.cwiseProduct(light.sky_horizon));
+  const __m128 ambient_ground = Load3(light.ambient * d.ground_irradiance);
+  const __m128 ambient_delta = Load3(light.ambient * (d.sky_mean - d.ground_irradiance));
+  const __m128 sun_radiance = Load3(light.sun_radiance);
+  // exposure / (samples of a pixel): a pixel has at most spp samples.
+  std::vector<float> exposure_over_count(spp + 1, 0.0f);
+  for (int c = 1; c <= spp; ++c) exposure_over_count[c] = light.exposure / static_cast<float>(c);
   std::array<Eigen::Vector2f, 64> offsets{};
   for (int s = 0; s < std::min(spp, 64); ++s) offsets[s] = CameraRays::SampleOffset(s, spp);
 
@@ -577,7 +611,7 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
     rtcInitIntersectContext(&shadow_context);
     shadow_context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
     for (int i = 0; i < kTilePixels; ++i) {
-      tb.sum[i].setZero();
+      tb.sum[i] = _mm_setzero_ps();
       tb.count[i] = 0;
     }
 
@@ -633,112 +667,118 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
       }
       if (s < 0) continue;  // the extra centre pass only feeds depth and masks
 
-      // Shade the hits and set up shadow rays, in two passes over the tile's rays: pass 1 finds
-      // the surface (normal, material, texture coordinates and level of detail), pass 2 samples
-      // the textures, adds ambient light and sets up the shadow rays (short loops keep more
-      // independent texture loads in flight). The raw cast computes the same shadow rays (it needs
+      // Three passes over the tile's rays. Pass 1: misses take the sky; hits get their facing unit
+      // normal, base colour and texture coordinates and level of detail (compacted lists). Pass 2:
+      // the texture lookups (a tight loop keeps several independent texel loads in flight). Pass 3:
+      // ambient light and the shadow rays. The raw cast computes the same shadow rays (it needs
       // the normal and the sun sample) but no albedo, texture, sky or ambient term.
+      int num_hits = 0, num_textured = 0;
       for (int r = 0; r < n; ++r) {
         const RTCRayHit& rh = tb.rayhit[r];
         const int local = tb.pixel[r];
         const Eigen::Vector3f dir(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
-        tb.hit[r] = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-        if (!tb.hit[r]) {
+        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
           if (!raw) {
             // Sky: mix(horizon, zenith, sqrt(d.z)) above the horizon, ground_albedo * horizon below.
-            tb.sum[local] += dir.z() >= 0.0f ? Eigen::Vector3f(light.sky_horizon + std::sqrt(dir.z()) * sky_delta)
-                                             : sky_ground;
+            const __m128 sky = dir.z() >= 0.0f
+                                   ? _mm_add_ps(sky_horizon, _mm_mul_ps(_mm_set1_ps(std::sqrt(dir.z())), sky_delta))
+                                   : sky_ground;
+            tb.sum[local] = _mm_add_ps(tb.sum[local], sky);
             ++tb.count[local];
           }
           continue;
         }
+        const int h = num_hits++;
+        tb.hit_ray[h] = r;
         const unsigned inst = rh.hit.instID[0];
-        const int obj_index = inst != RTC_INVALID_GEOMETRY_ID && d.top_instance_object[inst] >= 0
-                                  ? d.top_instance_object[inst]
-                                  : d.static_geom_object[rh.hit.geomID];
         Eigen::Vector3f normal(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
-        if (inst != RTC_INVALID_GEOMETRY_ID) normal = d.object_rotation[obj_index] * normal;
+        const Impl::TriangleShade* shade;
+        if (inst == RTC_INVALID_GEOMETRY_ID) {
+          shade = d.static_geom_shade[rh.hit.geomID];
+        } else {
+          const int obj = d.top_instance_object[inst] >= 0 ? d.top_instance_object[inst]
+                                                           : d.static_geom_object[rh.hit.geomID];
+          normal = d.object_rotation[obj] * normal;
+          shade = d.object_shade[obj];
+        }
         const float nlen2 = normal.squaredNorm();
         normal = nlen2 > 0.0f ? Eigen::Vector3f(normal / std::sqrt(nlen2)) : Eigen::Vector3f(-dir);
         if (normal.dot(dir) > 0.0f) normal = -normal;
-        tb.normal[r] = normal;
-        tb.texture[r] = nullptr;
+        tb.normal[h] = normal;
         if (raw) continue;
-        const Impl::TriangleShade& ts = d.mesh_shade[d.object_mesh[obj_index]][rh.hit.primID];
-        const Material& mat = scene.materials[ts.material];
-        tb.albedo[r] = mat.base_color;
-        if (!settings.textures || ts.texels_per_metre < 0.0f) continue;
+        const Impl::TriangleShade& ts = shade[rh.hit.primID];
+        const Impl::ShadeMaterial& mat = d.shade_materials[ts.material];
+        tb.albedo[h] = _mm_load_ps(mat.base_color);
+        if (!textures || ts.texels_per_metre < 0.0f) continue;
         const float bu = rh.hit.u, bv = rh.hit.v, bw = 1.0f - bu - bv;
-        const float u = bw * ts.uv[0] + bu * ts.uv[2] + bv * ts.uv[4];
-        const float v = bw * ts.uv[1] + bu * ts.uv[3] + bv * ts.uv[5];
-        const MipTexture& tex = d.textures[mat.texture];
+        const int k = num_textured++;
+        tb.textured_hit[k] = h;
+        tb.texture[k] = mat.texture;
+        tb.tex_u[k] = bw * ts.uv[0] + bu * ts.uv[2] + bv * ts.uv[4];
+        tb.tex_v[k] = bw * ts.uv[1] + bu * ts.uv[3] + bv * ts.uv[5];
         // Ray-cone footprint in metres, then in texels of level 0.
         const size_t pi = static_cast<size_t>(ty0 + local / kTile) * width + tx0 + local % kTile;
         const float cos_view = std::max(-normal.dot(dir), 0.1f);
         const float texels = rh.ray.tfar * rays.pixel_angle[pi] / cos_view * inv_sqrt_spp * ts.texels_per_metre;
-        const float lod = texels > 0.0f ? FastLog2(texels) + settings.lod_bias : 0.0f;
-        tb.texture[r] = &tex;
-        tb.tex_u[r] = u;
-        tb.tex_v[r] = v;
-        tb.tex_lod[r] = lod;
+        tb.tex_lod[k] = texels > 0.0f ? FastLog2(texels) + settings.lod_bias : 0.0f;
+      }
+
+      if (num_textured > 0) {
+        MipTexture::SampleBatch(tb.texture, tb.tex_u, tb.tex_v, tb.tex_lod, num_textured, tb.texel, settings.trilinear);
+        for (int k = 0; k < num_textured; ++k) {
+          const int h = tb.textured_hit[k];
+          tb.albedo[h] = _mm_mul_ps(tb.albedo[h], tb.texel[k]);
+        }
       }
 
       int num_shadow = 0;
-      for (int r = 0; r < n; ++r) {
-        if (!tb.hit[r]) continue;
-        const RTCRayHit& rh = tb.rayhit[r];
-        const int local = tb.pixel[r];
-        const Eigen::Vector3f dir(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
-        const float t = rh.ray.tfar;
-        const Eigen::Vector3f& normal = tb.normal[r];
-        const size_t pi = static_cast<size_t>(ty0 + local / kTile) * width + tx0 + local % kTile;
-        Eigen::Vector3f albedo = Eigen::Vector3f::Zero();
+      for (int h = 0; h < num_hits; ++h) {
+        const RTCRayHit& rh = tb.rayhit[tb.hit_ray[h]];
+        const int local = tb.pixel[tb.hit_ray[h]];
+        const Eigen::Vector3f& normal = tb.normal[h];
+        __m128 albedo = _mm_setzero_ps();
         if (!raw) {
-          albedo = tb.albedo[r];
-          if (const MipTexture* tex = tb.texture[r]) {
-            if (settings.trilinear) {
-              albedo = albedo.cwiseProduct(tex->Sample(tb.tex_u[r], tb.tex_v[r], tb.tex_lod[r]));
-            } else {
-              const int level = std::clamp(static_cast<int>(tb.tex_lod[r] + 0.5f), 0, tex->NumLevels() - 1);
-              albedo = albedo.cwiseProduct(tex->SampleLevel(tb.tex_u[r], tb.tex_v[r], level));
-            }
-          }
+          albedo = tb.albedo[h];
           // Ambient: hemisphere mix of sky and ground by the normal's elevation.
           const float up = 0.5f * (1.0f + normal.z());
-          tb.sum[local] += albedo.cwiseProduct(ambient_ground + up * ambient_delta);
+          tb.sum[local] = _mm_add_ps(
+              tb.sum[local], _mm_mul_ps(albedo, _mm_add_ps(ambient_ground, _mm_mul_ps(_mm_set1_ps(up), ambient_delta))));
           ++tb.count[local];
         }
-
-        const Eigen::Vector3f& to_sun =
-            soft_sun ? d.sun_samples[(static_cast<uint32_t>(Mix64(pi * 0x9e3779b97f4a7c15ull + 7)) * spp_u +
-                                      static_cast<uint32_t>(s)) &
-                                     (kSunSamples - 1)]
-                     : d.sun_dir;
-        const float cos_sun = normal.dot(to_sun);
+        const Eigen::Vector3f* to_sun = &d.sun_dir;
+        if (soft_sun) {
+          const size_t pi = static_cast<size_t>(ty0 + local / kTile) * width + tx0 + local % kTile;
+          to_sun = &d.sun_samples[(static_cast<uint32_t>(Mix64(pi * 0x9e3779b97f4a7c15ull + 7)) * spp_u +
+                                   static_cast<uint32_t>(s)) &
+                                  (kSunSamples - 1)];
+        }
+        const float cos_sun = normal.dot(*to_sun);
         if (cos_sun <= 0.0f) continue;
+        const __m128 direct =
+            raw ? albedo : _mm_mul_ps(_mm_mul_ps(albedo, sun_radiance), _mm_set1_ps(cos_sun * kInvPi));
         if (!settings.shadows) {
-          if (!raw) tb.sum[local] += albedo.cwiseProduct(light.sun_radiance) * (cos_sun * kInvPi);
+          if (!raw) tb.sum[local] = _mm_add_ps(tb.sum[local], direct);
           continue;
         }
+        const Eigen::Vector3f dir(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
+        const float t = rh.ray.tfar;
         const float offset = 1e-4f * (1.0f + t);
         const Eigen::Vector3f shadow_origin = origin + t * dir + offset * normal;
         RTCRay& sr = tb.shadow[num_shadow];
         sr.org_x = shadow_origin.x();
         sr.org_y = shadow_origin.y();
         sr.org_z = shadow_origin.z();
-        sr.dir_x = to_sun.x();
-        sr.dir_y = to_sun.y();
-        sr.dir_z = to_sun.z();
+        sr.dir_x = to_sun->x();
+        sr.dir_y = to_sun->y();
+        sr.dir_z = to_sun->z();
         sr.tnear = offset;
         sr.tfar = std::numeric_limits<float>::infinity();
         sr.mask = 0xffffffffu;
         sr.time = 0.0f;
         sr.id = 0;
         sr.flags = 0;
-        if (!raw) {
-          tb.shadow_ray[num_shadow] = r;
-          tb.direct[num_shadow] = albedo.cwiseProduct(light.sun_radiance) * (cos_sun * kInvPi);
-        }
+        tb.shadow_pixel[num_shadow] = local;
+        tb.direct[num_shadow] = direct;
         ++num_shadow;
       }
       if (num_shadow == 0) continue;
@@ -746,27 +786,36 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
       if (raw) continue;
       for (int k = 0; k < num_shadow; ++k) {
         // Embree sets tfar to -inf for occluded rays.
-        if (tb.shadow[k].tfar >= 0.0f) tb.sum[tb.pixel[tb.shadow_ray[k]]] += tb.direct[k];
+        if (tb.shadow[k].tfar >= 0.0f) tb.sum[tb.shadow_pixel[k]] = _mm_add_ps(tb.sum[tb.shadow_pixel[k]], tb.direct[k]);
       }
     }
     if (raw) return;
 
-    // Resolve: box filter, exposure, optional vignetting and noise, sRGB.
+    // Resolve: box filter, exposure, optional vignetting and noise, sRGB. The encoding clamps to
+    // [0, 1] (NaN -> 0) and reads the 64k table at round(65535 x).
+    const __m128 one = _mm_set1_ps(1.0f), scale = _mm_set1_ps(65535.0f), half = _mm_set1_ps(0.5f);
     for (int ly = 0; ly < th; ++ly) {
-      for (int lx = 0; lx < tw; ++lx) {
+      uint8_t* out = image->rgb.data() + (static_cast<size_t>(ty0 + ly) * width + tx0) * 3;
+      for (int lx = 0; lx < tw; ++lx, out += 3) {
         const int local = ly * kTile + lx;
-        if (tb.count[local] == 0) continue;
+        if (tb.count[local] == 0) {
+          out[0] = out[1] = out[2] = 0;
+          continue;
+        }
         const size_t pi = static_cast<size_t>(ty0 + ly) * width + tx0 + lx;
-        float gain = light.exposure / static_cast<float>(tb.count[local]);
+        float gain = exposure_over_count[tb.count[local]];
         if (settings.vignetting > 0.0f) {
           const Eigen::Vector3f& b = rays.bearing[pi];
           const float theta = std::atan2(std::hypot(b.x(), b.y()), b.z());
           const float rel = theta / theta_max;
           gain *= std::max(0.0f, 1.0f - settings.vignetting * rel * rel);
         }
-        const Eigen::Vector3f c = tb.sum[local] * gain;
+        const __m128 c = _mm_min_ps(_mm_max_ps(_mm_mul_ps(tb.sum[local], _mm_set1_ps(gain)), _mm_setzero_ps()), one);
+        const __m128i i4 = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(c, scale), half));
+        const int index[3] = {_mm_cvtsi128_si32(i4), _mm_cvtsi128_si32(_mm_shuffle_epi32(i4, 1)),
+                              _mm_cvtsi128_si32(_mm_shuffle_epi32(i4, 2))};
         for (int k = 0; k < 3; ++k) {
-          uint8_t value = EncodeSrgb(c[k], srgb);
+          uint8_t value = srgb[index[k]];
           if (settings.noise_sigma > 0.0f) {
             // Box-Muller from two hashed uniforms: deterministic per (seed, pixel, channel).
             const uint64_t h = Mix64(settings.noise_seed ^ Mix64(pi * 3 + k));
@@ -775,7 +824,7 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
             const float g = std::sqrt(-2.0f * std::log(u1)) * std::cos(6.2831853f * u2);
             value = static_cast<uint8_t>(std::clamp(std::lround(value + settings.noise_sigma * g), 0L, 255L));
           }
-          image->rgb[pi * 3 + k] = value;
+          out[k] = value;
         }
       }
     }

@@ -1,11 +1,14 @@
 #include "vo/frontend.h"
 
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <ctime>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -38,7 +41,39 @@ cv::Mat ToGray(const cv::Mat& image, int camera) {
   return gray;
 }
 
+// Sets OpenCV's thread count (process-wide) for a scope and restores it. The front-end runs its views
+// in parallel under TBB; OpenCV's own parallel loops nested in them (remap, KLT, pyramids) ran on
+// OpenCV's TBB arena with task overhead and without gain (measured: 4 x 5 remaps on 2 threads took
+// ~20 % more wall and CPU time than with OpenCV serial inside each view).
+class ScopedOpenCvThreads {
+ public:
+  explicit ScopedOpenCvThreads(int threads) : previous_(cv::getNumThreads()) {
+    if (previous_ != threads) cv::setNumThreads(threads);
+  }
+  ~ScopedOpenCvThreads() {
+    if (cv::getNumThreads() != previous_) cv::setNumThreads(previous_);
+  }
+  ScopedOpenCvThreads(const ScopedOpenCvThreads&) = delete;
+  ScopedOpenCvThreads& operator=(const ScopedOpenCvThreads&) = delete;
+
+ private:
+  int previous_;
+};
+
 }  // namespace
+
+TrackerOptions TrackerOptionsFrom(const FrontendOptions& options) {
+  TrackerOptions tracker;
+  tracker.target_features = options.target_features_per_view;
+  tracker.min_feature_distance_px = options.min_feature_distance_px;
+  tracker.fast_threshold = options.fast_threshold;
+  tracker.max_forward_backward_px = options.max_forward_backward_px;
+  tracker.klt_window_px = options.klt_window_px;
+  tracker.klt_levels = options.klt_levels;
+  tracker.klt_max_iterations = options.klt_max_iterations;
+  tracker.klt_epsilon_px = options.klt_epsilon_px;
+  return tracker;
+}
 
 struct Frontend::Impl {
   Rig rig;
@@ -71,14 +106,7 @@ Frontend::Frontend(const Rig& rig, const FrontendOptions& options) : impl_(std::
   tbb::parallel_for(0, rig.NumCameras(), [&](int i) {
     s.projections[i] = HybridProjection(rig.cameras[i].camera, rig.cameras[i].cam_from_rig, s.layouts[i], options.projection);
   });
-  TrackerOptions tracker_options;
-  tracker_options.target_features = options.target_features_per_view;
-  tracker_options.min_feature_distance_px = options.min_feature_distance_px;
-  tracker_options.fast_threshold = options.fast_threshold;
-  tracker_options.max_forward_backward_px = options.max_forward_backward_px;
-  tracker_options.klt_window_px = options.klt_window_px;
-  tracker_options.klt_levels = options.klt_levels;
-  s.trackers.assign(rig.NumCameras(), ViewTracker(tracker_options));
+  s.trackers.assign(rig.NumCameras(), ViewTracker(TrackerOptionsFrom(s.options)));
   s.warped.resize(rig.NumCameras());
   s.fisheye_gray.resize(rig.NumCameras());
   s.UpdatePairs();
@@ -100,6 +128,7 @@ void Frontend::SetExtrinsics(const std::vector<Rigid3>& cam_from_rig) {
     throw std::invalid_argument("Frontend::SetExtrinsics: " + std::to_string(cam_from_rig.size()) +
                                 " extrinsics for " + std::to_string(s.rig.NumCameras()) + " cameras");
   }
+  const ScopedOpenCvThreads serial_opencv(1);
   s.rig = s.rig.WithExtrinsics(cam_from_rig);
   s.layouts = ComputeHybridLayouts(s.rig);
   s.UpdatePairs();
@@ -148,42 +177,67 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
     }
   }
   FrontendFrame frame;
+  const ScopedOpenCvThreads serial_opencv(1);
 
-  auto start = std::chrono::steady_clock::now();
-  double cpu_start = CpuMs();
+  // The per-view stages (warp, track, detect + describe, bearings) run fused in one parallel loop
+  // over the views, without a barrier between stages. Stage times are the section's wall and CPU
+  // time apportioned by each stage's share of the per-view wall durations summed over the views.
+  enum { kWarp, kTrack, kDetect, kBearings, kStages };
+  std::vector<std::array<double, kStages>> view_ms(n);
+  // Bearings of all points (exact, from the warped pixels), shared by matching and the output.
+  std::vector<std::vector<std::optional<Eigen::Vector3d>>> bearings_in_cam(n);
+  const auto section_start = std::chrono::steady_clock::now();
+  const double section_cpu_start = CpuMs();
   tbb::parallel_for(0, n, [&](int i) {
+    auto start = std::chrono::steady_clock::now();
+    const auto lap = [&](int stage) {
+      const auto now = std::chrono::steady_clock::now();
+      view_ms[i][stage] = std::chrono::duration<double, std::milli>(now - start).count();
+      start = now;
+    };
     s.fisheye_gray[i] = ToGray(fisheye_images[i], i);
     cv::Mat warped;
     s.projections[i].Warp(s.fisheye_gray[i], &warped);
     s.warped[i] = warped;
+    lap(kWarp);
+    s.trackers[i].Track(s.warped[i], s.projections[i].valid_mask());
+    lap(kTrack);
+    s.trackers[i].DetectAndDescribe([] { return uint64_t{0}; });  // ids below
+    lap(kDetect);
+    const auto& points = s.trackers[i].points();
+    bearings_in_cam[i].reserve(points.size());
+    for (const TrackedPoint& p : points) {
+      bearings_in_cam[i].push_back(s.projections[i].BearingFromWarped(Eigen::Vector2d(p.px.x, p.px.y)));
+    }
+    lap(kBearings);
   });
-  frame.ms_warp = MsSince(start);
-  frame.cpu_ms_warp = CpuMs() - cpu_start;
-
-  start = std::chrono::steady_clock::now();
-  cpu_start = CpuMs();
-  tbb::parallel_for(0, n, [&](int i) { s.trackers[i].Track(s.warped[i], s.projections[i].valid_mask()); });
-  frame.ms_track = MsSince(start);
-  frame.cpu_ms_track = CpuMs() - cpu_start;
-
-  // New points get id 0 in parallel, then ids in camera order (deterministic).
-  start = std::chrono::steady_clock::now();
-  cpu_start = CpuMs();
-  tbb::parallel_for(0, n, [&](int i) { s.trackers[i].DetectAndDescribe([] { return uint64_t{0}; }); });
+  // New points got id 0 in parallel; ids in camera order (deterministic).
   for (int i = 0; i < n; ++i) {
     for (TrackedPoint& p : s.trackers[i].points()) {
       if (p.track_id == 0) p.track_id = ++s.last_id;
     }
   }
-  frame.ms_detect = MsSince(start);
-  frame.cpu_ms_detect = CpuMs() - cpu_start;
+  const double section_ms = MsSince(section_start), section_cpu_ms = CpuMs() - section_cpu_start;
+  std::array<double, kStages> stage_sum{};
+  for (const auto& times : view_ms) {
+    for (int k = 0; k < kStages; ++k) stage_sum[k] += times[k];
+  }
+  double all_stages = 0;
+  for (double t : stage_sum) all_stages += t;
+  const auto share = [&](int stage) { return all_stages > 0 ? stage_sum[stage] / all_stages : 0.25; };
+  frame.ms_warp = section_ms * share(kWarp);
+  frame.ms_track = section_ms * share(kTrack);
+  frame.ms_detect = section_ms * share(kDetect);
+  frame.cpu_ms_warp = section_cpu_ms * share(kWarp);
+  frame.cpu_ms_track = section_cpu_ms * share(kTrack);
+  frame.cpu_ms_detect = section_cpu_ms * share(kDetect);
 
-  start = std::chrono::steady_clock::now();
-  cpu_start = CpuMs();
+  const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = CpuMs();
   s.last_matches.clear();
   if (s.options.match_between_views && !s.pairs.empty()) {
     std::vector<MatchView> views(n);
-    tbb::parallel_for(0, n, [&](int i) {
+    for (int i = 0; i < n; ++i) {
       const Eigen::Matrix3d rig_from_cam = s.rig.cameras[i].cam_from_rig.RotationMatrix().transpose();
       views[i].points = &s.trackers[i].points();
       views[i].centre_in_rig = s.rig.cameras[i].cam_from_rig.Inverse().translation;
@@ -195,12 +249,11 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
         if (px && !projection->InWarpedImage(*px)) px.reset();
         return px;
       };
-      views[i].bearings_in_rig.reserve(s.trackers[i].points().size());
-      for (const TrackedPoint& p : s.trackers[i].points()) {
-        const auto bearing = s.projections[i].BearingFromWarped(Eigen::Vector2d(p.px.x, p.px.y));
+      views[i].bearings_in_rig.reserve(bearings_in_cam[i].size());
+      for (const auto& bearing : bearings_in_cam[i]) {
         views[i].bearings_in_rig.push_back(bearing ? Eigen::Vector3d(rig_from_cam * *bearing) : Eigen::Vector3d::Zero());
       }
-    });
+    }
     std::vector<std::vector<InterviewMatch>> pair_matches(s.pairs.size());
     tbb::parallel_for(0, static_cast<int>(s.pairs.size()), [&](int k) {
       const auto [a, b] = s.pairs[k];
@@ -243,14 +296,16 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
       }
     }
   }
-  frame.ms_match = MsSince(start);
-  frame.cpu_ms_match = CpuMs() - cpu_start;
+  frame.ms_match = MsSince(start) + section_ms * share(kBearings);
+  frame.cpu_ms_match = CpuMs() - cpu_start + section_cpu_ms * share(kBearings);
 
   frame.features_per_camera.resize(n);
   for (int i = 0; i < n; ++i) {
     auto& out = frame.features_per_camera[i];
-    for (const TrackedPoint& p : s.trackers[i].points()) {
-      const auto bearing = s.projections[i].BearingFromWarped(Eigen::Vector2d(p.px.x, p.px.y));
+    const auto& points = s.trackers[i].points();
+    for (size_t k = 0; k < points.size(); ++k) {
+      const TrackedPoint& p = points[k];
+      const auto& bearing = bearings_in_cam[i][k];
       if (!bearing) continue;
       Feature f;
       f.track_id = p.track_id;

@@ -71,42 +71,73 @@ std::optional<double> Zncc(const cv::Mat& image_a, cv::Point2f a, const cv::Mat&
 
 namespace {
 
-// Patch of side patch_px around the nearest pixel of p (row-major); false when it leaves the image.
-bool NearestPatch(const cv::Mat& image, const Eigen::Vector2d& p, int patch_px, float* out) {
-  const int half = patch_px / 2;
+// A reference patch for ZNCC against many candidate patches: the 8-bit values of the
+// patch_px x patch_px pixels around the nearest pixel of a point, with their sum and sum of squares.
+// ZNCC in integer sums (exact, no per-candidate copy):
+//   zncc = (n S_ab - S_a S_b) / sqrt((n S_aa - S_a^2) (n S_bb - S_b^2)),  n = patch_px^2.
+struct ReferencePatch {
+  std::vector<uint8_t> values;  // row-major
+  int side = 0;
+  int64_t sum = 0, variance_n2 = 0;  // S_a and n S_aa - S_a^2
+};
+
+// Top-left corner of the patch around the nearest pixel of p; false when the patch leaves the image.
+bool PatchCorner(const cv::Mat& image, const Eigen::Vector2d& p, int side, int* x0, int* y0) {
+  const int half = side / 2;
   const int x = static_cast<int>(std::lround(p.x())), y = static_cast<int>(std::lround(p.y()));
   if (x < half || y < half || x + half >= image.cols || y + half >= image.rows) return false;
-  for (int r = 0; r < patch_px; ++r) {
-    const uint8_t* row = image.ptr<uint8_t>(y - half + r) + (x - half);
-    for (int c = 0; c < patch_px; ++c) *out++ = row[c];
-  }
+  *x0 = x - half;
+  *y0 = y - half;
   return true;
 }
 
-// Makes `patch` zero-mean and unit-norm; false when it is flat.
-bool Normalise(std::vector<float>* patch) {
-  double sum = 0, sum2 = 0;
-  for (float v : *patch) sum += v, sum2 += double(v) * v;
-  const double n = static_cast<double>(patch->size());
-  const double variance = sum2 - sum * sum / n;
-  if (variance < 1e-6 * n) return false;
-  const double mean = sum / n, scale = 1.0 / std::sqrt(variance);
-  for (float& v : *patch) v = static_cast<float>((v - mean) * scale);
-  return true;
+// A patch is flat when its variance is below 1e-6 grey levels^2 (n S_aa - S_a^2 < 1e-6 n^2).
+bool Flat(int64_t variance_n2, int n) { return static_cast<double>(variance_n2) < 1e-6 * n * n; }
+
+// False when the patch leaves the image or is flat.
+bool LoadReference(const cv::Mat& image, const Eigen::Vector2d& p, int side, ReferencePatch* patch) {
+  int x0, y0;
+  if (!PatchCorner(image, p, side, &x0, &y0)) return false;
+  patch->side = side;
+  patch->values.resize(static_cast<size_t>(side) * side);
+  int64_t sum = 0, sum2 = 0;
+  uint8_t* out = patch->values.data();
+  for (int r = 0; r < side; ++r) {
+    const uint8_t* row = image.ptr<uint8_t>(y0 + r) + x0;
+    for (int c = 0; c < side; ++c) {
+      *out++ = row[c];
+      sum += row[c];
+      sum2 += row[c] * row[c];
+    }
+  }
+  const int n = side * side;
+  patch->sum = sum;
+  patch->variance_n2 = n * sum2 - sum * sum;
+  return !Flat(patch->variance_n2, n);
 }
 
-// ZNCC of a normalised patch with a raw one: sum(a_hat * b) / sqrt(sum(b^2) - sum(b)^2 / n).
-std::optional<double> ZnccNormalised(const std::vector<float>& a_hat, const float* b) {
-  double ab = 0, sb = 0, sb2 = 0;
-  for (size_t i = 0; i < a_hat.size(); ++i) {
-    ab += a_hat[i] * b[i];
-    sb += b[i];
-    sb2 += double(b[i]) * b[i];
+// ZNCC of the reference with the patch around the nearest pixel of p in `image`; nullopt when that
+// patch leaves the image or is flat.
+std::optional<double> ZnccWithReference(const ReferencePatch& reference, const cv::Mat& image, const Eigen::Vector2d& p) {
+  const int side = reference.side;
+  int x0, y0;
+  if (!PatchCorner(image, p, side, &x0, &y0)) return std::nullopt;
+  int32_t ab = 0, sb = 0, sb2 = 0;  // at most 121 * 255^2 < 2^23 for an 11 px patch
+  const uint8_t* a = reference.values.data();
+  for (int r = 0; r < side; ++r, a += side) {
+    const uint8_t* row = image.ptr<uint8_t>(y0 + r) + x0;
+    for (int c = 0; c < side; ++c) {
+      const int32_t b = row[c];
+      ab += a[c] * b;
+      sb += b;
+      sb2 += b * b;
+    }
   }
-  const double n = static_cast<double>(a_hat.size());
-  const double variance = sb2 - sb * sb / n;
-  if (variance < 1e-6 * n) return std::nullopt;
-  return ab / std::sqrt(variance);
+  const int n = side * side;
+  const int64_t variance_n2 = int64_t{n} * sb2 - int64_t{sb} * sb;
+  if (Flat(variance_n2, n)) return std::nullopt;
+  const double covariance_n2 = static_cast<double>(int64_t{n} * ab - reference.sum * sb);
+  return covariance_n2 / std::sqrt(static_cast<double>(reference.variance_n2) * static_cast<double>(variance_n2));
 }
 
 }  // namespace
@@ -116,10 +147,9 @@ bool UniqueAlongEpipolarCurve(const cv::Mat& patch_image, cv::Point2f patch_cent
                               const Eigen::Vector3d& centre_moving, const Eigen::Vector3d& bearing_moving,
                               double focal_px, const InterviewMatchOptions& options) {
   if (!view.pixel_from_direction_in_rig || view.image == nullptr) return true;
-  const int side = options.zncc_patch_px;
-  std::vector<float> reference(static_cast<size_t>(side) * side), sample(reference.size());
-  if (!NearestPatch(patch_image, Eigen::Vector2d(patch_centre.x, patch_centre.y), side, reference.data()) ||
-      !Normalise(&reference)) {
+  ReferencePatch reference;
+  if (options.zncc_patch_px > 45 ||  // keeps the integer sums of ZnccWithReference below 2^31
+      !LoadReference(patch_image, Eigen::Vector2d(patch_centre.x, patch_centre.y), options.zncc_patch_px, &reference)) {
     return false;
   }
   // The plane through the baseline and the matched bearing: the epipolar plane of the fixed
@@ -157,8 +187,7 @@ bool UniqueAlongEpipolarCurve(const cv::Mat& patch_image, cv::Point2f patch_cent
       const double t = static_cast<double>(k % kKnot) / kKnot;
       px = (1.0 - t) * *p0 + t * *knots[knot + 1];
     }
-    if (!NearestPatch(*view.image, px, side, sample.data())) continue;
-    const auto z = ZnccNormalised(reference, sample.data());
+    const auto z = ZnccWithReference(reference, *view.image, px);
     if (!z) continue;
     score[k] = static_cast<float>(*z);
     distance[k] = static_cast<float>((px - *centre_px).norm());
@@ -168,8 +197,9 @@ bool UniqueAlongEpipolarCurve(const cv::Mat& patch_image, cv::Point2f patch_cent
     double best = -2.0;
     for (int dy = -1; dy <= 1; ++dy) {
       for (int dx = -1; dx <= 1; ++dx) {
-        if (!NearestPatch(*view.image, px + Eigen::Vector2d(dx, dy), side, sample.data())) continue;
-        if (const auto z = ZnccNormalised(reference, sample.data())) best = std::max(best, *z);
+        if (const auto z = ZnccWithReference(reference, *view.image, px + Eigen::Vector2d(dx, dy))) {
+          best = std::max(best, *z);
+        }
       }
     }
     return best;

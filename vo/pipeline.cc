@@ -687,6 +687,10 @@ VoSummary RunVo(const VoOptions& options) {
     ms.detect += features.ms_detect;
     ms.track += features.ms_track;
     ms.match += features.ms_match;
+    ms.cpu_warp += features.cpu_ms_warp;
+    ms.cpu_detect += features.cpu_ms_detect;
+    ms.cpu_track += features.cpu_ms_track;
+    ms.cpu_match += features.cpu_ms_match;
     ms.ransac += result.ms_ransac;
     ms.refine += result.ms_refine;
     ms.triangulate += result.ms_triangulate;
@@ -716,8 +720,9 @@ VoSummary RunVo(const VoOptions& options) {
   if (auto update = backend.FinishPendingBa()) apply_ba_update(*update);
   progress.Finish();
   const double n = std::max(1, summary.frames);
-  for (double* v : {&ms.warp, &ms.detect, &ms.track, &ms.match, &ms.load, &ms.ransac, &ms.refine, &ms.triangulate,
-                    &ms.ba, &ms.ba_wait, &ms.backend_total, &ms.total}) {
+  for (double* v : {&ms.warp, &ms.detect, &ms.track, &ms.match, &ms.cpu_warp, &ms.cpu_detect, &ms.cpu_track,
+                    &ms.cpu_match, &ms.load, &ms.ransac, &ms.refine, &ms.triangulate, &ms.ba, &ms.ba_wait,
+                    &ms.backend_total, &ms.total}) {
     *v /= n;
   }
   ms.ransac_us_per_hypothesis = total_hypotheses > 0 ? ms.ransac * n * 1000.0 / total_hypotheses : 0.0;

@@ -67,6 +67,7 @@ struct VoOptions {
 // Mean wall time per processed frame, by stage, in milliseconds.
 struct VoStageTimes {
   double warp = 0, detect = 0, track = 0, match = 0;  // front-end (FrontendFrame::ms_*)
+  double cpu_warp = 0, cpu_detect = 0, cpu_track = 0, cpu_match = 0;  // front-end CPU, all threads (cpu_ms_*)
   double load = 0;  // waiting for the images (read on a second thread while the previous frame runs)
   double ransac = 0, refine = 0, triangulate = 0, backend_total = 0;
   double ba = 0;       // keyframe BA solve (on its own thread with async BA)

@@ -227,13 +227,8 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
     }
   }
 
-  TrackerOptions tracker_options;
+  TrackerOptions tracker_options = TrackerOptionsFrom(frontend_options);
   tracker_options.target_features = options.features_per_view;
-  tracker_options.min_feature_distance_px = frontend_options.min_feature_distance_px;
-  tracker_options.fast_threshold = frontend_options.fast_threshold;
-  tracker_options.max_forward_backward_px = frontend_options.max_forward_backward_px;
-  tracker_options.klt_window_px = frontend_options.klt_window_px;
-  tracker_options.klt_levels = frontend_options.klt_levels;
   Arm fisheye_arm, hybrid_arm;
   for (Arm* arm : {&fisheye_arm, &hybrid_arm}) {
     arm->trackers.assign(n, ViewTracker(tracker_options));

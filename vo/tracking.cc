@@ -118,6 +118,7 @@ ViewTracker::ViewTracker(const TrackerOptions& options) : options_(options) {}
 void ViewTracker::Clear() {
   image_.release();
   pyramid_.clear();
+  spare_pyramid_.clear();
   points_.clear();
   descriptors_.release();
 }
@@ -138,7 +139,7 @@ int ViewTracker::Track(const cv::Mat& image, const cv::Mat& mask) {
   if (image.type() != CV_8UC1) throw std::invalid_argument("ViewTracker: image must be 8-bit gray");
   if (mask.size() != image.size()) throw std::invalid_argument("ViewTracker: mask size differs from the image");
   const cv::Size window(options_.klt_window_px, options_.klt_window_px);
-  std::vector<cv::Mat> pyramid;
+  std::vector<cv::Mat>& pyramid = spare_pyramid_;  // reuses the buffers of two frames ago
   cv::buildOpticalFlowPyramid(image, pyramid, window, options_.klt_levels);
   if (detect_mask_.size() != mask.size() || detect_mask_.empty()) {
     detect_mask_ = DetectionMask(mask, options_.border_px);
@@ -150,18 +151,30 @@ int ViewTracker::Track(const cv::Mat& image, const cv::Mat& mask) {
     for (const TrackedPoint& p : points_) previous.push_back(p.px);
     std::vector<uint8_t> status_fw, status_bw;
     std::vector<float> error;
-    const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
+    const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, options_.klt_max_iterations,
+                                    options_.klt_epsilon_px);
     cv::calcOpticalFlowPyrLK(pyramid_, pyramid, previous, forward, status_fw, error, window, options_.klt_levels,
                              criteria);
-    backward = previous;
-    cv::calcOpticalFlowPyrLK(pyramid, pyramid_, forward, backward, status_bw, error, window, options_.klt_levels,
-                             criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
-    const float max_fb2 = options_.max_forward_backward_px * options_.max_forward_backward_px;
+    // Backward pass only for the forward successes that land in the detection area (each point's
+    // LK is independent of the others, so this only skips work whose result would be dropped).
+    std::vector<int> candidates;
+    std::vector<cv::Point2f> forward_ok;
     for (size_t i = 0; i < points_.size(); ++i) {
-      if (!status_fw[i] || !status_bw[i]) continue;
-      const cv::Point2f d = backward[i] - previous[i];
+      if (!status_fw[i] || !MaskAt(detect_mask_, forward[i])) continue;
+      candidates.push_back(static_cast<int>(i));
+      forward_ok.push_back(forward[i]);
+      backward.push_back(previous[i]);
+    }
+    if (!candidates.empty()) {
+      cv::calcOpticalFlowPyrLK(pyramid, pyramid_, forward_ok, backward, status_bw, error, window, options_.klt_levels,
+                               criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
+    }
+    const float max_fb2 = options_.max_forward_backward_px * options_.max_forward_backward_px;
+    for (size_t k = 0; k < candidates.size(); ++k) {
+      const int i = candidates[k];
+      if (!status_bw[k]) continue;
+      const cv::Point2f d = backward[k] - previous[i];
       if (d.dot(d) > max_fb2) continue;
-      if (!MaskAt(detect_mask_, forward[i])) continue;
       TrackedPoint p = points_[i];
       p.px = forward[i];
       ++p.age;
@@ -183,7 +196,7 @@ int ViewTracker::Track(const cv::Mat& image, const cv::Mat& mask) {
   }
   points_ = std::move(kept);
   image_ = image;
-  pyramid_ = std::move(pyramid);
+  std::swap(pyramid_, spare_pyramid_);
   return static_cast<int>(points_.size());
 }
 

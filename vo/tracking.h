@@ -20,8 +20,10 @@ struct TrackerOptions {
   int target_features = 600;         // per view; re-detect when fewer are tracked
   float min_feature_distance_px = 12.0f;  // between any two features (detections and tracks)
   int fast_threshold = 12;           // FAST-9 intensity threshold
-  int klt_window_px = 21;            // KLT window side
+  int klt_window_px = 15;            // KLT window side (FrontendOptions explains the choice)
   int klt_levels = 3;                // pyramid levels above the base
+  int klt_max_iterations = 20;       // LK iterations per pyramid level (at most)
+  float klt_epsilon_px = 0.03f;      // LK stops a level when its update is below this (pixels)
   float max_forward_backward_px = 1.0f;  // forward-backward KLT round-trip error
   int border_px = 20;                // features keep this distance from invalid pixels and image edges (ORB patch)
 };
@@ -57,7 +59,10 @@ class ViewTracker {
  private:
   TrackerOptions options_;
   cv::Mat image_, detect_mask_;
-  std::vector<cv::Mat> pyramid_;
+  // KLT pyramids (cv::buildOpticalFlowPyramid with derivatives) of the current image and a spare
+  // whose buffers the next frame's pyramid reuses: each image's pyramid is built once and serves
+  // the forward pass of the next frame and the backward pass of this one.
+  std::vector<cv::Mat> pyramid_, spare_pyramid_;
   std::vector<TrackedPoint> points_;
   cv::Mat descriptors_;
 };

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <vector>
 
 namespace rovo {
 namespace {
@@ -48,7 +50,7 @@ TEST(MipTextureTest, PyramidSizesAndBoxFilterPreservesMean) {
   for (int y = 0; y < 8; ++y)
     for (int x = 0; x < 16; ++x) mean0 += mip.Texel(0, x, y);
   mean0 /= 128.0f;
-  // Reduced levels are stored as 8-bit sRGB: the exact mean, rounded once (half a code).
+  // Reduced levels are stored as 16-bit linear: the exact mean, well within half an 8-bit code.
   auto srgb_step = [](const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
     float worst = 0.0f;
     for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(LinearToSrgb(a[c]) - LinearToSrgb(b[c])) * 255.0f);
@@ -94,6 +96,49 @@ TEST(MipTextureTest, TrilinearBlendsLevelsAndClamps) {
   EXPECT_LT((mip.Sample(u, v, -3.0f) - mip.SampleLevel(u, v, 0)).norm(), 1e-6f);
   EXPECT_LT((mip.Sample(u, v, 100.0f) - mip.Texel(3, 0, 0)).norm(), 1e-6f);
   EXPECT_LT((mip.Sample(u, v, std::nanf("")) - mip.SampleLevel(u, v, 0)).norm(), 1e-6f);
+}
+
+TEST(MipTextureTest, BatchLookupsEqualSingleLookupsBitForBit) {
+  // Mixed textures (odd, non-power-of-two, 1x1) and levels in one batch, coordinates outside
+  // [0, 1), non-finite values, integer and out-of-range levels of detail; 203 lookups cover
+  // several 64-lookup chunks and a partial group of four.
+  std::vector<MipTexture> textures;
+  textures.emplace_back(Gradient(16, 8));
+  textures.emplace_back(Gradient(13, 7));
+  textures.emplace_back(Gradient(1, 1));
+  textures.emplace_back(Gradient(40, 3));
+  const float specials[] = {0.0f, 1.0f, -1.0f, 0.999999f, -0.0f, 2e9f, -3e9f, std::nanf(""), INFINITY, 5.5f};
+  const float lods[] = {-1.0f, 0.0f, 1.0f, 2.0f, 0.5f, 1.75f, 3.999f, 7.0f, 100.0f, std::nanf("")};
+  constexpr int kN = 203;
+  std::vector<const MipTexture*> tex(kN);
+  std::vector<float> u(kN), v(kN), lod(kN);
+  uint32_t state = 12345;
+  auto next = [&] {
+    state = state * 1664525u + 1013904223u;
+    return static_cast<float>(state >> 8) / 16777216.0f;
+  };
+  for (int k = 0; k < kN; ++k) {
+    tex[k] = &textures[k % 7 % textures.size()];
+    u[k] = k % 11 == 0 ? specials[k % 10] : 6.0f * next() - 3.0f;
+    v[k] = k % 13 == 0 ? specials[(k / 13) % 10] : 6.0f * next() - 3.0f;
+    lod[k] = k % 3 == 0 ? lods[(k / 3) % 10] : 6.0f * next() - 1.0f;
+  }
+  for (const bool trilinear : {true, false}) {
+    __m128 out[kN];
+    MipTexture::SampleBatch(tex.data(), u.data(), v.data(), lod.data(), kN, out, trilinear);
+    for (int k = 0; k < kN; ++k) {
+      alignas(16) float batch[4], single[4];
+      _mm_store_ps(batch, out[k]);
+      const int nearest = std::isnan(lod[k]) || lod[k] + 0.5f < 0.0f
+                              ? 0
+                              : std::min(static_cast<int>(std::min(lod[k] + 0.5f, 1e6f)), tex[k]->NumLevels() - 1);
+      _mm_store_ps(single, trilinear ? tex[k]->Sample4(u[k], v[k], lod[k]) : tex[k]->SampleLevel4(u[k], v[k], nearest));
+      for (int c = 0; c < 3; ++c)
+        EXPECT_EQ(std::memcmp(&batch[c], &single[c], sizeof(float)), 0)
+            << (trilinear ? "trilinear" : "nearest level") << " lookup " << k << " channel " << c << ": " << batch[c]
+            << " vs " << single[c] << " (u " << u[k] << ", v " << v[k] << ", lod " << lod[k] << ")";
+    }
+  }
 }
 
 TEST(MipTextureTest, RejectsInconsistentSize) {
