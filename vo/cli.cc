@@ -120,8 +120,9 @@ void AddVoCommands(CliGroups& groups) {
                 {"back-end: RANSAC", t.ransac, -1},
                 {"back-end: refine", t.refine, -1},
                 {"back-end: triangulate", t.triangulate, -1},
-                {"back-end: local BA", t.ba, -1},
-                {"back-end: total", t.backend_total, -1},
+                {"back-end: local BA solve", t.ba, -1},
+                {"back-end: wait for BA", t.ba_wait, -1},
+                {"back-end: in-line total", t.backend_total, -1},
                 {"whole frame", t.total, -1}};
     for (const auto& row : rows) {
       if (row.cpu >= 0) {
@@ -131,6 +132,9 @@ void AddVoCommands(CliGroups& groups) {
       }
     }
     std::printf("RANSAC: %.2f us per hypothesis\n", t.ransac_us_per_hypothesis);
+    std::printf("local BA: %s\n", options.async_ba ? "solved on its own thread beside the next frame's front-end "
+                                                     "(in-line total = wait for it + the rest)"
+                                                   : "solved in line (--sync-ba)");
     std::printf("whole pipeline: %.2f frames/s (target 10 Hz)%s\n", t.total > 0 ? 1000.0 / t.total : 0.0,
                 options.preload_images ? ", images decoded beforehand" : ", images decoded on a second thread");
   });
