@@ -703,7 +703,8 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
         }
         const float nlen2 = normal.squaredNorm();
         normal = nlen2 > 0.0f ? Eigen::Vector3f(normal / std::sqrt(nlen2)) : Eigen::Vector3f(-dir);
-        if (normal.dot(dir) > 0.0f) normal = -normal;
+        const float facing = normal.dot(dir);  // -|n.d| after the flip (negation is exact)
+        if (facing > 0.0f) normal = -normal;
         tb.normal[h] = normal;
         if (raw) continue;
         const Impl::TriangleShade& ts = shade[rh.hit.primID];
@@ -718,7 +719,7 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
         tb.tex_v[k] = bw * ts.uv[1] + bu * ts.uv[3] + bv * ts.uv[5];
         // Ray-cone footprint in metres, then in texels of level 0.
         const size_t pi = static_cast<size_t>(ty0 + local / kTile) * width + tx0 + local % kTile;
-        const float cos_view = std::max(-normal.dot(dir), 0.1f);
+        const float cos_view = std::max(facing > 0.0f ? facing : -facing, 0.1f);  // -normal.dot(dir)
         const float texels = rh.ray.tfar * rays.pixel_angle[pi] / cos_view * inv_sqrt_spp * ts.texels_per_metre;
         tb.tex_lod[k] = texels > 0.0f ? FastLog2(texels) + settings.lod_bias : 0.0f;
       }
