@@ -190,7 +190,7 @@ struct MipTexture::Footprint4 {
   alignas(16) float ax[4], ay[4];
 };
 
-void MipTexture::Address4(const Level* const level[4], __m128 u01, __m128 v01, Footprint4* fp) {
+__attribute__((always_inline)) inline void MipTexture::Address4(const Level* const level[4], __m128 u01, __m128 v01, Footprint4* fp) {
   // Transpose the lanes' (fwidth, fheight, width, height) into one register per field.
   __m128 fw = _mm_loadu_ps(&level[0]->fwidth), fh = _mm_loadu_ps(&level[1]->fwidth);
   __m128 wf = _mm_loadu_ps(&level[2]->fwidth), hf = _mm_loadu_ps(&level[3]->fwidth);
@@ -238,7 +238,7 @@ inline void Prefetch(const uint64_t* texels, const uint32_t* const index[4], int
 
 }  // namespace
 
-__m128 MipTexture::Filter(const Footprint4& fp, int lane) {
+__attribute__((always_inline)) inline __m128 MipTexture::Filter(const Footprint4& fp, int lane) {
   const uint64_t* texels = fp.texels[lane];
   const __m128i zero = _mm_setzero_si128();
   auto load = [&](int corner) {

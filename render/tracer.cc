@@ -54,18 +54,18 @@ float Sobol2(uint32_t i) {
 
 float Wrap01(float x) { return x - std::floor(x); }
 
-// log2(x) for x > 0: exponent plus a quadratic in the mantissa m in [1, 2),
+// log2(x) for x > 0, per lane: exponent plus a quadratic in the mantissa m in [1, 2),
 // log2(m) ~ (m - 1) (1.3465 - 0.3465 (m - 1)); exact at powers of two, |error| < 0.01,
 // monotonic and continuous (a level-of-detail selector, not a math library).
-float FastLog2(float x) {
-  uint32_t bits;
-  std::memcpy(&bits, &x, sizeof bits);
-  const float exponent = static_cast<float>(static_cast<int>((bits >> 23) & 0xffu) - 127);
-  bits = (bits & 0x007fffffu) | 0x3f800000u;
-  float m;
-  std::memcpy(&m, &bits, sizeof m);
-  m -= 1.0f;
-  return exponent + m * (1.3465f - 0.3465f * m);
+__m128 FastLog2x4(__m128 x) {
+  const __m128i bits = _mm_castps_si128(x);
+  const __m128 exponent = _mm_cvtepi32_ps(
+      _mm_sub_epi32(_mm_and_si128(_mm_srli_epi32(bits, 23), _mm_set1_epi32(0xff)), _mm_set1_epi32(127)));
+  const __m128 m = _mm_sub_ps(
+      _mm_castsi128_ps(_mm_or_si128(_mm_and_si128(bits, _mm_set1_epi32(0x007fffff)), _mm_set1_epi32(0x3f800000))),
+      _mm_set1_ps(1.0f));
+  return _mm_add_ps(exponent,
+                    _mm_mul_ps(m, _mm_sub_ps(_mm_set1_ps(1.3465f), _mm_mul_ps(_mm_set1_ps(0.3465f), m))));
 }
 
 constexpr int kSunSamples = 64;
@@ -526,7 +526,8 @@ struct alignas(64) TileBuffers {
   // The hits with a texture lookup, compacted (index into the hit arrays).
   int textured_hit[kTilePixels];
   const MipTexture* texture[kTilePixels];
-  float tex_u[kTilePixels], tex_v[kTilePixels], tex_lod[kTilePixels];
+  float tex_u[kTilePixels], tex_v[kTilePixels];
+  alignas(16) float tex_lod[kTilePixels];
   __m128 texel[kTilePixels];  // the filtered texture colour
 };
 
@@ -703,7 +704,8 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
         }
         const float nlen2 = normal.squaredNorm();
         normal = nlen2 > 0.0f ? Eigen::Vector3f(normal / std::sqrt(nlen2)) : Eigen::Vector3f(-dir);
-        if (normal.dot(dir) > 0.0f) normal = -normal;
+        const float facing = normal.dot(dir);  // after the flip n.d = -|facing| exactly
+        if (facing > 0.0f) normal = -normal;
         tb.normal[h] = normal;
         if (raw) continue;
         const Impl::TriangleShade& ts = shade[rh.hit.primID];
@@ -718,12 +720,20 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
         tb.tex_v[k] = bw * ts.uv[1] + bu * ts.uv[3] + bv * ts.uv[5];
         // Ray-cone footprint in metres, then in texels of level 0.
         const size_t pi = static_cast<size_t>(ty0 + local / kTile) * width + tx0 + local % kTile;
-        const float cos_view = std::max(-normal.dot(dir), 0.1f);
+        const float cos_view = std::max(facing > 0.0f ? facing : -facing, 0.1f);  // -normal.dot(dir)
         const float texels = rh.ray.tfar * rays.pixel_angle[pi] / cos_view * inv_sqrt_spp * ts.texels_per_metre;
-        tb.tex_lod[k] = texels > 0.0f ? FastLog2(texels) + settings.lod_bias : 0.0f;
+        tb.tex_lod[k] = texels;  // turned into the level of detail below, four at a time
       }
 
       if (num_textured > 0) {
+        // lod = FastLog2(texels) + bias where texels > 0, else 0.
+        for (int k = num_textured; k % 4 != 0; ++k) tb.tex_lod[k] = 0.0f;
+        const __m128 bias = _mm_set1_ps(settings.lod_bias);
+        for (int k = 0; k < num_textured; k += 4) {
+          const __m128 texels = _mm_load_ps(tb.tex_lod + k);
+          _mm_store_ps(tb.tex_lod + k, _mm_and_ps(_mm_cmpgt_ps(texels, _mm_setzero_ps()),
+                                                  _mm_add_ps(FastLog2x4(texels), bias)));
+        }
         MipTexture::SampleBatch(tb.texture, tb.tex_u, tb.tex_v, tb.tex_lod, num_textured, tb.texel, settings.trilinear);
         for (int k = 0; k < num_textured; ++k) {
           const int h = tb.textured_hit[k];

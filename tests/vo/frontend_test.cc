@@ -5,8 +5,10 @@
 #include "datasets/rig.h"
 
 #include <gtest/gtest.h>
+#include <opencv2/core/utility.hpp>
 #include <tbb/global_control.h>
 
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <set>
@@ -197,7 +199,7 @@ TEST_F(FrontendBox, DeterministicIds) {
 }
 
 // The whole output (ids, sub-pixel positions, merges, matches), including a warp-map rebuild by
-// SetExtrinsics, is identical for 1, 2 and 4 TBB threads (OpenCV runs on the same TBB pool).
+// SetExtrinsics, is identical for 1, 2 and 4 TBB threads (OpenCV runs serially inside each view).
 TEST_F(FrontendBox, IdenticalForAnyThreadCount) {
   const auto run = [](int threads) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
@@ -242,6 +244,37 @@ TEST_F(FrontendBox, IdenticalForAnyThreadCount) {
       }
     }
   }
+}
+
+// Process sets OpenCV's thread count to 1 only while it runs; the fused per-view stages report times
+// that split the call's wall time (they sum to at most the wall time of the call).
+TEST_F(FrontendBox, RestoresOpenCvThreadsAndSplitsStageTimes) {
+  const int original = cv::getNumThreads();
+  cv::setNumThreads(2);
+  const int before = cv::getNumThreads();
+  ASSERT_NE(before, 1);  // so that a missing restore would show
+  FrontendOptions options;
+  options.target_features_per_view = 200;
+  Frontend frontend(*rig_, options);
+  for (int k = 0; k < 2; ++k) {
+    const auto start = std::chrono::steady_clock::now();
+    const FrontendFrame frame = frontend.Process(frames_[k]);
+    const double wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_EQ(cv::getNumThreads(), before);
+    for (double ms : {frame.ms_warp, frame.ms_track, frame.ms_detect, frame.ms_match, frame.cpu_ms_warp,
+                      frame.cpu_ms_track, frame.cpu_ms_detect, frame.cpu_ms_match}) {
+      EXPECT_GE(ms, 0.0);
+    }
+    EXPECT_GT(frame.ms_warp, 0.0);
+    EXPECT_GT(frame.ms_detect, 0.0);
+    EXPECT_LE(frame.ms_warp + frame.ms_track + frame.ms_detect + frame.ms_match, wall_ms + 1e-6);
+    if (k == 1) {
+      EXPECT_GT(frame.ms_track, 0.0);  // the first frame only stores its image
+    }
+  }
+  frontend.SetExtrinsics(rig_->Extrinsics());
+  EXPECT_EQ(cv::getNumThreads(), before);
+  cv::setNumThreads(original);
 }
 
 TEST_F(FrontendBox, ExtrinsicUpdatesRebuildOnlyPastTheThreshold) {
