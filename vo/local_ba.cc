@@ -9,6 +9,13 @@
 namespace rovo {
 namespace {
 
+// [v]x, the cross-product matrix: [v]x w = v x w.
+Eigen::Matrix3d Hat(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d h;
+  h << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return h;
+}
+
 // Rotation matrix of an angle-axis vector phi (Rodrigues, the convention of ceres::AngleAxisRotatePoint)
 // and the right Jacobian of SO(3): R(phi + d) = R(phi) Exp(Jr(phi) d) + O(d^2),
 //   R  = I + sin(th)/th [phi]x + (1 - cos(th))/th^2 [phi]x^2,
@@ -28,17 +35,10 @@ void RotationAndRightJacobian(const double* phi, Eigen::Matrix3d* rotation, Eige
     b = (1.0 - co) / th2;
     c = (th - s) / (th2 * th);
   }
-  Eigen::Matrix3d hat;
-  hat << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  const Eigen::Matrix3d hat = Hat(v);
   const Eigen::Matrix3d hat2 = hat * hat;
   *rotation = Eigen::Matrix3d::Identity() + a * hat + b * hat2;
   if (right_jacobian) *right_jacobian = Eigen::Matrix3d::Identity() - b * hat + c * hat2;
-}
-
-Eigen::Matrix3d Hat(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d h;
-  h << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return h;
 }
 
 }  // namespace

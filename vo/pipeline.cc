@@ -277,7 +277,7 @@ std::optional<VoBackend::BaUpdate> VoBackend::FinishPendingBa() {
 
 BackendFrameResult VoBackend::ProcessFrame(int frame, const FrontendFrame& frontend) {
   BackendFrameResult result;
-  if (auto update = FinishPendingBa()) result.ms_ba_wait = update->ms_wait;
+  FinishPendingBa();  // callers that want the keyframe's refined pose call it themselves first
   FrameRecord& rec = result.record;
   rec.frame = frame;
   for (const auto& [from, into] : frontend.merged_ids) map_.Merge(from, into);
@@ -429,7 +429,6 @@ BackendFrameResult VoBackend::ProcessFrame(int frame, const FrontendFrame& front
         });
         result.world_from_rig = rig_from_world.Inverse();  // before BA: see FinishPendingBa
         result.num_landmarks = static_cast<int>(map_.NumWithPoint());
-        result.ba_pending = true;
         return result;
       }
       SolvePending(&pending->problem, pending->options, &pending->report, &pending->ms_solve);
@@ -482,8 +481,8 @@ struct LoadedFrame {
   std::string problems;
 };
 
-// Reads frame f+1's images on a second thread while frame f is processed (PNG decoding is the
-// largest single cost of a frame; the back-end's BA is single-threaded, so a core is usually free).
+// Reads frame f+1's images on a second thread while frame f is processed (PNG decoding costs about
+// 30 CPU-ms per full-size view; it overlaps the front-end's and the BA's less parallel stretches).
 class ImagePrefetcher {
  public:
   ImagePrefetcher(const std::string& dataset_dir, const Rig& rig, int begin, int end)

@@ -121,11 +121,9 @@ struct BackendOptions {
 };
 
 struct BackendFrameResult {
-  Rigid3 world_from_rig;
+  Rigid3 world_from_rig;     // with async_ba on a keyframe: before its BA (FinishPendingBa gives the refined one)
   FrameRecord record;        // status, counts, errors (frame and timestamp filled by the caller)
-  double ms_ransac = 0, ms_refine = 0, ms_triangulate = 0, ms_ba = 0;
-  double ms_ba_wait = 0;     // async_ba: waiting for the previous keyframe's BA
-  bool ba_pending = false;   // async_ba: a keyframe BA was started; world_from_rig is its input pose
+  double ms_ransac = 0, ms_refine = 0, ms_triangulate = 0, ms_ba = 0;  // ms_ba: synchronous BA only
   int ransac_hypotheses = 0;
   int num_landmarks = 0;
 };
