@@ -291,10 +291,12 @@ std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
 
   // 2. VO runs.
   std::vector<VoJob> jobs;
-  std::vector<int> frame_ends;  // per preset: runs cover frames [0, end)
+  std::vector<int> frame_ends;      // per preset: runs cover frames [0, end)
+  std::vector<int> dataset_frames;  // per preset: frames of the dataset
   for (size_t i = 0; i < presets.size(); ++i) {
     const DatasetInfo info = ReadDatasetInfo(dataset_dirs[i]);
     frame_ends.push_back(options.frames > 0 ? std::min(options.frames, info.frame_count) : info.frame_count);
+    dataset_frames.push_back(info.frame_count);
     if (static_cast<int>(info.perturbed.size()) < options.noise_sets) {
       throw std::runtime_error(DatasetJsonPath(dataset_dirs[i]) + ": field \"perturbed\" holds " +
                                std::to_string(info.perturbed.size()) + " noise sets, --seeds asks for " +
@@ -381,7 +383,7 @@ std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
     summary.preset = presets[i];
     summary.dataset_dir = fs::absolute(dataset_dirs[i]).lexically_normal().string();
     summary.frames = frame_ends[i];
-    summary.dataset_frames = ReadDatasetInfo(dataset_dirs[i]).frame_count;
+    summary.dataset_frames = dataset_frames[i];
     std::vector<RunMetrics> metrics;
     for (size_t r = 0; r < evaluations.size(); ++r) {
       RunMetrics m = evaluations[r].metrics;
