@@ -161,6 +161,50 @@ void Frontend::SetExtrinsics(const std::vector<Rigid3>& cam_from_rig) {
   });
 }
 
+namespace {
+
+// A matched point to move to a sub-pixel position (RefineMatchPositions).
+struct Refinement {
+  int camera, index;
+  cv::Point2f px;
+};
+
+// The new matches of a pair whose one side is a fresh detection (age 0; the a side only when b is
+// not fresh too) and the other a different track: the fresh side moves to where KLT from the other
+// side's patch lands. Matches of one id (re-matched tracks) and of two older tracks are kept as they
+// are: moving a tracked point would put a jump into its track.
+std::vector<Refinement> RefineNewMatches(const ViewTracker& tracker_a, const ViewTracker& tracker_b, int a, int b,
+                                         const std::vector<InterviewMatch>& matches, int window_px) {
+  std::vector<Refinement> out;
+  const auto& points_a = tracker_a.points();
+  const auto& points_b = tracker_b.points();
+  for (const bool move_b : {true, false}) {
+    std::vector<cv::Point2f> from, to;
+    std::vector<int> moving;
+    for (const InterviewMatch& match : matches) {
+      const TrackedPoint& pa = points_a[match.index_a];
+      const TrackedPoint& pb = points_b[match.index_b];
+      if (pa.track_id == pb.track_id) continue;
+      const bool fresh = move_b ? pb.age == 0 : (pa.age == 0 && pb.age != 0);
+      if (!fresh) continue;
+      from.push_back(move_b ? pa.px : pb.px);
+      to.push_back(move_b ? pb.px : pa.px);
+      moving.push_back(move_b ? match.index_b : match.index_a);
+    }
+    const ViewTracker& source = move_b ? tracker_a : tracker_b;
+    const ViewTracker& target = move_b ? tracker_b : tracker_a;
+    SubpixelMatchOptions options;
+    options.window_px = window_px;
+    const auto refined = RefineMatchPositions(source.image(), target.image(), from, to, options);
+    for (size_t k = 0; k < refined.size(); ++k) {
+      if (refined[k]) out.push_back({move_b ? b : a, moving[k], *refined[k]});
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
   Impl& s = *impl_;
   const int n = s.rig.NumCameras();
@@ -255,6 +299,7 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
       }
     }
     std::vector<std::vector<InterviewMatch>> pair_matches(s.pairs.size());
+    std::vector<std::vector<Refinement>> refinements(s.pairs.size());
     tbb::parallel_for(0, static_cast<int>(s.pairs.size()), [&](int k) {
       const auto [a, b] = s.pairs[k];
       PairGeometry geometry;
@@ -262,7 +307,17 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
       geometry.plane_normal_in_rig = s.layouts[a].right_normal_in_rig;
       geometry.focal_px = 0.5 * (s.projections[a].focal_px() + s.projections[b].focal_px());
       pair_matches[k] = MatchViews(geometry, views[a], views[b], s.options.matching);
+      if (s.options.refine_matches) {
+        refinements[k] = RefineNewMatches(s.trackers[a], s.trackers[b], a, b, pair_matches[k], s.options.klt_window_px);
+      }
     });
+    for (const auto& list : refinements) {
+      for (const Refinement& r : list) {
+        TrackedPoint& p = s.trackers[r.camera].points()[r.index];
+        p.px = r.px;
+        bearings_in_cam[r.camera][r.index] = s.projections[r.camera].BearingFromWarped(Eigen::Vector2d(r.px.x, r.px.y));
+      }
+    }
 
     // Unify ids sequentially: `from` = the younger (larger) id, `into` = the older one. A merge that
     // would put one id twice into a view is refused.

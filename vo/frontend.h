@@ -60,6 +60,10 @@ struct FrontendOptions {
   HybridProjectionOptions projection;   // warp geometry (focal, extents, rebuild threshold)
   InterviewMatchOptions matching;       // inter-view filters
   bool match_between_views = true;      // inter-view matching on/off (ablation)
+  // Sub-pixel refinement of new inter-view matches (RefineMatchPositions, interview_matching.h).
+  // Measured on dynamic_urban full size, first 300 frames, GTExt: relative RMSE 0.077 -> 0.070 %,
+  // inlier ratio 89.4 -> 89.9 %, reprojection error 0.078 -> 0.075 deg.
+  bool refine_matches = true;
 };
 
 // The tracker settings of a front-end configuration (its per-view target and KLT/detector fields).

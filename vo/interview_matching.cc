@@ -1,10 +1,12 @@
 #include "vo/interview_matching.h"
 
 #include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace rovo {
 
@@ -329,6 +331,55 @@ std::vector<InterviewMatch> MatchViews(const PairGeometry& pair, const MatchView
     matches.push_back(match);
   }
   return matches;
+}
+
+std::vector<std::optional<cv::Point2f>> RefineMatchPositions(const cv::Mat& image_from, const cv::Mat& image_to,
+                                                             const std::vector<cv::Point2f>& from,
+                                                             const std::vector<cv::Point2f>& to,
+                                                             const SubpixelMatchOptions& options) {
+  if (from.size() != to.size()) throw std::invalid_argument("RefineMatchPositions: from and to differ in size");
+  if (image_from.type() != CV_8UC1 || image_to.type() != CV_8UC1) {
+    throw std::invalid_argument("RefineMatchPositions: images must be 8-bit gray");
+  }
+  std::vector<std::optional<cv::Point2f>> refined(to.size());
+  const cv::Size window(options.window_px, options.window_px);
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, options.max_iterations,
+                                  options.epsilon_px);
+  // Equal-size patches around both points (the two views' images may differ in size); KLT on the
+  // base level only: the start is within max_shift_px of the answer.
+  const int half = options.window_px / 2 + static_cast<int>(std::ceil(options.max_shift_px)) + 2;
+  const auto patch_at = [&](const cv::Mat& image, cv::Point2f centre, cv::Point* corner) -> std::optional<cv::Mat> {
+    const int x0 = static_cast<int>(std::lround(centre.x)) - half, y0 = static_cast<int>(std::lround(centre.y)) - half;
+    if (x0 < 0 || y0 < 0 || x0 + 2 * half + 1 > image.cols || y0 + 2 * half + 1 > image.rows) return std::nullopt;
+    *corner = cv::Point(x0, y0);
+    return image(cv::Rect(x0, y0, 2 * half + 1, 2 * half + 1)).clone();
+  };
+  const double max_shift2 = options.max_shift_px * options.max_shift_px;
+  const double max_round2 = options.max_round_trip_px * options.max_round_trip_px;
+  std::vector<cv::Point2f> start(1), forward(1), backward(1);
+  std::vector<uint8_t> status_forward, status_backward;
+  std::vector<float> error;
+  for (size_t k = 0; k < to.size(); ++k) {
+    cv::Point corner_from, corner_to;
+    const auto patch_from = patch_at(image_from, from[k], &corner_from);
+    const auto patch_to = patch_at(image_to, to[k], &corner_to);
+    if (!patch_from || !patch_to) continue;
+    const cv::Point2f offset_from(corner_from), offset_to(corner_to);
+    start[0] = from[k] - offset_from;
+    forward[0] = to[k] - offset_to;
+    cv::calcOpticalFlowPyrLK(*patch_from, *patch_to, start, forward, status_forward, error, window, 0, criteria,
+                             cv::OPTFLOW_USE_INITIAL_FLOW);
+    if (!status_forward[0]) continue;
+    backward[0] = start[0];
+    cv::calcOpticalFlowPyrLK(*patch_to, *patch_from, forward, backward, status_backward, error, window, 0, criteria,
+                             cv::OPTFLOW_USE_INITIAL_FLOW);
+    if (!status_backward[0]) continue;
+    const cv::Point2f result = forward[0] + offset_to;
+    const cv::Point2f shift = result - to[k], round_trip = backward[0] - start[0];
+    if (shift.dot(shift) > max_shift2 || round_trip.dot(round_trip) > max_round2) continue;
+    refined[k] = result;
+  }
+  return refined;
 }
 
 }  // namespace rovo

@@ -119,4 +119,24 @@ double AngleDifferenceDeg(double a_deg, double b_deg);
 std::vector<InterviewMatch> MatchViews(const PairGeometry& pair, const MatchView& a, const MatchView& b,
                                        const InterviewMatchOptions& options);
 
+// Sub-pixel refinement of matched positions (our addition to the paper's matcher). A new feature
+// sits where FAST found it, on the integer pixel grid, so a match of two fresh detections carries up
+// to +-0.5 px of quantisation in each view. The front-end moves the fresh side of a new match to
+// where KLT (translation only, from the other view's patch, starting at the detection) lands: for
+// each k, `to[k]` in image_to is refined against the patch of image_from around `from[k]`. A result
+// is kept when KLT converges within max_shift_px of the start and tracking it back lands within
+// max_round_trip_px of from[k]; nullopt otherwise, also near an image border (the caller keeps the
+// detection). 8-bit gray images, of any sizes.
+struct SubpixelMatchOptions {
+  int window_px = 15;              // KLT window side
+  int max_iterations = 30;
+  double epsilon_px = 0.01;
+  double max_shift_px = 2.0;
+  double max_round_trip_px = 0.3;
+};
+std::vector<std::optional<cv::Point2f>> RefineMatchPositions(const cv::Mat& image_from, const cv::Mat& image_to,
+                                                             const std::vector<cv::Point2f>& from,
+                                                             const std::vector<cv::Point2f>& to,
+                                                             const SubpixelMatchOptions& options = {});
+
 }  // namespace rovo

@@ -46,6 +46,74 @@ TEST(InterviewFilters, PositiveDisparity) {
   EXPECT_FALSE(PositiveDisparity(ca, da, cb, da));
 }
 
+// Sub-pixel refinement: view b is view a shifted by a known sub-pixel offset; detections on the
+// integer grid move to within 0.05 px of the true positions, and a point without texture to follow
+// (flat patch) or a start far from the answer is left alone.
+TEST(InterviewRefinement, RecoversSubpixelOffsets) {
+  // A band-limited texture (sum of random sinusoids, wavelengths 6..30 px) sampled exactly in both
+  // images, so that no resampling error enters the truth.
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  struct Wave {
+    double kx, ky, phase;
+  };
+  std::vector<Wave> waves;
+  for (int k = 0; k < 24; ++k) {
+    const double wavelength = 6.0 + 24.0 * unit(rng), direction = 2.0 * M_PI * unit(rng);
+    waves.push_back({2.0 * M_PI / wavelength * std::cos(direction), 2.0 * M_PI / wavelength * std::sin(direction),
+                     2.0 * M_PI * unit(rng)});
+  }
+  const cv::Point2f offset(3.37f, -1.21f);  // b(x + offset) = a(x)
+  const auto render = [&](cv::Point2f shift) {
+    cv::Mat image(240, 320, CV_8U);
+    for (int v = 0; v < image.rows; ++v) {
+      for (int u = 0; u < image.cols; ++u) {
+        double value = 0.0;
+        for (const Wave& w : waves) value += std::cos(w.kx * (u - shift.x) + w.ky * (v - shift.y) + w.phase);
+        image.at<uint8_t>(v, u) = cv::saturate_cast<uint8_t>(128.0 + 22.0 * value);
+      }
+    }
+    image(cv::Rect(0, 0, 60, 60)).setTo(128);  // flat corner (the same in both)
+    return image;
+  };
+  const cv::Mat image_a = render(cv::Point2f(0, 0)), image_b = render(offset);
+
+  std::vector<cv::Point2f> from, to;
+  for (int v = 80; v <= 180; v += 25) {
+    for (int u = 80; u <= 260; u += 30) {
+      from.emplace_back(static_cast<float>(u), static_cast<float>(v));
+      const cv::Point2f truth = from.back() + offset;
+      to.emplace_back(std::round(truth.x), std::round(truth.y));  // FAST-like integer position
+    }
+  }
+  from.emplace_back(30.0f, 30.0f);  // flat
+  to.emplace_back(33.0f, 29.0f);
+  from.emplace_back(150.0f, 120.0f);  // start 6 px off: beyond max_shift_px
+  to.emplace_back(150.0f + offset.x + 6.0f, 120.0f + offset.y);
+
+  const auto refined = RefineMatchPositions(image_a, image_b, from, to);
+  ASSERT_EQ(refined.size(), from.size());
+  double worst = 0.0, worst_start = 0.0;
+  const size_t textured = from.size() - 2;
+  for (size_t k = 0; k < textured; ++k) {
+    ASSERT_TRUE(refined[k].has_value()) << k;
+    const cv::Point2f truth = from[k] + offset;
+    worst = std::max(worst, cv::norm(*refined[k] - truth));
+    worst_start = std::max(worst_start, cv::norm(to[k] - truth));
+  }
+  EXPECT_GT(worst_start, 0.3);  // the integer starts are off by up to ~0.5 px
+  EXPECT_LT(worst, 0.05);
+  EXPECT_FALSE(refined[textured].has_value());
+  EXPECT_FALSE(refined[textured + 1].has_value());
+  EXPECT_THROW(RefineMatchPositions(image_a, image_b, from, {}), std::invalid_argument);
+  // Images of different sizes (views of different cameras) work alike.
+  const cv::Mat larger_b = cv::Mat::zeros(image_b.rows + 17, image_b.cols + 40, CV_8U);
+  image_b.copyTo(larger_b(cv::Rect(0, 0, image_b.cols, image_b.rows)));
+  const auto refined_larger = RefineMatchPositions(image_a, larger_b, from, to);
+  for (size_t k = 0; k < from.size(); ++k) EXPECT_EQ(refined_larger[k].has_value(), refined[k].has_value()) << k;
+  EXPECT_LT(cv::norm(*refined_larger[0] - (from[0] + offset)), 0.05);
+}
+
 TEST(InterviewFilters, RectifiedYAndAngles) {
   const Eigen::Vector3d up = Eigen::Vector3d::UnitZ(), m = Eigen::Vector3d::UnitX();
   EXPECT_NEAR(*RectifiedY(Eigen::Vector3d(2, 5, -1).normalized(), up, m), 0.5, 1e-12);
