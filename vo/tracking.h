@@ -24,7 +24,7 @@ struct TrackerOptions {
   int klt_levels = 3;                // pyramid levels above the base
   int klt_max_iterations = 20;       // LK iterations per pyramid level (at most)
   float klt_epsilon_px = 0.03f;      // LK stops a level when its update is below this (pixels)
-  float max_forward_backward_px = 1.0f;  // forward-backward KLT round-trip error
+  float max_forward_backward_px = 0.3f;  // forward-backward KLT round-trip error (FrontendOptions explains)
   int border_px = 20;                // features keep this distance from invalid pixels and image edges (ORB patch)
 };
 
