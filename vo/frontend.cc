@@ -12,6 +12,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <mutex>
 #include <unordered_map>
 
 namespace rovo {
@@ -41,23 +42,42 @@ cv::Mat ToGray(const cv::Mat& image, int camera) {
   return gray;
 }
 
-// Sets OpenCV's thread count (process-wide) for a scope and restores it. The front-end runs its views
-// in parallel under TBB; OpenCV's own parallel loops nested in them (remap, KLT, pyramids) ran on
-// OpenCV's TBB arena with task overhead and without gain (measured: 4 x 5 remaps on 2 threads took
-// ~20 % more wall and CPU time than with OpenCV serial inside each view).
+// Makes OpenCV serial (cv::setNumThreads(1), process-wide) while any front-end call runs and restores
+// the caller's setting when the last one returns. The front-end runs its views in parallel under TBB;
+// OpenCV's own parallel loops nested in them (remap, KLT, pyramids) ran on OpenCV's TBB arena with
+// task overhead and without gain (measured: 4 x 5 remaps on 2 threads took ~20 % more wall and CPU
+// time than with OpenCV serial inside each view). Counted across threads: with several front-ends
+// at once (`rovo suite --jobs 2` runs two VO runs in one process) a per-call set-and-restore changed
+// OpenCV's thread pool while another call's KLT was inside it, which crashed.
 class ScopedOpenCvThreads {
  public:
-  explicit ScopedOpenCvThreads(int threads) : previous_(cv::getNumThreads()) {
-    if (previous_ != threads) cv::setNumThreads(threads);
+  ScopedOpenCvThreads() {
+    const std::lock_guard<std::mutex> lock(Mutex());
+    if (Count()++ == 0) {
+      Saved() = cv::getNumThreads();
+      if (Saved() != 1) cv::setNumThreads(1);
+    }
   }
   ~ScopedOpenCvThreads() {
-    if (cv::getNumThreads() != previous_) cv::setNumThreads(previous_);
+    const std::lock_guard<std::mutex> lock(Mutex());
+    if (--Count() == 0 && Saved() != 1) cv::setNumThreads(Saved());
   }
   ScopedOpenCvThreads(const ScopedOpenCvThreads&) = delete;
   ScopedOpenCvThreads& operator=(const ScopedOpenCvThreads&) = delete;
 
  private:
-  int previous_;
+  static std::mutex& Mutex() {
+    static std::mutex mutex;
+    return mutex;
+  }
+  static int& Count() {
+    static int count = 0;
+    return count;
+  }
+  static int& Saved() {
+    static int saved = 0;
+    return saved;
+  }
 };
 
 }  // namespace
@@ -128,7 +148,7 @@ void Frontend::SetExtrinsics(const std::vector<Rigid3>& cam_from_rig) {
     throw std::invalid_argument("Frontend::SetExtrinsics: " + std::to_string(cam_from_rig.size()) +
                                 " extrinsics for " + std::to_string(s.rig.NumCameras()) + " cameras");
   }
-  const ScopedOpenCvThreads serial_opencv(1);
+  const ScopedOpenCvThreads serial_opencv;
   s.rig = s.rig.WithExtrinsics(cam_from_rig);
   s.layouts = ComputeHybridLayouts(s.rig);
   s.UpdatePairs();
@@ -221,7 +241,7 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
     }
   }
   FrontendFrame frame;
-  const ScopedOpenCvThreads serial_opencv(1);
+  const ScopedOpenCvThreads serial_opencv;
 
   // The per-view stages (warp, track, detect + describe, bearings) run fused in one parallel loop
   // over the views, without a barrier between stages. Stage times are the section's wall and CPU

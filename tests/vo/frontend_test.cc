@@ -12,6 +12,7 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <thread>
 
 namespace rovo {
 namespace {
@@ -274,6 +275,42 @@ TEST_F(FrontendBox, RestoresOpenCvThreadsAndSplitsStageTimes) {
   }
   frontend.SetExtrinsics(rig_->Extrinsics());
   EXPECT_EQ(cv::getNumThreads(), before);
+  cv::setNumThreads(original);
+}
+
+// Two front-ends in two threads at once (as `rovo suite --jobs 2` runs two VO runs in one process):
+// each gives the same features as when run alone, and OpenCV's thread count is restored at the end.
+TEST_F(FrontendBox, ConcurrentFrontendsMatchSequentialRuns) {
+  const int original = cv::getNumThreads();
+  cv::setNumThreads(2);
+  FrontendOptions options;
+  options.target_features_per_view = 200;
+  const auto run = [&](std::vector<FrontendFrame>* out) {
+    Frontend frontend(*rig_, options);
+    for (int repeat = 0; repeat < 3; ++repeat) {
+      for (const auto& frame : frames_) out->push_back(frontend.Process(frame));
+    }
+  };
+  std::vector<FrontendFrame> alone, first, second;
+  run(&alone);
+  std::thread a(run, &first), b(run, &second);
+  a.join();
+  b.join();
+  EXPECT_EQ(cv::getNumThreads(), 2);
+  for (const auto* together : {&first, &second}) {
+    ASSERT_EQ(together->size(), alone.size());
+    for (size_t k = 0; k < alone.size(); ++k) {
+      for (int i = 0; i < rig_->NumCameras(); ++i) {
+        const auto& x = alone[k].features_per_camera[i];
+        const auto& y = (*together)[k].features_per_camera[i];
+        ASSERT_EQ(x.size(), y.size()) << "frame " << k << " camera " << i;
+        for (size_t j = 0; j < x.size(); ++j) {
+          EXPECT_EQ(x[j].track_id, y[j].track_id);
+          EXPECT_EQ(x[j].warped_px, y[j].warped_px);
+        }
+      }
+    }
+  }
   cv::setNumThreads(original);
 }
 
