@@ -11,66 +11,17 @@
 namespace rovo {
 namespace {
 
-struct World {
-  std::vector<Eigen::Vector3d> points;
-  std::vector<Rigid3> world_from_rig;  // per frame
-  std::vector<Rigid3> cam_from_rig;
-};
-
-// A rig driving ~1 m per frame along a gentle S-curve through a corridor of points.
-World MakeWorld(int frames, uint64_t seed) {
-  World w;
-  w.cam_from_rig = test::SquareRigExtrinsics();
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> along(-20.0, frames + 20.0), side(4.0, 15.0), height(-1.5, 8.0),
-      sign(-1.0, 1.0);
-  for (int k = 0; k < 20 * (frames + 40); ++k) {
-    const double x = along(rng);
-    w.points.emplace_back(x, (sign(rng) < 0 ? -1 : 1) * side(rng) + 3.0 * std::sin(0.05 * x), height(rng));
-  }
-  for (int f = 0; f < frames; ++f) {
-    const double x = 1.0 * f;
-    const double yaw = std::atan(0.15 * std::cos(0.05 * x));
-    w.world_from_rig.emplace_back(Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())),
-                                  Eigen::Vector3d(x, 3.0 * std::sin(0.05 * x), 1.5));
-  }
-  return w;
-}
-
-FrontendFrame Observe(const World& w, int frame, std::mt19937_64& rng, double noise_rad, double outlier_ratio) {
-  FrontendFrame out;
-  out.features_per_camera.resize(4);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  const Rigid3 rig_from_world = w.world_from_rig[frame].Inverse();
-  for (size_t k = 0; k < w.points.size(); ++k) {
-    const Eigen::Vector3d in_rig = rig_from_world * w.points[k];
-    if (in_rig.norm() > 25.0) continue;
-    for (int j = 0; j < 4; ++j) {
-      const Eigen::Vector3d in_cam = w.cam_from_rig[j] * in_rig;
-      if (!test::InFov220(in_cam)) continue;
-      Feature f;
-      f.track_id = k + 1;
-      f.camera = j;
-      f.warped_px = Eigen::Vector2f::Zero();
-      f.bearing_in_cam = test::NoisyBearing(rng, in_cam.normalized(), noise_rad);
-      if (u(rng) < outlier_ratio) f.bearing_in_cam = test::NoisyBearing(rng, f.bearing_in_cam, 0.05);
-      out.features_per_camera[j].push_back(f);
-    }
-  }
-  return out;
-}
-
 double PositionError(const Rigid3& a, const Rigid3& b) { return (a.translation - b.translation).norm(); }
 
 TEST(VoBackend, TracksExactSequenceWithGroundTruthExtrinsics) {
   const int frames = 30;
-  const World w = MakeWorld(frames, 1);
+  const test::World w = test::MakeWorld(frames, 1);
   std::mt19937_64 rng(2);
   BackendOptions options;
   VoBackend backend(w.cam_from_rig, w.world_from_rig[0], options);
   int keyframes = 0;
   for (int f = 0; f < frames; ++f) {
-    const BackendFrameResult r = backend.ProcessFrame(f, Observe(w, f, rng, 0.0, 0.0));
+    const BackendFrameResult r = backend.ProcessFrame(f, test::Observe(w, f, rng, 0.0, 0.0));
     EXPECT_EQ(r.record.status, f == 0 ? "init" : "ok") << "frame " << f;
     if (f > 0) {
       EXPECT_GT(r.record.inlier_ratio, 0.9) << "frame " << f;
@@ -85,13 +36,13 @@ TEST(VoBackend, TracksExactSequenceWithGroundTruthExtrinsics) {
 
 TEST(VoBackend, NoiseAndOutliersStayAccurate) {
   const int frames = 40;
-  const World w = MakeWorld(frames, 3);
+  const test::World w = test::MakeWorld(frames, 3);
   std::mt19937_64 rng(4);
   BackendOptions options;
   VoBackend backend(w.cam_from_rig, w.world_from_rig[0], options);
   double max_error = 0.0;
   for (int f = 0; f < frames; ++f) {
-    const BackendFrameResult r = backend.ProcessFrame(f, Observe(w, f, rng, 0.0005, 0.2));
+    const BackendFrameResult r = backend.ProcessFrame(f, test::Observe(w, f, rng, 0.0005, 0.2));
     EXPECT_NE(r.record.status, "lost") << "frame " << f;
     max_error = std::max(max_error, PositionError(r.world_from_rig, w.world_from_rig[f]));
     if (f > 0) {
@@ -105,12 +56,12 @@ TEST(VoBackend, NoiseAndOutliersStayAccurate) {
 // from inter-view triangulation and tracking again.
 TEST(VoBackend, RecoversAfterGapOfBlackFrames) {
   const int frames = 36;
-  const World w = MakeWorld(frames, 5);
+  const test::World w = test::MakeWorld(frames, 5);
   std::mt19937_64 rng(6);
   VoBackend backend(w.cam_from_rig, w.world_from_rig[0], BackendOptions{});
   for (int f = 0; f < frames; ++f) {
     const bool black = f >= 15 && f < 18;
-    const FrontendFrame input = black ? FrontendFrame{} : Observe(w, f, rng, 0.0003, 0.0);
+    const FrontendFrame input = black ? FrontendFrame{} : test::Observe(w, f, rng, 0.0003, 0.0);
     const BackendFrameResult r = backend.ProcessFrame(f, input);
     if (black) {
       EXPECT_EQ(r.record.status, "lost") << "frame " << f;
@@ -126,7 +77,7 @@ TEST(VoBackend, RecoversAfterGapOfBlackFrames) {
 
 TEST(VoBackend, OnlineCalibrationReducesExtrinsicError) {
   const int frames = 40;
-  const World w = MakeWorld(frames, 7);
+  const test::World w = test::MakeWorld(frames, 7);
   std::mt19937_64 rng(8);
   std::vector<Rigid3> noisy = w.cam_from_rig;
   for (int j = 1; j < 4; ++j) noisy[j] = Rigid3(test::RandomRotation(rng, 3.0) * noisy[j].rotation, noisy[j].translation);
@@ -134,7 +85,7 @@ TEST(VoBackend, OnlineCalibrationReducesExtrinsicError) {
   options.ba.optimize_extrinsics = true;
   VoBackend backend(noisy, w.world_from_rig[0], options);
   for (int f = 0; f < frames; ++f) {
-    const auto r = backend.ProcessFrame(f, Observe(w, f, rng, 0.0002, 0.0));
+    const auto r = backend.ProcessFrame(f, test::Observe(w, f, rng, 0.0002, 0.0));
     if (getenv("ROVO_DEBUG")) {
       printf("%d %s corr %d inl %d ratio %.2f kf %d lm %d err %.3f\n", f, r.record.status.c_str(), r.record.num_correspondences,
              r.record.num_inliers, r.record.inlier_ratio, r.record.keyframe, r.num_landmarks,
