@@ -8,11 +8,11 @@
 #include <array>
 #include <chrono>
 #include <ctime>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
-#include <mutex>
 #include <unordered_map>
 
 namespace rovo {
