@@ -50,7 +50,8 @@ struct FrontendOptions {
   // KLT forward-backward round-trip error. 0.3 px instead of 1: drops the tracks that slide over the
   // texture (occlusion edges, strong perspective change). Measured 2026-11-21, full size, first 300
   // frames, GTExt (with refine_matches): relative RMSE cloudy 0.026 -> 0.021 %, sunset 0.028 -> 0.025 %,
-  // static 0.046 -> 0.019 %, canyon_multifov 0.140 -> 0.103 %; inlier ratio +3..5 points.
+  // static 0.046 -> 0.019 %, dynamic 0.077 -> 0.050 %, canyon_multifov 0.140 -> 0.103 %; inlier ratio
+  // +3..5 points. Why sliding tracks shorten the trajectory: README, known limitations.
   float max_forward_backward_px = 0.3f;
   // KLT: window 15 with <= 20 iterations down to 0.03 px costs ~60 % of the former 21 / 30 / 0.01
   // px. Measured 2026-11-21 on the quick cloudy/sunset datasets (GTExt and OnlineExt of both):
