@@ -92,6 +92,8 @@ TrackerOptions TrackerOptionsFrom(const FrontendOptions& options) {
   tracker.klt_levels = options.klt_levels;
   tracker.klt_max_iterations = options.klt_max_iterations;
   tracker.klt_epsilon_px = options.klt_epsilon_px;
+  tracker.klt_predict_flow = options.klt_predict_flow;
+  tracker.klt_predicted_levels = options.klt_predicted_levels;
   return tracker;
 }
 
@@ -102,6 +104,10 @@ struct Frontend::Impl {
   std::vector<HybridProjection> projections;  // maps (rebuilt only past the threshold)
   std::vector<ViewTracker> trackers;
   std::vector<cv::Mat> warped, fisheye_gray;
+  // Per view, the warp buffers of the last two frames: a frame writes into the one of two frames
+  // ago when nothing else holds it any more (saves allocating and page-faulting a full image).
+  std::vector<std::array<cv::Mat, 2>> warp_buffers;
+  uint64_t frames_processed = 0;
   std::vector<std::pair<int, int>> pairs;     // (camera, its right neighbour), each overlap once
   std::vector<ViewMatch> last_matches;
   uint64_t last_id = 0;
@@ -129,6 +135,7 @@ Frontend::Frontend(const Rig& rig, const FrontendOptions& options) : impl_(std::
   s.trackers.assign(rig.NumCameras(), ViewTracker(TrackerOptionsFrom(s.options)));
   s.warped.resize(rig.NumCameras());
   s.fisheye_gray.resize(rig.NumCameras());
+  s.warp_buffers.resize(rig.NumCameras());
   s.UpdatePairs();
 }
 
@@ -260,9 +267,10 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
       start = now;
     };
     s.fisheye_gray[i] = ToGray(fisheye_images[i], i);
-    cv::Mat warped;
-    s.projections[i].Warp(s.fisheye_gray[i], &warped);
-    s.warped[i] = warped;
+    cv::Mat& buffer = s.warp_buffers[i][s.frames_processed % 2];
+    if (buffer.u != nullptr && buffer.u->refcount > 1) buffer = cv::Mat();  // still in use elsewhere
+    s.projections[i].Warp(s.fisheye_gray[i], &buffer);
+    s.warped[i] = buffer;
     lap(kWarp);
     s.trackers[i].Track(s.warped[i], s.projections[i].valid_mask());
     lap(kTrack);
@@ -391,6 +399,7 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
       out.push_back(f);
     }
   }
+  ++s.frames_processed;
   return frame;
 }
 

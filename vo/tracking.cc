@@ -146,41 +146,67 @@ int ViewTracker::Track(const cv::Mat& image, const cv::Mat& mask) {
   }
   std::vector<TrackedPoint> kept;
   if (!points_.empty() && !pyramid_.empty()) {
-    std::vector<cv::Point2f> previous, forward, backward;
-    previous.reserve(points_.size());
-    for (const TrackedPoint& p : points_) previous.push_back(p.px);
-    std::vector<uint8_t> status_fw, status_bw;
-    std::vector<float> error;
     const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, options_.klt_max_iterations,
                                     options_.klt_epsilon_px);
-    cv::calcOpticalFlowPyrLK(pyramid_, pyramid, previous, forward, status_fw, error, window, options_.klt_levels,
-                             criteria);
-    // Backward pass only for the forward successes that land in the detection area (each point's
-    // LK is independent of the others, so this only skips work whose result would be dropped).
-    std::vector<int> candidates;
-    std::vector<cv::Point2f> forward_ok;
-    for (size_t i = 0; i < points_.size(); ++i) {
-      if (!status_fw[i] || !MaskAt(detect_mask_, forward[i])) continue;
-      candidates.push_back(static_cast<int>(i));
-      forward_ok.push_back(forward[i]);
-      backward.push_back(previous[i]);
-    }
-    if (!candidates.empty()) {
-      cv::calcOpticalFlowPyrLK(pyramid, pyramid_, forward_ok, backward, status_bw, error, window, options_.klt_levels,
-                               criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
-    }
     const float max_fb2 = options_.max_forward_backward_px * options_.max_forward_backward_px;
-    for (size_t k = 0; k < candidates.size(); ++k) {
-      const int i = candidates[k];
-      if (!status_bw[k]) continue;
-      const cv::Point2f d = backward[k] - previous[i];
-      if (d.dot(d) > max_fb2) continue;
-      TrackedPoint p = points_[i];
-      p.px = forward[i];
-      ++p.age;
-      p.has_descriptor = false;
-      kept.push_back(std::move(p));
+    // One KLT round for the points `which`: the forward pass starts at start[k] with `levels`
+    // levels when `guided`, else at the point itself with all levels; the backward (check) pass runs
+    // for the forward successes that land in the detection area. Appends the survivors to `kept`,
+    // returns the lost ones.
+    const auto round = [&](const std::vector<int>& which, const std::vector<cv::Point2f>& start, bool guided,
+                           int levels) {
+      std::vector<cv::Point2f> previous, forward = start;
+      previous.reserve(which.size());
+      for (int i : which) previous.push_back(points_[i].px);
+      std::vector<uint8_t> status_fw, status_bw;
+      cv::calcOpticalFlowPyrLK(pyramid_, pyramid, previous, forward, status_fw, cv::noArray(), window, levels, criteria,
+                               guided ? cv::OPTFLOW_USE_INITIAL_FLOW : 0);
+      std::vector<int> candidates, lost;
+      std::vector<cv::Point2f> forward_ok, backward;
+      for (size_t k = 0; k < which.size(); ++k) {
+        if (!status_fw[k] || !MaskAt(detect_mask_, forward[k])) {
+          lost.push_back(which[k]);
+          continue;
+        }
+        candidates.push_back(static_cast<int>(k));
+        forward_ok.push_back(forward[k]);
+      }
+      if (!candidates.empty()) {
+        cv::calcOpticalFlowPyrLK(pyramid, pyramid_, forward_ok, backward, status_bw, cv::noArray(), window,
+                                 options_.klt_levels, criteria);
+      }
+      for (size_t c = 0; c < candidates.size(); ++c) {
+        const int k = candidates[c];
+        const cv::Point2f d = backward[c] - previous[k];
+        if (!status_bw[c] || d.dot(d) > max_fb2) {
+          lost.push_back(which[k]);
+          continue;
+        }
+        TrackedPoint p = points_[which[k]];
+        p.flow = forward[k] - p.px;
+        p.px = forward[k];
+        ++p.age;
+        p.has_descriptor = false;
+        kept.push_back(std::move(p));
+      }
+      return lost;
+    };
+    std::vector<int> predicted, unpredicted;
+    std::vector<cv::Point2f> predicted_start;
+    for (int i = 0; i < static_cast<int>(points_.size()); ++i) {
+      if (options_.klt_predict_flow && points_[i].age > 0) {
+        predicted.push_back(i);
+        predicted_start.push_back(points_[i].px + points_[i].flow);
+      } else {
+        unpredicted.push_back(i);
+      }
     }
+    if (!predicted.empty()) {
+      const std::vector<int> lost = round(predicted, predicted_start, true, options_.klt_predicted_levels);
+      unpredicted.insert(unpredicted.end(), lost.begin(), lost.end());
+      std::sort(unpredicted.begin(), unpredicted.end());
+    }
+    if (!unpredicted.empty()) round(unpredicted, {}, false, options_.klt_levels);
     // Enforce the minimum distance among tracks too (converging tracks): older tracks win.
     std::stable_sort(kept.begin(), kept.end(),
                      [](const TrackedPoint& a, const TrackedPoint& b) { return a.age > b.age; });

@@ -24,7 +24,18 @@ struct TrackerOptions {
   int klt_levels = 3;                // pyramid levels above the base
   int klt_max_iterations = 20;       // LK iterations per pyramid level (at most)
   float klt_epsilon_px = 0.03f;      // LK stops a level when its update is below this (pixels)
-  float max_forward_backward_px = 0.3f;  // forward-backward KLT round-trip error (FrontendOptions explains)
+  // Forward-backward check: the backward pass tracks the forward result back into the previous
+  // image from scratch (all levels, no initial guess), and the track is kept when it lands within
+  // this distance of where it started (FrontendOptions explains the value). Starting the backward
+  // pass at the known start (as before 2026-11-21) let gross forward errors pass: LK barely moves
+  // from a start whose patch does not match, so the round trip looked closed.
+  float max_forward_backward_px = 0.3f;
+  // The forward pass of a track tracked before starts at its position plus its last displacement
+  // (constant image velocity) with klt_predicted_levels levels; a track this loses (LK failure or
+  // round trip) is tracked again from its position with all klt_levels. New tracks always use all
+  // levels. false: every track uses all levels from its position.
+  bool klt_predict_flow = true;
+  int klt_predicted_levels = 0;
   int border_px = 20;                // features keep this distance from invalid pixels and image edges (ORB patch)
 };
 
@@ -32,6 +43,7 @@ struct TrackedPoint {
   uint64_t track_id = 0;
   cv::Point2f px;
   int age = 0;          // frames tracked in this view (0 = detected this frame)
+  cv::Point2f flow;     // displacement in the last Track (valid when age > 0)
   float angle_deg = 0;  // ORB orientation (intensity centroid), degrees in [0, 360)
   bool has_descriptor = false;
   cv::Mat descriptor;   // 1x32 CV_8U (ORB), a view into ViewTracker's descriptor matrix

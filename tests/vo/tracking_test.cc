@@ -98,6 +98,47 @@ TEST(Tracking, KltFollowsAShiftAndKeepsIds) {
   EXPECT_EQ(fresh, static_cast<int>(tracker.points().size()) - kept);
 }
 
+// A texture moving 28 px per frame: the first step needs the pyramid, the later ones start from the
+// last displacement with the base level only. When the motion reverses, the prediction is 56 px off
+// and the tracks must survive through the full-pyramid retry.
+TEST(Tracking, PredictedFlowFollowsFastMotionAndRecoversFromAReversal) {
+  TrackerOptions options;
+  options.klt_predict_flow = true;
+  options.klt_predicted_levels = 0;
+  ViewTracker tracker(options);
+  const cv::Mat base = TexturedImage(760, 480, 5);
+  const cv::Mat mask(480, 640, CV_8UC1, cv::Scalar(255));
+  const std::vector<double> offsets = {0, 28, 56, 84, 56, 28};  // x shift of the view per frame
+  std::map<uint64_t, cv::Point2f> first;
+  for (size_t k = 0; k < offsets.size(); ++k) {
+    // The view moves right over the texture: features move left by the offset.
+    const cv::Mat view = Shifted(base, -offsets[k], 0)(cv::Rect(0, 0, 640, 480)).clone();
+    const int kept = tracker.Track(view, mask);
+    if (k == 0) {
+      tracker.DetectAndDescribe(Counter);
+      for (const TrackedPoint& p : tracker.points()) first[p.track_id] = p.px;
+      continue;
+    }
+    int checked = 0;
+    double sum_error = 0;
+    for (const TrackedPoint& p : tracker.points()) {
+      if (!first.count(p.track_id)) continue;
+      const cv::Point2f expected = first[p.track_id] - cv::Point2f(static_cast<float>(offsets[k]), 0);
+      sum_error += cv::norm(p.px - expected);
+      ++checked;
+      EXPECT_NEAR(p.flow.x, -(offsets[k] - offsets[k - 1]), 0.2) << "flow is the last displacement";
+      EXPECT_NEAR(p.flow.y, 0.0, 0.2);
+    }
+    ASSERT_GT(checked, 0) << "frame " << k;
+    EXPECT_LT(sum_error / checked, 0.1) << "frame " << k;
+    // Nearly every original track whose point is still inside the view (away from the border) survives.
+    int inside = 0;
+    for (const auto& [id, px] : first) inside += px.x - offsets[k] > 40 && px.x - offsets[k] < 600;
+    EXPECT_GT(checked, 0.85 * inside) << "frame " << k << ", kept " << kept;
+    tracker.DetectAndDescribe(Counter);
+  }
+}
+
 TEST(Tracking, ForwardBackwardCheckDropsChangedRegions) {
   ViewTracker tracker;
   const cv::Mat image = TexturedImage(640, 480, 3);
