@@ -147,6 +147,11 @@ void WriteMatchesPng(const std::string& path, const cv::Mat& image_a, const cv::
   WriteFileAtomic(path, std::string(png.begin(), png.end()));
 }
 
+bool MaskAt(const cv::Mat& mask, const Eigen::Vector2d& px) {
+  const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
+  return u >= 0 && v >= 0 && u < mask.cols && v < mask.rows && mask.at<uint8_t>(v, u) != 0;
+}
+
 // Error bins of the ground-truth check (fisheye px): [0, .5), [.5, 1), [1, 2), [2, 4), [4, 8), >= 8.
 constexpr double kErrorBinEdges[] = {0.5, 1.0, 2.0, 4.0, 8.0};
 constexpr int kErrorBins = 6;
@@ -170,7 +175,9 @@ struct Arm {
   std::vector<std::set<uint64_t>> contributing;                      // per camera: ids that contributed
   double first_sum = 0, age_sum = 0, step_sum = 0;
   int64_t first_pairs = 0, step_pairs = 0;
-  int64_t matches = 0, inliers = 0;
+  int64_t matches = 0, inliers = 0;          // epipolar-consistent mutual-NN matches
+  int64_t raw_matches = 0, raw_inliers = 0;  // all mutual-NN matches (descriptors only)
+  int64_t chain_matches = 0, chain_inliers = 0;  // the front-end's filter chain on this arm's images
   std::vector<int64_t> error_bins = std::vector<int64_t>(kErrorBins, 0);
   std::vector<DrawnMatch> drawn;  // last frame, first pair
 };
@@ -326,25 +333,59 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
           views[side].points = &points[side];
           views[side].centre_in_rig = rig.cameras[camera].cam_from_rig.Inverse().translation;
           views[side].image = hybrid ? &warped[camera] : &images[camera];
-        }
-        for (const InterviewMatch& m : MatchViews(PairGeometry{}, views[0], views[1], nn_options)) {
-          const Eigen::Vector3d& da = views[0].bearings_in_rig[m.index_a];
-          const Eigen::Vector3d& db = views[1].bearings_in_rig[m.index_b];
-          if (EpipolarAngle(views[0].centre_in_rig, da, views[1].centre_in_rig, db) > options.epipolar_deg * M_PI / 180) {
-            continue;
+          const Eigen::Matrix3d cam_from_rig = rig.cameras[camera].cam_from_rig.RotationMatrix();
+          if (hybrid) {
+            const HybridProjection* projection = &frontend.projection(camera);
+            views[side].pixel_from_direction_in_rig = [projection, cam_from_rig](const Eigen::Vector3d& d) {
+              auto px = projection->WarpedFromBearing(cam_from_rig * d);
+              if (px && !projection->InWarpedImage(*px)) px.reset();
+              return px;
+            };
+          } else {
+            const Camera* lens = &rig.cameras[camera].camera;
+            const cv::Mat* mask = &fisheye_masks[camera];
+            views[side].pixel_from_direction_in_rig = [lens, mask, cam_from_rig](const Eigen::Vector3d& d) {
+              auto px = lens->Project(Eigen::Vector3d(cam_from_rig * d));
+              if (px && !MaskAt(*mask, *px)) px.reset();
+              return px;
+            };
           }
-          const cv::Point2f pa = points[0][m.index_a].px, pb = points[1][m.index_b].px;
+        }
+        // The verdict of a match between views[0] point ia and views[1] point ib (-1: no depth).
+        const auto verdict_of = [&](int ia, int ib, double* error) {
+          const cv::Point2f pa = points[0][ia].px, pb = points[1][ib].px;
           std::optional<Eigen::Vector2d> fa(Eigen::Vector2d(pa.x, pa.y)), fb(Eigen::Vector2d(pb.x, pb.y));
           if (hybrid) {
             fa = frontend.projection(a).FisheyeFromWarped(*fa);
             fb = frontend.projection(b).FisheyeFromWarped(*fb);
-            if (!fa || !fb) continue;
+            if (!fa || !fb) return -1;
           }
-          const Eigen::Vector3d bearing_a = rig.cameras[a].cam_from_rig.RotationMatrix() * da;
+          const Eigen::Vector3d bearing_a = rig.cameras[a].cam_from_rig.RotationMatrix() * views[0].bearings_in_rig[ia];
+          return GroundTruthMatchVerdict(rig, a, bearing_a, *fa, b, *fb, depths[a], depths[b], options.inlier_px, error);
+        };
+        PairGeometry geometry;
+        geometry.up_in_rig = layouts[a].up_in_rig;
+        geometry.plane_normal_in_rig = layouts[a].right_normal_in_rig;
+        geometry.focal_px = 0.5 * (frontend.projection(a).focal_px() + frontend.projection(b).focal_px());
+        for (const InterviewMatch& m : MatchViews(geometry, views[0], views[1], options.frontend_matching)) {
           double error = 0;
-          const int verdict =
-              GroundTruthMatchVerdict(rig, a, bearing_a, *fa, b, *fb, depths[a], depths[b], options.inlier_px, &error);
+          const int verdict = verdict_of(m.index_a, m.index_b, &error);
           if (verdict < 0) continue;
+          ++arm->chain_matches;
+          arm->chain_inliers += verdict;
+        }
+        for (const InterviewMatch& m : MatchViews(PairGeometry{}, views[0], views[1], nn_options)) {
+          const Eigen::Vector3d& da = views[0].bearings_in_rig[m.index_a];
+          const Eigen::Vector3d& db = views[1].bearings_in_rig[m.index_b];
+          const bool epipolar_ok =
+              EpipolarAngle(views[0].centre_in_rig, da, views[1].centre_in_rig, db) <= options.epipolar_deg * M_PI / 180;
+          const cv::Point2f pa = points[0][m.index_a].px, pb = points[1][m.index_b].px;
+          double error = 0;
+          const int verdict = verdict_of(m.index_a, m.index_b, &error);
+          if (verdict < 0) continue;
+          ++arm->raw_matches;
+          arm->raw_inliers += verdict;
+          if (!epipolar_ok) continue;
           ++arm->matches;
           arm->inliers += verdict;
           ++arm->error_bins[ErrorBin(error)];
@@ -392,6 +433,14 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
   result.tracked_pairs_hybrid = hybrid_arm.first_pairs;
   result.features_fisheye = distinct(fisheye_arm);
   result.features_hybrid = distinct(hybrid_arm);
+  result.raw_matches_fisheye = fisheye_arm.raw_matches;
+  result.raw_inliers_fisheye = fisheye_arm.raw_inliers;
+  result.raw_matches_hybrid = hybrid_arm.raw_matches;
+  result.raw_inliers_hybrid = hybrid_arm.raw_inliers;
+  result.chain_matches_fisheye = fisheye_arm.chain_matches;
+  result.chain_inliers_fisheye = fisheye_arm.chain_inliers;
+  result.chain_matches_hybrid = hybrid_arm.chain_matches;
+  result.chain_inliers_hybrid = hybrid_arm.chain_inliers;
   result.matches_fisheye = fisheye_arm.matches;
   result.inliers_fisheye = fisheye_arm.inliers;
   result.matches_hybrid = hybrid_arm.matches;
@@ -413,29 +462,39 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
   std::snprintf(line, sizeof(line), "| Descriptor distance (mean Hamming, frame t vs t+1) | %.2f | %.2f | - |\n",
                 result.hamming_step_fisheye, result.hamming_step_hybrid);
   md << line;
-  std::snprintf(line, sizeof(line),
-                "| Inter-view inlier ratio (%%), epipolar-consistent mutual-NN matches in the overlaps | %.2f | %.2f | 21.53 / 73.16 |\n",
-                100.0 * result.InlierRatioFisheye(), 100.0 * result.InlierRatioHybrid());
-  md << line;
-  std::snprintf(line, sizeof(line), "| Inter-view inlier ratio (%%), front-end filters (hybrid only) | - | %.2f | - |\n\n",
-                100.0 * result.InlierRatioFrontend());
-  md << line;
+  // "ratio % (correct / all)" of a match count.
+  const auto cell = [](int64_t inliers, int64_t matches) {
+    char text[96];
+    std::snprintf(text, sizeof(text), "%.2f (%lld / %lld)", matches ? 100.0 * double(inliers) / double(matches) : 0.0,
+                  static_cast<long long>(inliers), static_cast<long long>(matches));
+    return std::string(text);
+  };
+  md << "| Inter-view inlier ratio %, mutual-NN ORB matches in the overlaps, descriptors only (correct / all) | "
+     << cell(result.raw_inliers_fisheye, result.raw_matches_fisheye) << " | "
+     << cell(result.raw_inliers_hybrid, result.raw_matches_hybrid) << " | - |\n";
+  md << "| Inter-view inlier ratio %, the same matches kept when epipolar-consistent | "
+     << cell(result.inliers_fisheye, result.matches_fisheye) << " | " << cell(result.inliers_hybrid, result.matches_hybrid)
+     << " | 21.53 / 73.16 |\n";
+  md << "| Inter-view inlier ratio %, the front-end's filter chain on the same overlap features | "
+     << cell(result.chain_inliers_fisheye, result.chain_matches_fisheye) << " | "
+     << cell(result.chain_inliers_hybrid, result.chain_matches_hybrid) << " | - |\n";
+  md << "| Inter-view inlier ratio %, the front-end itself | - | " << cell(result.inliers_frontend, result.matches_frontend)
+     << " | - |\n\n";
   std::snprintf(line, sizeof(line),
                 "Ratios: descriptor distance hybrid/fisheye = %.3f (target <= 0.35); inlier ratio hybrid/fisheye = "
-                "%.2f (target >= 3, hybrid >= 80%%).\n\n",
+                "%.2f (target >= 3, hybrid >= 80%%); correct matches of the filter chain hybrid/fisheye = %.2f.\n\n",
                 result.hamming_fisheye > 0 ? result.hamming_hybrid / result.hamming_fisheye : 0.0,
-                result.InlierRatioFisheye() > 0 ? result.InlierRatioHybrid() / result.InlierRatioFisheye() : 0.0);
+                result.InlierRatioFisheye() > 0 ? result.InlierRatioHybrid() / result.InlierRatioFisheye() : 0.0,
+                result.chain_inliers_fisheye > 0
+                    ? double(result.chain_inliers_hybrid) / double(result.chain_inliers_fisheye)
+                    : 0.0);
   md << line;
   std::snprintf(line, sizeof(line),
-                "Counts: (track, later frame) pairs fisheye %lld (%lld tracks, mean %.1f frames after the first), "
-                "hybrid %lld (%lld tracks, mean %.1f frames); matches (inliers) fisheye %lld (%lld), hybrid %lld "
-                "(%lld), front-end %lld (%lld).\n\n",
+                "Tracks behind the descriptor distances: (track, later frame) pairs fisheye %lld (%lld tracks, mean "
+                "%.1f frames after the first), hybrid %lld (%lld tracks, mean %.1f frames).\n\n",
                 static_cast<long long>(result.tracked_pairs_fisheye), static_cast<long long>(result.features_fisheye),
                 result.mean_age_fisheye, static_cast<long long>(result.tracked_pairs_hybrid),
-                static_cast<long long>(result.features_hybrid), result.mean_age_hybrid,
-                static_cast<long long>(result.matches_fisheye), static_cast<long long>(result.inliers_fisheye),
-                static_cast<long long>(result.matches_hybrid), static_cast<long long>(result.inliers_hybrid),
-                static_cast<long long>(result.matches_frontend), static_cast<long long>(result.inliers_frontend));
+                static_cast<long long>(result.features_hybrid), result.mean_age_hybrid);
   md << line;
   const auto bins_row = [](const char* name, const std::vector<int64_t>& bins) {
     std::string row = std::string("| ") + name;
@@ -451,8 +510,13 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
         "descriptors recomputed every frame) on both image kinds. Descriptor distance: Hamming distance between a "
         "track's ORB descriptor at its first frame and at every later frame it is alive, averaged over all such "
         "pairs. Matches: mutual nearest ORB neighbours between neighbouring views among the features whose "
-        "direction lies inside both views' hybrid images (same scene area for both arms), kept when within "
-     << options.epipolar_deg << " deg of the epipolar plane (ground-truth extrinsics). Inlier: the depth-map "
+        "direction lies inside both views' hybrid images (same scene area for both arms); the second row keeps "
+        "those within "
+     << options.epipolar_deg
+     << " deg of the epipolar plane (ground-truth extrinsics). The filter chain is interview_matching.h's "
+        "(y-distance, descriptor, orientation, epipolar, ratio, mutual, positive disparity, ZNCC, uniqueness along "
+        "the epipolar curve) with the same settings on both arms; its appearance filters (descriptor, orientation, "
+        "ZNCC, uniqueness) see the arm's own images, its geometric ones the same bearings. Inlier: the depth-map "
      << "back-projection of the first feature (any of its 3x3 depth pixels) reprojects within " << options.inlier_px
      << " fisheye px of the second and is not occluded (depth agrees). Matches without depth (sky) are not "
         "counted.\n";
@@ -475,6 +539,10 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
                           {"tracked_pairs", arm.first_pairs},
                           {"mean_frames_after_first", age},
                           {"tracks", tracks},
+                          {"raw_matches", arm.raw_matches},
+                          {"raw_inliers", arm.raw_inliers},
+                          {"chain_matches", arm.chain_matches},
+                          {"chain_inliers", arm.chain_inliers},
                           {"matches", arm.matches},
                           {"inliers", arm.inliers},
                           {"inlier_ratio", ratio_value},

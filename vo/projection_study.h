@@ -14,8 +14,10 @@
 //     images (the same scene area for both arms). Matches are mutual nearest neighbours of the ORB
 //     descriptors (brute force, cross-checked), kept when epipolar-consistent (angle to the
 //     epipolar plane <= epipolar_deg under the ground-truth extrinsics), as in the paper. A match
-//     is an inlier by GROUND TRUTH (GroundTruthMatchVerdict below). The front-end's full filter
-//     chain (interview_matching.h) on the hybrid images is reported as a third column.
+//     is an inlier by GROUND TRUTH (GroundTruthMatchVerdict below). Rows: all mutual-NN matches
+//     (descriptors only), those that are epipolar-consistent (the paper's row), and the front-end's
+//     filter chain (interview_matching.h, same settings, the arm's own images for the appearance
+//     filters) on the same overlap features of both arms; the front-end's own matches last.
 // Outputs in --out: table.md (with a histogram of the ground-truth reprojection distances),
 // study.json (numbers, dataset seed, settings), matches_fisheye.png, matches_hybrid.png (the NN
 // matches of part (b)) and matches_frontend.png (the front-end's accepted matches), each one
@@ -77,9 +79,23 @@ struct ProjectionStudyResult {
   double hamming_step_fisheye = 0, hamming_step_hybrid = 0;  // mean Hamming distance, t vs t+1
   double mean_age_fisheye = 0, mean_age_hybrid = 0;          // mean frames since the first, over the pairs
   int64_t features_fisheye = 0, features_hybrid = 0;  // distinct tracks that contributed
+  int64_t raw_matches_fisheye = 0, raw_inliers_fisheye = 0;  // (b), all mutual-NN matches (descriptors only)
+  int64_t raw_matches_hybrid = 0, raw_inliers_hybrid = 0;
+  int64_t chain_matches_fisheye = 0, chain_inliers_fisheye = 0;  // (b), the front-end's filter chain
+  int64_t chain_matches_hybrid = 0, chain_inliers_hybrid = 0;
   int64_t matches_fisheye = 0, inliers_fisheye = 0;   // (b), epipolar-consistent matches
   int64_t matches_hybrid = 0, inliers_hybrid = 0;
   int64_t matches_frontend = 0, inliers_frontend = 0; // front-end's full filters (hybrid)
+  double RawInlierRatioFisheye() const {
+    return raw_matches_fisheye ? double(raw_inliers_fisheye) / raw_matches_fisheye : 0.0;
+  }
+  double RawInlierRatioHybrid() const { return raw_matches_hybrid ? double(raw_inliers_hybrid) / raw_matches_hybrid : 0.0; }
+  double ChainInlierRatioFisheye() const {
+    return chain_matches_fisheye ? double(chain_inliers_fisheye) / chain_matches_fisheye : 0.0;
+  }
+  double ChainInlierRatioHybrid() const {
+    return chain_matches_hybrid ? double(chain_inliers_hybrid) / chain_matches_hybrid : 0.0;
+  }
   double InlierRatioFisheye() const { return matches_fisheye ? double(inliers_fisheye) / matches_fisheye : 0.0; }
   double InlierRatioHybrid() const { return matches_hybrid ? double(inliers_hybrid) / matches_hybrid : 0.0; }
   double InlierRatioFrontend() const { return matches_frontend ? double(inliers_frontend) / matches_frontend : 0.0; }

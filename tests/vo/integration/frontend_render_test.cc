@@ -93,6 +93,14 @@ TEST_F(RenderedQuick, ProjectionStudyWritesItsTable) {
   EXPECT_LE(result.InlierRatioFisheye(), 1.0);
   EXPECT_GE(result.InlierRatioFrontend(), 0.90);
   EXPECT_GT(result.InlierRatioFrontend(), result.InlierRatioHybrid());
+  // Descriptors alone (no geometric filter) and the same filter chain on both arms: the chain's
+  // precision is similar, the hybrid images give more correct matches (measured 2026-11-21 at half
+  // size, 100 frames: 9793 vs 6977, 92.5 vs 93.5 %).
+  EXPECT_GT(result.raw_matches_hybrid, result.matches_hybrid);
+  EXPECT_LT(result.RawInlierRatioHybrid(), result.InlierRatioHybrid());
+  EXPECT_GE(result.ChainInlierRatioHybrid(), 0.85);
+  EXPECT_GE(result.ChainInlierRatioFisheye(), 0.85);
+  EXPECT_GT(result.chain_inliers_hybrid, result.chain_inliers_fisheye);
   for (const char* name : {"table.md", "study.json", "matches_hybrid.png", "matches_fisheye.png", "matches_frontend.png"}) {
     EXPECT_TRUE(std::filesystem::exists(options.out_dir + "/" + name)) << name;
   }
