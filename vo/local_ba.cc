@@ -3,6 +3,7 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -43,46 +44,104 @@ void RotationAndRightJacobian(const double* phi, Eigen::Matrix3d* rotation, Eige
 
 }  // namespace
 
+// RotationAndRightJacobian through a small per-thread cache keyed by the angle-axis values: the
+// residuals of one evaluation pass share a handful of poses, so each rotation is computed once per
+// pass instead of once per residual (the result is the same bits either way).
+void CachedRotation(const double* phi, Eigen::Matrix3d* rotation, Eigen::Matrix3d* right_jacobian) {
+  struct Entry {
+    double phi[3] = {0, 0, 0};
+    Eigen::Matrix3d rotation, right_jacobian;
+    bool valid = false;
+  };
+  constexpr int kEntries = 16;
+  thread_local Entry cache[kEntries];
+  thread_local int next = 0;
+  for (Entry& e : cache) {
+    if (e.valid && e.phi[0] == phi[0] && e.phi[1] == phi[1] && e.phi[2] == phi[2]) {
+      *rotation = e.rotation;
+      if (right_jacobian) *right_jacobian = e.right_jacobian;
+      return;
+    }
+  }
+  Entry& e = cache[next];
+  next = (next + 1) % kEntries;
+  RotationAndRightJacobian(phi, &e.rotation, &e.right_jacobian);
+  std::copy(phi, phi + 3, e.phi);
+  e.valid = true;
+  *rotation = e.rotation;
+  if (right_jacobian) *right_jacobian = e.right_jacobian;
+}
+
 // r = b - u,  u = q / |q|,  q = R_c (R_r X + t_r) + t_c,  p = R_r X + t_r.
 // Unknowns: rig_from_world (phi_r, t_r), cam_from_rig (phi_c, t_c), point_in_world X. With
 // dr/dq = -(I - u u^T) / |q| =: -P:
 //   dr/dX = -P R_c R_r,   dr/dt_r = -P R_c,   dr/dt_c = -P,
 //   dr/dphi_c = P R_c [p]x Jr(phi_c),   dr/dphi_r = P R_c R_r [X]x Jr(phi_r).
-// Analytic: about 4x cheaper than the same residual in 15-dimensional autodiff Jets, and Jacobians of
-// blocks held constant (fixed extrinsics) are not computed at all.
+// Analytic: about 4x cheaper than the same residual in 15-dimensional autodiff Jets. Jacobians are
+// written where `jacobians[k]` is non-null: [0] phi_r, [1] t_r, [2] phi_c, [3] t_c, [4] X; the cam
+// Jacobian `cam_jr` is needed only for [2].
+bool EvaluateBearing(const Eigen::Vector3d& bearing, const double* rig_aa, const double* rig_t_data,
+                     const Eigen::Matrix3d& cam_rotation, const Eigen::Vector3d& cam_t, const Eigen::Matrix3d* cam_jr,
+                     const double* point_data, double* residuals, double* const* jacobians) {
+  Eigen::Matrix3d rig_rotation, rig_jr;
+  CachedRotation(rig_aa, &rig_rotation, jacobians && jacobians[0] ? &rig_jr : nullptr);
+  const Eigen::Map<const Eigen::Vector3d> rig_t(rig_t_data), point_in_world(point_data);
+  const Eigen::Vector3d in_rig = rig_rotation * point_in_world + rig_t;
+  const Eigen::Vector3d in_cam = cam_rotation * in_rig + cam_t;
+  const double norm = in_cam.norm();
+  if (!(norm > 0.0)) return false;
+  const Eigen::Vector3d u = in_cam / norm;
+  Eigen::Map<Eigen::Vector3d> residual(residuals);
+  residual = bearing - u;
+  if (!jacobians) return true;
+  const Eigen::Matrix3d projector = (Eigen::Matrix3d::Identity() - u * u.transpose()) / norm;  // P
+  const Eigen::Matrix3d p_rc = projector * cam_rotation;                                       // P R_c
+  using RowMajor3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+  auto block = [&](int k) { return Eigen::Map<RowMajor3>(jacobians[k]); };
+  if (jacobians[0]) block(0) = p_rc * rig_rotation * Hat(point_in_world) * rig_jr;
+  if (jacobians[1]) block(1) = -p_rc;
+  if (jacobians[2]) block(2) = p_rc * Hat(in_rig) * *cam_jr;
+  if (jacobians[3]) block(3) = -projector;
+  if (jacobians[4]) block(4) = -p_rc * rig_rotation;
+  return true;
+}
+
+// The residual above over the blocks (phi_r, t_r, phi_c, t_c, X): online extrinsics.
 class BearingResidual final : public ceres::SizedCostFunction<3, 3, 3, 3, 3, 3> {
  public:
   explicit BearingResidual(const Eigen::Vector3d& bearing_in_cam) : bearing_(bearing_in_cam) {}
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    const bool need_rig_rot = jacobians && jacobians[0];
-    const bool need_cam_rot = jacobians && jacobians[2];
-    Eigen::Matrix3d rig_rotation, cam_rotation, rig_jr, cam_jr;
-    RotationAndRightJacobian(parameters[0], &rig_rotation, need_rig_rot ? &rig_jr : nullptr);
-    RotationAndRightJacobian(parameters[2], &cam_rotation, need_cam_rot ? &cam_jr : nullptr);
-    const Eigen::Map<const Eigen::Vector3d> rig_t(parameters[1]), cam_t(parameters[3]), point_in_world(parameters[4]);
-    const Eigen::Vector3d in_rig = rig_rotation * point_in_world + rig_t;
-    const Eigen::Vector3d in_cam = cam_rotation * in_rig + cam_t;
-    const double norm = in_cam.norm();
-    if (!(norm > 0.0)) return false;
-    const Eigen::Vector3d u = in_cam / norm;
-    Eigen::Map<Eigen::Vector3d> residual(residuals);
-    residual = bearing_ - u;
-    if (!jacobians) return true;
-    const Eigen::Matrix3d projector = (Eigen::Matrix3d::Identity() - u * u.transpose()) / norm;  // P
-    const Eigen::Matrix3d p_rc = projector * cam_rotation;                                       // P R_c
-    using RowMajor3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
-    auto block = [&](int k) { return Eigen::Map<RowMajor3>(jacobians[k]); };
-    if (jacobians[0]) block(0) = p_rc * rig_rotation * Hat(point_in_world) * rig_jr;
-    if (jacobians[1]) block(1) = -p_rc;
-    if (jacobians[2]) block(2) = p_rc * Hat(in_rig) * cam_jr;
-    if (jacobians[3]) block(3) = -projector;
-    if (jacobians[4]) block(4) = -p_rc * rig_rotation;
-    return true;
+    Eigen::Matrix3d cam_rotation, cam_jr;
+    CachedRotation(parameters[2], &cam_rotation, jacobians && jacobians[2] ? &cam_jr : nullptr);
+    return EvaluateBearing(bearing_, parameters[0], parameters[1], cam_rotation,
+                           Eigen::Map<const Eigen::Vector3d>(parameters[3]), &cam_jr, parameters[4], residuals,
+                           jacobians);
   }
 
  private:
   Eigen::Vector3d bearing_;
+};
+
+// The same residual with cam_from_rig held fixed (GTExt, NoisyExt): blocks (phi_r, t_r, X) only,
+// which spares the solver two constant blocks per residual.
+class FixedCameraBearingResidual final : public ceres::SizedCostFunction<3, 3, 3, 3> {
+ public:
+  FixedCameraBearingResidual(const Eigen::Vector3d& bearing_in_cam, const Eigen::Matrix3d& cam_rotation,
+                             const Eigen::Vector3d& cam_t)
+      : bearing_(bearing_in_cam), cam_rotation_(cam_rotation), cam_t_(cam_t) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    double* all[5] = {nullptr, nullptr, nullptr, nullptr, nullptr};
+    if (jacobians) all[0] = jacobians[0], all[1] = jacobians[1], all[4] = jacobians[2];
+    return EvaluateBearing(bearing_, parameters[0], parameters[1], cam_rotation_, cam_t_, nullptr, parameters[2],
+                           residuals, jacobians ? all : nullptr);
+  }
+
+ private:
+  Eigen::Vector3d bearing_;
+  Eigen::Matrix3d cam_rotation_;
+  Eigen::Vector3d cam_t_;
 };
 
 ceres::CostFunction* CreateBearingResidual(const Eigen::Vector3d& bearing_in_cam) {
@@ -200,33 +259,39 @@ LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& option
   std::vector<double> baselines =
       problem.baseline_lengths.empty() ? RingBaselineLengths(problem.cam_from_rig) : problem.baseline_lengths;
 
+  // Two shared losses (single- and multi-camera weight), owned here.
+  ceres::CauchyLoss cauchy(options.cauchy_scale_rad);
+  ceres::ScaledLoss loss_single(&cauchy, 1.0, ceres::DO_NOT_TAKE_OWNERSHIP);
+  ceres::ScaledLoss loss_multi(&cauchy, options.multi_camera_weight, ceres::DO_NOT_TAKE_OWNERSHIP);
   ceres::Problem::Options problem_options;
-  problem_options.loss_function_ownership = ceres::TAKE_OWNERSHIP;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem ceres_problem(problem_options);
+  // A camera held fixed (all of them without online calibration, camera 0 always) enters its
+  // residuals as constants (FixedCameraBearingResidual); the others as parameter blocks.
+  std::vector<Eigen::Matrix3d> cam_rotations(num_cams);
+  for (int j = 0; j < num_cams; ++j) RotationAndRightJacobian(cams[j].aa.data(), &cam_rotations[j], nullptr);
+  const auto camera_free = [&](int j) { return options.optimize_extrinsics && j != 0; };
   std::vector<char> pose_used(num_poses, 0), cam_used(num_cams, 0), point_used(problem.points_in_world.size(), 0);
   for (const LocalBaObservation& o : problem.observations) {
-    const double weight =
-        (o.point_index < static_cast<int>(problem.point_num_cameras.size()) && problem.point_num_cameras[o.point_index] >= 2)
-            ? options.multi_camera_weight
-            : 1.0;
-    ceres::LossFunction* loss =
-        new ceres::ScaledLoss(new ceres::CauchyLoss(options.cauchy_scale_rad), weight, ceres::TAKE_OWNERSHIP);
-    ceres_problem.AddResidualBlock(CreateBearingResidual(o.bearing_in_cam), loss, poses[o.pose_index].aa.data(),
-                                   poses[o.pose_index].t.data(), cams[o.camera].aa.data(), cams[o.camera].t.data(),
-                                   problem.points_in_world[o.point_index].data());
+    const bool multi =
+        o.point_index < static_cast<int>(problem.point_num_cameras.size()) && problem.point_num_cameras[o.point_index] >= 2;
+    ceres::LossFunction* loss = multi ? &loss_multi : &loss_single;
+    double* point = problem.points_in_world[o.point_index].data();
+    if (camera_free(o.camera)) {
+      ceres_problem.AddResidualBlock(CreateBearingResidual(o.bearing_in_cam), loss, poses[o.pose_index].aa.data(),
+                                     poses[o.pose_index].t.data(), cams[o.camera].aa.data(), cams[o.camera].t.data(),
+                                     point);
+    } else {
+      ceres_problem.AddResidualBlock(
+          new FixedCameraBearingResidual(o.bearing_in_cam, cam_rotations[o.camera], cams[o.camera].t), loss,
+          poses[o.pose_index].aa.data(), poses[o.pose_index].t.data(), point);
+    }
     pose_used[o.pose_index] = cam_used[o.camera] = point_used[o.point_index] = 1;
     ++report.num_residuals;
   }
   if (pose_used[0]) {
     ceres_problem.SetParameterBlockConstant(poses[0].aa.data());
     ceres_problem.SetParameterBlockConstant(poses[0].t.data());
-  }
-  for (int j = 0; j < num_cams; ++j) {
-    if (!cam_used[j]) continue;
-    if (!options.optimize_extrinsics || j == 0) {
-      ceres_problem.SetParameterBlockConstant(cams[j].aa.data());
-      ceres_problem.SetParameterBlockConstant(cams[j].t.data());
-    }
   }
   if (options.optimize_extrinsics && options.baseline_weight > 0.0) {
     for (size_t p = 0; p < baselines.size(); ++p) {
@@ -235,6 +300,12 @@ LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& option
       ceres_problem.AddResidualBlock(BaselineCost::Create(baselines[p], options.baseline_weight), nullptr,
                                      cams[a].aa.data(), cams[a].t.data(), cams[b].aa.data(), cams[b].t.data());
     }
+  }
+  // Fixed cameras that a baseline term brought in stay constant.
+  for (int j = 0; j < num_cams; ++j) {
+    if (camera_free(j) || !ceres_problem.HasParameterBlock(cams[j].aa.data())) continue;
+    ceres_problem.SetParameterBlockConstant(cams[j].aa.data());
+    ceres_problem.SetParameterBlockConstant(cams[j].t.data());
   }
 
   if (options.optimize_extrinsics && options.extrinsic_prior_deg > 0.0) {
@@ -259,7 +330,7 @@ LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& option
     ordering->AddElementToGroup(poses[i].t.data(), 1);
   }
   for (int j = 0; j < num_cams; ++j) {
-    if (!cam_used[j]) continue;
+    if (!ceres_problem.HasParameterBlock(cams[j].aa.data())) continue;
     ordering->AddElementToGroup(cams[j].aa.data(), 1);
     ordering->AddElementToGroup(cams[j].t.data(), 1);
   }
