@@ -1,7 +1,8 @@
 #pragma once
 // Intra-view feature processing (ROVO paper IV-B): FAST corners (ORB's detector) picked strongest
 // first under a minimum-distance constraint so they cover the image uniformly; pyramidal KLT
-// (cv::calcOpticalFlowPyrLK) from the previous frame with a forward-backward check; re-detection to
+// (cv::calcOpticalFlowPyrLK) from the previous frame, started at the last displacement for tracks
+// seen before, with an independent forward-backward check; re-detection to
 // keep a target count; ORB descriptors (oriented BRIEF, orientation by the intensity centroid of a
 // radius-15 disc) recomputed on every point every frame so that inter-view matching can use them.
 //
