@@ -1,11 +1,15 @@
 // `rovo` subcommands of vo/: `rovo vo` (run the pipeline on a dataset) and `rovo bench vo`.
 #include "datasets/cli_groups.h"
+#include "datasets/rig.h"
+#include "vo/hybrid_projection.h"
 #include "vo/pipeline.h"
-
 #include "vo/projection_study.h"
 
 #include <CLI/CLI.hpp>
+#include <opencv2/core.hpp>
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
@@ -13,6 +17,28 @@
 
 namespace rovo {
 namespace {
+
+// Machine reference printed with the bench table, so that figures taken on different machines can be
+// compared: one full-size hybrid warp (rovo4, camera 0, a fixed random image) on one core, median of 9.
+double MachineReferenceWarpMs() {
+  const Rig rig = MakeRigPreset("rovo4");
+  const std::vector<HybridLayout> layouts = ComputeHybridLayouts(rig);
+  const HybridProjection projection(rig.cameras[0].camera, rig.cameras[0].cam_from_rig, layouts[0]);
+  cv::Mat image(rig.cameras[0].camera.height, rig.cameras[0].camera.width, CV_8UC1);
+  cv::RNG(7).fill(image, cv::RNG::UNIFORM, 0, 255);
+  const int threads = cv::getNumThreads();
+  cv::setNumThreads(1);
+  cv::Mat warped;
+  std::vector<double> ms;
+  for (int k = 0; k < 10; ++k) {
+    const auto start = std::chrono::steady_clock::now();
+    projection.Warp(image, &warped);
+    if (k > 0) ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+  }
+  cv::setNumThreads(threads);
+  std::nth_element(ms.begin(), ms.begin() + ms.size() / 2, ms.end());
+  return ms[ms.size() / 2];
+}
 
 
 struct VoArgs {
@@ -137,6 +163,7 @@ void AddVoCommands(CliGroups& groups) {
                                                    : "solved in line (--sync-ba)");
     std::printf("whole pipeline: %.2f frames/s (target 10 Hz)%s\n", t.total > 0 ? 1000.0 / t.total : 0.0,
                 options.preload_images ? ", images decoded beforehand" : ", images decoded on a second thread");
+    std::printf("machine reference: one full-size hybrid warp on one core takes %.2f ms\n", MachineReferenceWarpMs());
   });
 
   AddProjectionStudyCommand(groups);
