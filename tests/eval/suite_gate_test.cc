@@ -69,6 +69,23 @@ TEST(Suite, TableShowsOursAndThePapersRelativeError) {
   EXPECT_FALSE(PaperRowForPreset("nonexistent").has_value());
 }
 
+TEST(Suite, TableSaysWhenARunHasNoValue) {
+  PresetSummary p;
+  p.preset = "sunset_urban";
+  p.frames = 60;
+  p.path_length_m = 100.0;
+  RunMetrics lost = Metrics("noisy", 2, 0.0, 0.0);  // lost on every frame: nothing to align
+  lost.rmse_se3_m.reset();
+  lost.relative_rmse_pct.reset();
+  lost.rmse_origin_m.reset();
+  p.modes = SummariseModes({Metrics("gt", -1, 0.1, 0.7), Metrics("noisy", 0, 3.0, 0.4), Metrics("noisy", 1, 5.0, 0.5),
+                            lost, Metrics("online", 0, 0.2, 0.6)});
+  const std::string md = SuiteTableMarkdown({p}, true);
+  EXPECT_NE(md.find("4.000 ± 1.414 (2 of 3 runs)"), std::string::npos) << md;  // NoisyExt RMSE
+  EXPECT_NE(md.find("4.00 (2 of 3 runs) / 0.200 / 0.100"), std::string::npos) << md;  // relative
+  EXPECT_EQ(md.find("of 1 runs"), std::string::npos) << md;  // complete modes carry no count
+}
+
 nlohmann::json SampleSuiteJson() {
   SuiteOptions options;
   options.quick = true;
