@@ -21,6 +21,8 @@ try:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    # Tick labels in plain numbers: no "-1.799e2" offset above an axis of values near -180.
+    matplotlib.rcParams["axes.formatter.useoffset"] = False
 except ImportError:
     sys.stderr.write("plot_report.py: matplotlib is not installed\n")
     sys.exit(3)
