@@ -40,7 +40,6 @@ double MachineReferenceWarpMs() {
   return ms[ms.size() / 2];
 }
 
-
 struct VoArgs {
   VoOptions options;
   std::string extrinsics = "gt";

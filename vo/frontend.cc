@@ -104,10 +104,6 @@ struct Frontend::Impl {
   std::vector<HybridProjection> projections;  // maps (rebuilt only past the threshold)
   std::vector<ViewTracker> trackers;
   std::vector<cv::Mat> warped, fisheye_gray;
-  // Per view, the warp buffers of the last two frames: a frame writes into the one of two frames
-  // ago when nothing else holds it any more (saves allocating and page-faulting a full image).
-  std::vector<std::array<cv::Mat, 2>> warp_buffers;
-  uint64_t frames_processed = 0;
   std::vector<std::pair<int, int>> pairs;     // (camera, its right neighbour), each overlap once
   std::vector<ViewMatch> last_matches;
   uint64_t last_id = 0;
@@ -135,7 +131,6 @@ Frontend::Frontend(const Rig& rig, const FrontendOptions& options) : impl_(std::
   s.trackers.assign(rig.NumCameras(), ViewTracker(TrackerOptionsFrom(s.options)));
   s.warped.resize(rig.NumCameras());
   s.fisheye_gray.resize(rig.NumCameras());
-  s.warp_buffers.resize(rig.NumCameras());
   s.UpdatePairs();
 }
 
@@ -172,8 +167,8 @@ void Frontend::SetExtrinsics(const std::vector<Rigid3>& cam_from_rig) {
     for (const TrackedPoint& p : s.trackers[i].points()) {
       const auto bearing = old.BearingFromWarped(Eigen::Vector2d(p.px.x, p.px.y));
       if (!bearing) continue;
-      const auto px = rebuilt.WarpedFromBearing(*bearing);
-      if (!px || !rebuilt.InWarpedImage(*px)) continue;
+      const auto px = rebuilt.WarpedInImageFromBearing(*bearing);
+      if (!px) continue;
       TrackedPoint q = p;
       q.px = cv::Point2f(static_cast<float>(px->x()), static_cast<float>(px->y()));
       carried.push_back(std::move(q));
@@ -267,10 +262,9 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
       start = now;
     };
     s.fisheye_gray[i] = ToGray(fisheye_images[i], i);
-    cv::Mat& buffer = s.warp_buffers[i][s.frames_processed % 2];
-    if (buffer.u != nullptr && buffer.u->refcount > 1) buffer = cv::Mat();  // still in use elsewhere
-    s.projections[i].Warp(s.fisheye_gray[i], &buffer);
-    s.warped[i] = buffer;
+    cv::Mat warped;
+    s.projections[i].Warp(s.fisheye_gray[i], &warped);
+    s.warped[i] = warped;
     lap(kWarp);
     s.trackers[i].Track(s.warped[i], s.projections[i].valid_mask());
     lap(kTrack);
@@ -317,9 +311,7 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
       const HybridProjection* projection = &s.projections[i];
       const Eigen::Matrix3d cam_from_rig = rig_from_cam.transpose();
       views[i].pixel_from_direction_in_rig = [projection, cam_from_rig](const Eigen::Vector3d& d) {
-        auto px = projection->WarpedFromBearing(cam_from_rig * d);
-        if (px && !projection->InWarpedImage(*px)) px.reset();
-        return px;
+        return projection->WarpedInImageFromBearing(cam_from_rig * d);
       };
       views[i].bearings_in_rig.reserve(bearings_in_cam[i].size());
       for (const auto& bearing : bearings_in_cam[i]) {
@@ -399,7 +391,6 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
       out.push_back(f);
     }
   }
-  ++s.frames_processed;
   return frame;
 }
 

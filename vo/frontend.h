@@ -65,7 +65,8 @@ struct FrontendOptions {
   // Forward pass from the last displacement (TrackerOptions explains). With the independent
   // backward check (tracking.h), measured 2026-11-21 on full-size datasets, first 300 frames,
   // GTExt, against the session-4 tracker: relative RMSE dynamic_urban 0.051 -> 0.046 %,
-  // canyon_multifov 0.245 -> 0.071 %, cloudy_urban 0.022 -> 0.016 %; inlier ratio +0.6..2 points.
+  // canyon_multifov 0.245 -> 0.071 %, cloudy_urban 0.022 -> 0.016 %, sunset_urban 0.029 -> 0.021 %;
+  // inlier ratio +0.4..2.0 points.
   bool klt_predict_flow = true;
   int klt_predicted_levels = 0;         // levels of a predicted forward pass
   HybridProjectionOptions projection;   // warp geometry (focal, extents, rebuild threshold)

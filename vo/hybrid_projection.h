@@ -107,6 +107,12 @@ class HybridProjection {
   // when the direction is along `up`, or 90 deg or more away from the plane normal in a plane
   // region. The pixel may lie outside the warped rectangle (check InWarpedImage).
   std::optional<Eigen::Vector2d> WarpedFromBearing(const Eigen::Vector3d& bearing_in_cam) const;
+  // WarpedFromBearing, nullopt also when the pixel lies outside the warped rectangle.
+  std::optional<Eigen::Vector2d> WarpedInImageFromBearing(const Eigen::Vector3d& bearing_in_cam) const {
+    auto px = WarpedFromBearing(bearing_in_cam);
+    if (px && !InWarpedImage(*px)) px.reset();
+    return px;
+  }
   // Fisheye pixel of a warped pixel (BearingFromWarped then Camera::Project).
   std::optional<Eigen::Vector2d> FisheyeFromWarped(const Eigen::Vector2d& warped_px) const;
   // Warped pixel of a fisheye pixel.

@@ -261,8 +261,8 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
   // A direction (rig frame) is in the overlap of (a, b) when it falls inside both hybrid images.
   const auto in_hybrid_image = [&](int camera, const Eigen::Vector3d& bearing_in_rig) {
     const HybridProjection& projection = frontend.projection(camera);
-    const auto px = projection.WarpedFromBearing(rig.cameras[camera].cam_from_rig.RotationMatrix() * bearing_in_rig);
-    if (!px || !projection.InWarpedImage(*px)) return false;
+    const auto px = projection.WarpedInImageFromBearing(rig.cameras[camera].cam_from_rig.RotationMatrix() * bearing_in_rig);
+    if (!px) return false;
     const int u = static_cast<int>(std::lround(px->x())), v = static_cast<int>(std::lround(px->y()));
     return projection.valid_mask().at<uint8_t>(v, u) != 0;
   };
@@ -316,8 +316,7 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
       if (last) arm->drawn.clear();
       for (size_t k = 0; k < pairs.size(); ++k) {
         const auto [a, b] = pairs[k];
-        // The overlap features of both views (indices into the trackers' points).
-        std::vector<int> index[2];
+        // The overlap features of both views.
         std::vector<TrackedPoint> points[2];
         MatchView views[2];
         for (int side = 0; side < 2; ++side) {
@@ -326,7 +325,6 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
           for (int q = 0; q < static_cast<int>(all.size()); ++q) {
             const Eigen::Vector3d& d = bearings_in_rig[camera][q];
             if (!all[q].has_descriptor || d.isZero() || !in_hybrid_image(a, d) || !in_hybrid_image(b, d)) continue;
-            index[side].push_back(q);
             points[side].push_back(all[q]);
             views[side].bearings_in_rig.push_back(d);
           }
@@ -337,9 +335,7 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
           if (hybrid) {
             const HybridProjection* projection = &frontend.projection(camera);
             views[side].pixel_from_direction_in_rig = [projection, cam_from_rig](const Eigen::Vector3d& d) {
-              auto px = projection->WarpedFromBearing(cam_from_rig * d);
-              if (px && !projection->InWarpedImage(*px)) px.reset();
-              return px;
+              return projection->WarpedInImageFromBearing(cam_from_rig * d);
             };
           } else {
             const Camera* lens = &rig.cameras[camera].camera;
