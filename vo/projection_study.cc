@@ -573,8 +573,8 @@ void AddProjectionStudyCommand(CliGroups& groups) {
   CLI::App* cmd = groups.study->add_subcommand(
       "projection",
       "Paper Table II on a dataset: ORB descriptor distance of tracked features (first frame vs later) and "
-      "inter-view matching inlier ratio (verified with the dataset's depth), raw fisheye vs hybrid "
-      "projection. Writes table.md, study.json and match drawings. Needs a dataset rendered with --depth.");
+      "inter-view matching inlier ratio (verified with the dataset's depth; descriptors only, epipolar-consistent, "
+      "and the front-end's filter chain), raw fisheye vs hybrid projection. Writes table.md, study.json and match drawings. Needs a dataset rendered with --depth.");
   cmd->add_option("dataset", options->dataset_dir, "Dataset folder (with depth/)")->required();
   cmd->add_option("--out", options->out_dir, "Output folder")->required();
   cmd->add_option("--frames", options->frames, "Frames to use from the start")->capture_default_str()->check(
