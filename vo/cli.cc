@@ -73,9 +73,10 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
       ->check(CLI::Range(0.0, 45.0))
       ->capture_default_str();
   cmd->add_option("--tau", args->options.ransac_tau_deg,
-                  "RANSAC inlier threshold in degrees (angle between observed and predicted bearing; 0: the default, "
-                  "2 pixels at the image centre, i.e. 0.29 deg for the full-size rovo4 lenses; recorded in run.json)")
-      ->check(CLI::Range(0.0, 10.0));
+                  "RANSAC inlier threshold in degrees: the angle between observed and predicted bearing, the same "
+                  "for every rig (recorded in run.json)")
+      ->check(CLI::Range(0.01, 10.0))
+      ->capture_default_str();
   cmd->add_option("--keyframe-distance", args->options.keyframe_distance_m,
                   "Rig travel in metres that makes a keyframe (and a local BA); 0: the default, recorded in run.json")
       ->check(CLI::Range(0.0, 100.0));

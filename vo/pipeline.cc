@@ -553,24 +553,6 @@ std::vector<Rigid3> BootstrapExtrinsics(const VoOptions& options, const Rig& rig
   return cam_from_rig;
 }
 
-// Mean over the cameras of the angle between the optical axis and the bearing one pixel to its right:
-// the angular size of a pixel at the image centre.
-double CentralPixelAngleRad(const Rig& rig) {
-  double sum = 0.0;
-  int n = 0;
-  for (const RigCamera& cam : rig.cameras) {
-    const Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
-    const std::optional<Eigen::Vector2d> centre = cam.camera.Project(axis);
-    if (!centre) continue;
-    const std::optional<Eigen::Vector3d> right = cam.camera.Unproject(*centre + Eigen::Vector2d(1.0, 0.0));
-    if (!right) continue;
-    sum += AngleBetween(axis, *right);
-    ++n;
-  }
-  if (n == 0) throw std::invalid_argument("vo: no camera of the rig projects its optical axis (dataset.json rig.cameras)");
-  return sum / n;
-}
-
 nlohmann::json PoseJson(const Rigid3& x) {
   return {{"translation", {x.translation.x(), x.translation.y(), x.translation.z()}},
           {"rotation_xyzw", {x.rotation.x(), x.rotation.y(), x.rotation.z(), x.rotation.w()}}};
@@ -626,9 +608,10 @@ VoSummary RunVo(const VoOptions& options) {
   backend_options.ransac.views = RansacViewsFromName(options.ransac);
   backend_options.ba.optimize_extrinsics = options.mode == ExtrinsicsMode::kOnline;
   backend_options.async_ba = options.async_ba;
-  backend_options.ransac.tau_rad = options.ransac_tau_deg > 0.0
-                                       ? options.ransac_tau_deg * M_PI / 180.0
-                                       : options.ransac_tau_px * CentralPixelAngleRad(info.rig);
+  if (!(options.ransac_tau_deg > 0.0)) {
+    throw std::invalid_argument("vo: the RANSAC inlier threshold must be positive (--tau, degrees)");
+  }
+  backend_options.ransac.tau_rad = options.ransac_tau_deg * M_PI / 180.0;
   if (options.keyframe_distance_m > 0.0) backend_options.keyframes.min_translation_m = options.keyframe_distance_m;
   // Online: each keyframe BA may move an extrinsic by about this much (random-walk prior, local_ba.h):
   // measured on cloudy_urban quick, it halves the wander of the estimate between windows.
