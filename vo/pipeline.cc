@@ -564,6 +564,10 @@ VoSummary RunVo(const VoOptions& options) {
   const auto run_start = Clock::now();
   if (options.dataset_dir.empty()) throw std::invalid_argument("vo: no dataset folder given");
   if (options.out_dir.empty()) throw std::invalid_argument("vo: no output (run) folder given");
+  if (!(options.ransac_tau_deg > 0.0)) {
+    throw std::invalid_argument("vo: the RANSAC inlier threshold must be positive (--tau, degrees), got " +
+                                std::to_string(options.ransac_tau_deg));
+  }
   const DatasetInfo info = ReadDatasetInfo(options.dataset_dir);
   const int num_cams = info.rig.NumCameras();
   const int begin = options.frame_begin;
@@ -608,9 +612,6 @@ VoSummary RunVo(const VoOptions& options) {
   backend_options.ransac.views = RansacViewsFromName(options.ransac);
   backend_options.ba.optimize_extrinsics = options.mode == ExtrinsicsMode::kOnline;
   backend_options.async_ba = options.async_ba;
-  if (!(options.ransac_tau_deg > 0.0)) {
-    throw std::invalid_argument("vo: the RANSAC inlier threshold must be positive (--tau, degrees)");
-  }
   backend_options.ransac.tau_rad = options.ransac_tau_deg * M_PI / 180.0;
   if (options.keyframe_distance_m > 0.0) backend_options.keyframes.min_translation_m = options.keyframe_distance_m;
   // Online: each keyframe BA may move an extrinsic by about this much (random-walk prior, local_ba.h):

@@ -13,6 +13,19 @@ namespace {
 
 double PositionError(const Rigid3& a, const Rigid3& b) { return (a.translation - b.translation).norm(); }
 
+TEST(RunVo, RejectsANonPositiveInlierThresholdBeforeReadingTheDataset) {
+  VoOptions options;
+  options.dataset_dir = "/nonexistent/dataset";
+  options.out_dir = "/nonexistent/run";
+  options.ransac_tau_deg = 0.0;
+  try {
+    RunVo(options);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--tau"), std::string::npos) << e.what();
+  }
+}
+
 TEST(VoBackend, TracksExactSequenceWithGroundTruthExtrinsics) {
   const int frames = 30;
   const test::World w = test::MakeWorld(frames, 1);
