@@ -114,7 +114,8 @@ void AddVoCommands(CliGroups& groups) {
   auto bench_args = std::make_shared<VoArgs>();
   CLI::App* bench = groups.bench->add_subcommand(
       "vo", "Time the whole pipeline on a dataset (full image size) and print a table of mean ms per frame by stage, "
-            "with a machine reference (one full-size hybrid warp on one core) to compare machines");
+            "with a machine reference (one full-size hybrid warp on one core; it does not capture every drift of a "
+            "shared machine, so compare speeds from back-to-back runs)");
   AddVoRunOptions(bench, bench_args.get());
   bench->add_option("--out", bench_args->options.out_dir, "Run folder to write (default: DATASET/../bench_vo_run)");
   bench->add_flag("--preload", bench_args->options.preload_images,

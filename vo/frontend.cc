@@ -262,6 +262,7 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
       start = now;
     };
     s.fisheye_gray[i] = ToGray(fisheye_images[i], i);
+    // A fresh buffer: the tracker still holds the previous warped image (s.warped[i] shares it).
     cv::Mat warped;
     s.projections[i].Warp(s.fisheye_gray[i], &warped);
     s.warped[i] = warped;

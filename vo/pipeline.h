@@ -53,15 +53,11 @@ struct VoOptions {
   int online_bootstrap_rounds = 6;
   // RANSAC inlier threshold (MultiViewRansacOptions::tau_rad) in degrees: one angle for every rig,
   // as the paper's cost is angular (max(0, tau - angle)). Until 2026-11-21 it was 2 pixels at the
-  // image centre (0.29 deg for the full-size rovo4 lenses, 0.60 deg for canyon_multifov's and 0.57
-  // deg for the quick forms), which let canyon_multifov's drifted tracks count as inliers (mean
-  // reprojection error 0.18 deg). Measured 2026-11-21, GTExt relative RMSE, 2 px -> 0.2 deg: first
-  // 300 frames at full size dynamic_urban 0.047 -> 0.044 %, cloudy_urban 0.016 -> 0.015 %,
-  // sunset_urban 0.021 -> 0.024 %; whole canyon_multifov 0.037 -> 0.040 % (reprojection 0.178 ->
-  // 0.086 deg, inliers 92.9 -> 79.0 %); quick cloudy / sunset 0.041 -> 0.018 % / 0.034 -> 0.029 %,
-  // OnlineExt (noise sets 0, 1) 0.069 -> 0.054, 0.044 -> 0.032 % / 0.040 -> 0.041, 0.051 -> 0.045 %.
-  // A tighter threshold counts fewer inliers: canyon_multifov OnlineExt 82 -> 49 % (its estimated
-  // extrinsics are off by up to 0.1 deg, half the threshold).
+  // image centre: 0.29 deg on the full-size rovo4 lenses but 0.60 deg on canyon_multifov's, whose
+  // drifted tracks then counted as inliers (reprojection error 0.18 deg). With 0.2 deg, whole
+  // sequences: canyon_multifov reprojection 0.178 -> 0.086 deg (GTExt), relative RMSE within the
+  // run-to-run spread on all five presets (README), inlier ratios lower (canyon_multifov OnlineExt
+  // 82 -> 49 %: its online extrinsics are off by up to 0.09 deg, half the threshold).
   double ransac_tau_deg = 0.2;
   // Back-end settings exposed on the command line; <= 0 keeps BackendOptions' default.
   double keyframe_distance_m = 0.0;      // KeyframeOptions::min_translation_m

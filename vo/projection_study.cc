@@ -261,7 +261,8 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
   // A direction (rig frame) is in the overlap of (a, b) when it falls inside both hybrid images.
   const auto in_hybrid_image = [&](int camera, const Eigen::Vector3d& bearing_in_rig) {
     const HybridProjection& projection = frontend.projection(camera);
-    const auto px = projection.WarpedInImageFromBearing(rig.cameras[camera].cam_from_rig.RotationMatrix() * bearing_in_rig);
+    const Eigen::Vector3d bearing_in_cam = rig.cameras[camera].cam_from_rig.RotationMatrix() * bearing_in_rig;
+    const auto px = projection.WarpedInImageFromBearing(bearing_in_cam);
     if (!px) return false;
     const int u = static_cast<int>(std::lround(px->x())), v = static_cast<int>(std::lround(px->y()));
     return projection.valid_mask().at<uint8_t>(v, u) != 0;
@@ -574,7 +575,8 @@ void AddProjectionStudyCommand(CliGroups& groups) {
       "projection",
       "Paper Table II on a dataset: ORB descriptor distance of tracked features (first frame vs later) and "
       "inter-view matching inlier ratio (verified with the dataset's depth; descriptors only, epipolar-consistent, "
-      "and the front-end's filter chain), raw fisheye vs hybrid projection. Writes table.md, study.json and match drawings. Needs a dataset rendered with --depth.");
+      "and the front-end's filter chain), raw fisheye vs hybrid projection. Writes table.md, study.json and match "
+      "drawings. Needs a dataset rendered with --depth.");
   cmd->add_option("dataset", options->dataset_dir, "Dataset folder (with depth/)")->required();
   cmd->add_option("--out", options->out_dir, "Output folder")->required();
   cmd->add_option("--frames", options->frames, "Frames to use from the start")->capture_default_str()->check(
