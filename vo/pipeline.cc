@@ -57,6 +57,8 @@ void BackendOptions::Check() const {
   if (window_keyframes < 2) throw std::invalid_argument("BackendOptions.window_keyframes must be >= 2");
   if (min_correspondences < 3) throw std::invalid_argument("BackendOptions.min_correspondences must be >= 3");
   if (max_unseen_frames < 0) throw std::invalid_argument("BackendOptions.max_unseen_frames must be >= 0");
+  if (!(online_max_error_deg > 0.0)) throw std::invalid_argument("BackendOptions.online_max_error_deg must be > 0");
+  if (online_settle_frames < 0) throw std::invalid_argument("BackendOptions.online_settle_frames must be >= 0");
 }
 
 VoBackend::VoBackend(const std::vector<Rigid3>& initial_cam_from_rig, const Rigid3& initial_world_from_rig,
@@ -280,6 +282,7 @@ BackendFrameResult VoBackend::ProcessFrame(int frame, const FrontendFrame& front
   FinishPendingBa();  // callers that want the keyframe's refined pose call it themselves first
   FrameRecord& rec = result.record;
   rec.frame = frame;
+  if (first_frame_ < 0) first_frame_ = frame;
   for (const auto& [from, into] : frontend.merged_ids) map_.Merge(from, into);
   int total_features = 0;
   for (const auto& f : frontend.features_per_camera) total_features += static_cast<int>(f.size());
@@ -357,8 +360,8 @@ BackendFrameResult VoBackend::ProcessFrame(int frame, const FrontendFrame& front
   Rigid3 rig_from_world = refined.usable ? refined.rig_from_world : ransac.rig_from_world;
   // Inliers and their mean angular error under the refined pose.
   std::vector<std::vector<char>> rejected(num_cams);
-  const double reject_rad =
-      options_.ba.optimize_extrinsics ? options_.online_max_error_deg * M_PI / 180.0 : options_.ransac.tau_rad;
+  const bool settling = options_.ba.optimize_extrinsics && frame - first_frame_ < options_.online_settle_frames;
+  const double reject_rad = settling ? options_.online_max_error_deg * M_PI / 180.0 : options_.ransac.tau_rad;
   double error_sum = 0.0;
   int inliers = 0;
   for (int j = 0; j < num_cams; ++j) {
@@ -614,6 +617,7 @@ VoSummary RunVo(const VoOptions& options) {
   backend_options.async_ba = options.async_ba;
   backend_options.ransac.tau_rad = options.ransac_tau_deg * M_PI / 180.0;
   if (options.keyframe_distance_m > 0.0) backend_options.keyframes.min_translation_m = options.keyframe_distance_m;
+  if (options.online_settle_frames >= 0) backend_options.online_settle_frames = options.online_settle_frames;
   // Online: each keyframe BA may move an extrinsic by about this much (random-walk prior, local_ba.h):
   // measured on cloudy_urban quick, it halves the wander of the estimate between windows.
   backend_options.ba.extrinsic_prior_deg = 0.005;
@@ -741,7 +745,9 @@ VoSummary RunVo(const VoOptions& options) {
                   {"window_keyframes", backend_options.window_keyframes},
                   {"async_ba", backend_options.async_ba},
                   {"keyframe_distance_m", backend_options.keyframes.min_translation_m},
-                  {"keyframe_max_frame_gap", backend_options.keyframes.max_frame_gap}};
+                  {"keyframe_max_frame_gap", backend_options.keyframes.max_frame_gap},
+                  {"online_max_error_deg", backend_options.online_max_error_deg},
+                  {"online_settle_frames", backend_options.online_settle_frames}};
   j["summary"] = {{"frames", summary.frames},
                   {"frames_ok", summary.frames_ok},
                   {"frames_init", summary.frames_init},
