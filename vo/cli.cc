@@ -22,8 +22,9 @@ namespace {
 
 // Machine reference printed with the bench table: full-size hybrid warps (rovo4, camera 0, a fixed
 // random image), one per core on `cores` cores at once (shared caches and memory bandwidth included),
-// median wall time of 9 rounds. Measured before and after the run: a shared machine's speed drifts by
-// up to 25 % between hours, and a run is comparable to another only if the reference agrees.
+// median wall time of 31 rounds (single rounds vary by 2x on this shared machine). Measured before and
+// after the run: the machine's speed drifts by a third or more between hours (the one-core warp took
+// 6.8 ms one evening, 10.5 ms another), so runs are comparable only when their references agree.
 double MachineReferenceWarpMs(int cores) {
   const Rig rig = MakeRigPreset("rovo4");
   const std::vector<HybridLayout> layouts = ComputeHybridLayouts(rig);
@@ -34,7 +35,7 @@ double MachineReferenceWarpMs(int cores) {
   cv::setNumThreads(1);
   std::vector<cv::Mat> warped(cores);
   std::vector<double> ms;
-  for (int k = 0; k < 10; ++k) {
+  for (int k = 0; k < 32; ++k) {
     const auto start = std::chrono::steady_clock::now();
     std::vector<std::thread> workers;
     for (int c = 0; c < cores; ++c) workers.emplace_back([&, c] { projection.Warp(image, &warped[c]); });
