@@ -40,7 +40,8 @@ double MachineReferenceWarpMs(int cores) {
     std::vector<std::thread> workers;
     for (int c = 0; c < cores; ++c) workers.emplace_back([&, c] { projection.Warp(image, &warped[c]); });
     for (std::thread& w : workers) w.join();
-    if (k > 0) ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    const double round_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    if (k > 0) ms.push_back(round_ms);
   }
   cv::setNumThreads(threads);
   std::nth_element(ms.begin(), ms.begin() + ms.size() / 2, ms.end());
@@ -136,7 +137,8 @@ void AddVoCommands(CliGroups& groups) {
     Finalise(bench_args.get());
     VoOptions options = bench_args->options;
     if (options.out_dir.empty()) options.out_dir = options.dataset_dir + "_bench_vo_run";
-    const int cores = std::max(1, options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency()));
+    const int cores =
+        options.threads > 0 ? options.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
     const double reference_before_ms = MachineReferenceWarpMs(cores);
     const VoSummary s = RunVo(options);
     const double reference_after_ms = MachineReferenceWarpMs(cores);
@@ -182,8 +184,10 @@ void AddVoCommands(CliGroups& groups) {
     std::printf("machine reference: one full-size hybrid warp per core on %d core%s at once: %.2f ms before the run, "
                 "%.2f ms after\n",
                 cores, cores == 1 ? "" : "s", reference_before_ms, reference_after_ms);
-    if (std::abs(reference_after_ms - reference_before_ms) > 0.1 * std::min(reference_before_ms, reference_after_ms)) {
-      std::printf("warning: the machine's speed changed by more than 10 %% during the run; repeat it before comparing\n");
+    const double reference_low_ms = std::min(reference_before_ms, reference_after_ms);
+    if (std::abs(reference_after_ms - reference_before_ms) > 0.1 * reference_low_ms) {
+      std::printf("warning: the machine's speed changed by more than 10 %% during the run; repeat it before "
+                  "comparing\n");
     }
   });
 
