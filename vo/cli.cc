@@ -78,7 +78,7 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
   cmd->add_option("--online-prior", args->options.online_prior_deg,
                   "OnlineExt: bound on the starting extrinsics' rotation error in degrees; the start-up "
                   "calibration at the first frame matches with filters this loose (0: no start-up calibration, "
-                  "BA only)")
+                  "BA only: an ablation, which does not correct errors of degrees)")
       ->check(CLI::Range(0.0, 45.0))
       ->capture_default_str();
   cmd->add_option("--tau", args->options.ransac_tau_deg,

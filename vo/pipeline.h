@@ -121,8 +121,10 @@ struct BackendOptions {
   // rejected, as in GTExt. Keeping the 0.2-2 deg observations for the whole run (as before
   // 2026-11-21) let them into the map: canyon_multifov OnlineExt counted 1730 correspondences per
   // frame against GTExt's 1480, and 49 % inliers against 79 %, even when started at the true
-  // extrinsics. The start-up calibration (extrinsic_bootstrap.h) leaves ~0.1 deg; without it
-  // (--online-prior 0) raise both (e.g. 12 deg and a few hundred frames).
+  // extrinsics. The start-up calibration (extrinsic_bootstrap.h) leaves ~0.1 deg. Without it
+  // (--online-prior 0) the BA alone does not correct degree-sized errors at all, whatever these two
+  // are: its random-walk prior (LocalBaOptions::extrinsic_prior_deg, 0.005 deg per solve) holds them
+  // (quick cloudy_urban: 14 deg at the end, with a 2 or a 12 deg bound).
   double online_max_error_deg = 2.0;
   int online_settle_frames = 50;
   void Check() const;
