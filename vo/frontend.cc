@@ -85,6 +85,7 @@ class ScopedOpenCvThreads {
 TrackerOptions TrackerOptionsFrom(const FrontendOptions& options) {
   TrackerOptions tracker;
   tracker.target_features = options.target_features_per_view;
+  tracker.max_new_per_frame = options.max_new_features_per_view;
   tracker.min_feature_distance_px = options.min_feature_distance_px;
   tracker.fast_threshold = options.fast_threshold;
   tracker.max_forward_backward_px = options.max_forward_backward_px;

@@ -45,6 +45,7 @@ struct FrontendFrame {
 
 struct FrontendOptions {
   int target_features_per_view = 600;   // KLT tracks + new detections per view
+  int max_new_features_per_view = 0;    // TrackerOptions::max_new_per_frame (0: no limit)
   float min_feature_distance_px = 12;   // between features of one view (warped pixels)
   int fast_threshold = 12;              // FAST-9 threshold of the detector
   // KLT forward-backward round-trip error. 0.3 px instead of 1: drops the tracks that slide over the

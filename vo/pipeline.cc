@@ -624,7 +624,9 @@ VoSummary RunVo(const VoOptions& options) {
   if (options.mode == ExtrinsicsMode::kOnline && options.online_prior_deg > 0.0) {
     cam_from_rig = BootstrapExtrinsics(options, info.rig, cam_from_rig);
   }
-  Frontend frontend(info.rig.WithExtrinsics(cam_from_rig), FrontendOptions{});
+  FrontendOptions frontend_options;
+  frontend_options.max_new_features_per_view = options.max_new_features;
+  Frontend frontend(info.rig.WithExtrinsics(cam_from_rig), frontend_options);
   VoBackend backend(cam_from_rig, world_from_rig0, backend_options);
 
   RunData run;
@@ -734,6 +736,7 @@ VoSummary RunVo(const VoOptions& options) {
   j["version"] = ROVO_VERSION;
   j["initial_world_from_rig"] = PoseJson(world_from_rig0);
   j["online_prior_deg"] = options.online_prior_deg;
+  j["max_new_features"] = options.max_new_features;
   j["backend"] = {{"ransac_tau_deg", backend_options.ransac.tau_rad * 180.0 / M_PI},
                   {"ransac_max_iterations", backend_options.ransac.max_iterations},
                   {"ransac_confidence", backend_options.ransac.confidence},

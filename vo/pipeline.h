@@ -62,6 +62,7 @@ struct VoOptions {
   // Back-end settings exposed on the command line; <= 0 keeps BackendOptions' default.
   double keyframe_distance_m = 0.0;      // KeyframeOptions::min_translation_m
   int online_settle_frames = -1;         // BackendOptions::online_settle_frames (< 0: its default)
+  int max_new_features = 0;              // FrontendOptions::max_new_features_per_view (0: no limit)
   bool async_ba = true;                  // BackendOptions::async_ba (same trajectory in GTExt/NoisyExt)
   bool preload_images = false;           // decode all frames before the loop (timing without PNG decoding)
 };

@@ -160,6 +160,35 @@ TEST(Tracking, ForwardBackwardCheckDropsChangedRegions) {
   EXPECT_LT(right_after, 0.1 * left_before);
 }
 
+// max_new_per_frame: a view without tracks fills up to the target; once it has tracks, at most that
+// many new points are added per frame.
+TEST(Tracking, LimitsNewDetectionsOnlyWhileTheViewHasTracks) {
+  TrackerOptions options;
+  options.target_features = 300;
+  options.max_new_per_frame = 40;
+  ViewTracker tracker(options);
+  const cv::Mat image = TexturedImage(640, 480, 5);
+  const cv::Mat mask(480, 640, CV_8UC1, cv::Scalar(255));
+  tracker.Track(image, mask);
+  tracker.DetectAndDescribe(Counter);
+  ASSERT_GE(static_cast<int>(tracker.points().size()), 250);  // first frame: no limit
+  // The right half becomes an unrelated texture: its tracks die, and only 40 new points replace them.
+  cv::Mat next = image.clone();
+  TexturedImage(640, 480, 98)(cv::Rect(320, 0, 320, 480)).copyTo(next(cv::Rect(320, 0, 320, 480)));
+  const int kept = tracker.Track(next, mask);
+  ASSERT_LT(kept, 250);
+  tracker.DetectAndDescribe(Counter);
+  int fresh = 0;
+  for (const TrackedPoint& p : tracker.points()) fresh += p.age == 0;
+  EXPECT_EQ(fresh, 40);
+  EXPECT_EQ(static_cast<int>(tracker.points().size()), kept + 40);
+  // A view that lost every track (e.g. a black frame) fills up again.
+  tracker.Clear();
+  tracker.Track(next, mask);
+  tracker.DetectAndDescribe(Counter);
+  EXPECT_GE(static_cast<int>(tracker.points().size()), 250);
+}
+
 TEST(Tracking, DescriptorsAreStableUnderSmallShiftAndOrientationFollowsRotation) {
   ViewTracker tracker;
   const cv::Mat image = TexturedImage(640, 480, 4);
