@@ -235,16 +235,16 @@ void ViewTracker::DetectAndDescribe(const std::function<uint64_t()>& next_id) {
               [](const cv::KeyPoint& a, const cv::KeyPoint& b) { return a.response > b.response; });
     OccupancyGrid grid(image_.cols, image_.rows, options_.min_feature_distance_px);
     for (const TrackedPoint& p : points_) grid.Add(p.px);
-    const int max_new = points_.empty() || options_.max_new_per_frame <= 0 ? options_.target_features
-                                                                           : options_.max_new_per_frame;
-    int added = 0;
+    const size_t limit = points_.empty() || options_.max_new_per_frame <= 0
+                             ? options_.target_features
+                             : std::min(options_.target_features,
+                                        static_cast<int>(points_.size()) + options_.max_new_per_frame);
     for (const cv::KeyPoint& kp : corners) {
-      if (static_cast<int>(points_.size()) >= options_.target_features || added >= max_new) break;
+      if (points_.size() >= limit) break;
       if (!MaskAt(detect_mask_, kp.pt) || !grid.Free(kp.pt)) continue;
       grid.Add(kp.pt);
       TrackedPoint p;
       p.track_id = next_id();
-      ++added;
       p.px = kp.pt;
       points_.push_back(std::move(p));
     }
