@@ -82,7 +82,8 @@ void AddSuiteCommand(CLI::App& root) {
       "The paper's Table I suites: renders missing datasets, runs VO with ground-truth extrinsics (GTExt) once and "
       "with each of K perturbed extrinsic sets fixed (NoisyExt) and calibrated online (OnlineExt), evaluates, and "
       "writes suite.json, table.md (mean +- std over noise sets, the paper's figures beside ours) and report.html. "
-      "Resumes: complete runs and datasets are not redone.");
+      "Resumes: complete runs made with the same settings (frames, seed, noise set, --max-new-features) and complete "
+      "datasets are not redone.");
   cmd->add_option("--presets", *presets, "Comma-separated presets (default: all: " + preset_names + ")");
   cmd->add_flag("--quick", options->quick, "Use the presets' quick forms (fewer frames, smaller images)");
   cmd->add_option("--frames", options->frames,
@@ -100,6 +101,10 @@ void AddSuiteCommand(CLI::App& root) {
   cmd->add_option("--data", options->data_dir, "Dataset cache folder (default: OUT/data)");
   cmd->add_option("--scene-seed", options->scene_seed, "Scene and render seed")->default_val(0);
   cmd->add_option("--vo-seed", options->vo_seed, "RANSAC seed of every run")->default_val(0);
+  cmd->add_option("--max-new-features", options->max_new_features,
+                  "New detections per view and frame at most, while the view has tracks, in every run (rovo vo "
+                  "--max-new-features; 0: no limit; default: rovo vo's). Runs made with another value are redone")
+      ->check(CLI::Range(0, 100000));
   cmd->add_flag("--no-plots", *no_plots, "Skip plots and report.html");
   cmd->add_option("--out", options->out_dir, "Suite output folder")->required();
   cmd->callback([options, presets, no_plots] {
@@ -167,6 +172,7 @@ void AddGateCommand(CLI::App& root) {
         options.scene_seed = s.value("scene_seed", uint64_t{0});
         options.vo_seed = s.value("vo_seed", uint64_t{0});
         options.vo_threads = s.value("vo_threads", 0);
+        options.max_new_features = s.value("max_new_features", -1);
       } catch (const nlohmann::json::exception& e) {
         throw std::runtime_error(args->gates + ": field \"suite\": " + e.what());
       }

@@ -8,6 +8,8 @@
 // Each gate names a preset, a mode (gt|noisy|online), a metric of AggregatedMetricNames() and a
 // bound "max" (value <= max passes) or "min" (value >= min passes). The value is the metric's
 // mean over the suite's noise sets. A metric missing from the suite fails its gate.
+// "suite" (read by `rovo gate --run`) may also hold "vo_seed", "vo_threads" and "max_new_features"
+// (SuiteOptions); omitted ones take SuiteOptions' defaults.
 
 #include <nlohmann/json.hpp>
 

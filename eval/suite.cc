@@ -25,8 +25,39 @@
 namespace rovo {
 namespace fs = std::filesystem;
 
-namespace {
+bool RunReusable(const std::string& run_dir, const RunSettings& want, std::string* mismatch) {
+  mismatch->clear();
+  std::error_code ec;
+  if (!fs::is_regular_file(RunInfoPath(run_dir), ec)) return false;
+  nlohmann::json info;
+  try {
+    info = ReadJsonFile(RunInfoPath(run_dir));
+  } catch (const std::exception&) {
+    return false;
+  }
+  if (!info.is_object() || !info.contains("dataset") || !info.contains("frames") ||
+      info["frames"] != nlohmann::json::array({0, want.frame_end}) || !fs::is_regular_file(RunTrajectoryPath(run_dir), ec) ||
+      !fs::is_regular_file(RunFramesPath(run_dir), ec) || !fs::is_regular_file(RunExtrinsicsPath(run_dir), ec)) {
+    return false;  // incomplete (a run writes run.json last)
+  }
+  // Runs from before max_new_features was recorded had no limit.
+  const nlohmann::json recorded_limit = info.value("max_new_features", nlohmann::json(0));
+  const std::pair<const char*, std::pair<nlohmann::json, nlohmann::json>> checks[] = {
+      {"mode", {info.value("mode", nlohmann::json()), ExtrinsicsModeName(want.mode)}},
+      {"noise_set", {info.value("noise_set", nlohmann::json()), want.noise_set}},
+      {"seed", {info.value("seed", nlohmann::json()), want.seed}},
+      {"max_new_features", {recorded_limit, want.max_new_features}},
+  };
+  for (const auto& [field, values] : checks) {
+    if (values.first != values.second) {
+      *mismatch = std::string(field) + ": " + values.first.dump() + " vs " + values.second.dump();
+      return false;
+    }
+  }
+  return true;
+}
 
+namespace {
 
 // " (k of K runs)" when only k of the mode's K runs have the metric, else empty.
 std::string ShortCount(const std::optional<Stat>& stat, int runs) {
@@ -42,20 +73,6 @@ std::string FmtStat(const std::optional<Stat>& stat, int runs, const char* forma
   return s + ShortCount(stat, runs);
 }
 
-// `frame_end`: the run must cover frames [0, frame_end).
-bool RunComplete(const std::string& run_dir, int frame_end) {
-  std::error_code ec;
-  if (!fs::is_regular_file(RunInfoPath(run_dir), ec)) return false;
-  try {
-    const nlohmann::json info = ReadJsonFile(RunInfoPath(run_dir));
-    return info.is_object() && info.contains("mode") && info.contains("dataset") && info.contains("seed") &&
-           info.contains("frames") && info["frames"] == nlohmann::json::array({0, frame_end}) &&
-           fs::is_regular_file(RunTrajectoryPath(run_dir), ec) && fs::is_regular_file(RunFramesPath(run_dir), ec) &&
-           fs::is_regular_file(RunExtrinsicsPath(run_dir), ec);
-  } catch (const std::exception&) {
-    return false;
-  }
-}
 
 // Complete: the first `max_frames` frames (all when <= 0) have every camera's image.
 bool DatasetComplete(const std::string& dataset_dir, int max_frames) {
@@ -81,9 +98,7 @@ struct VoJob {
   std::string preset;
   std::string dataset_dir;
   std::string run_dir;
-  ExtrinsicsMode mode;
-  int noise_set;
-  int frame_end;  // the run covers frames [0, frame_end)
+  RunSettings settings;
 };
 
 }  // namespace
@@ -242,6 +257,7 @@ nlohmann::json SuiteToJson(const std::vector<PresetSummary>& presets, const Suit
   j["noise_sets"] = options.noise_sets;
   j["scene_seed"] = options.scene_seed;
   j["vo_seed"] = options.vo_seed;
+  j["max_new_features"] = options.max_new_features >= 0 ? options.max_new_features : VoOptions{}.max_new_features;
   j["presets"] = nlohmann::json::object();
   for (const PresetSummary& p : presets) {
     nlohmann::json pj;
@@ -304,6 +320,7 @@ std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
   }
 
   // 2. VO runs.
+  const int max_new_features = options.max_new_features >= 0 ? options.max_new_features : VoOptions{}.max_new_features;
   std::vector<VoJob> jobs;
   std::vector<int> frame_ends;      // per preset: runs cover frames [0, end)
   std::vector<int> dataset_frames;  // per preset: frames of the dataset
@@ -318,19 +335,27 @@ std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
     }
     const fs::path runs = fs::path(options.out_dir) / "runs" / presets[i];
     const int end = frame_ends[i];
-    jobs.push_back({presets[i], dataset_dirs[i], (runs / "gt").string(), ExtrinsicsMode::kGroundTruth, 0, end});
+    const auto settings = [&](ExtrinsicsMode mode, int noise_set) {
+      return RunSettings{mode, noise_set, end, options.vo_seed, max_new_features};
+    };
+    jobs.push_back({presets[i], dataset_dirs[i], (runs / "gt").string(), settings(ExtrinsicsMode::kGroundTruth, 0)});
     for (int k = 0; k < options.noise_sets; ++k) {
       jobs.push_back({presets[i], dataset_dirs[i], (runs / ("noisy_" + std::to_string(k))).string(),
-                      ExtrinsicsMode::kNoisy, k, end});
+                      settings(ExtrinsicsMode::kNoisy, k)});
       jobs.push_back({presets[i], dataset_dirs[i], (runs / ("online_" + std::to_string(k))).string(),
-                      ExtrinsicsMode::kOnline, k, end});
+                      settings(ExtrinsicsMode::kOnline, k)});
     }
   }
   std::vector<const VoJob*> todo;
   for (const VoJob& job : jobs) {
-    if (RunComplete(job.run_dir, job.frame_end)) {
+    std::string mismatch;
+    if (RunReusable(job.run_dir, job.settings, &mismatch)) {
       if (!options.quiet) std::fprintf(stderr, "rovo suite: run %s is complete, skipping\n", job.run_dir.c_str());
     } else {
+      if (!mismatch.empty()) {
+        std::fprintf(stderr, "rovo suite: run %s was made with other settings (%s), running it again\n",
+                     job.run_dir.c_str(), mismatch.c_str());
+      }
       todo.push_back(&job);
     }
   }
@@ -354,12 +379,13 @@ std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
           VoOptions vo;
           vo.dataset_dir = job.dataset_dir;
           vo.out_dir = job.run_dir;
-          vo.mode = job.mode;
-          vo.noise_set = job.noise_set;
+          vo.mode = job.settings.mode;
+          vo.noise_set = job.settings.noise_set;
+          vo.max_new_features = job.settings.max_new_features;
           vo.seed = options.vo_seed;
           vo.threads = threads_per_job;
           vo.quiet = options.quiet || parallel > 1;
-          vo.frame_end = job.frame_end;
+          vo.frame_end = job.settings.frame_end;
           RunVo(vo);
         } catch (...) {
           std::lock_guard<std::mutex> lock(error_mutex);
@@ -385,7 +411,7 @@ std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
     for (const VoJob& job : jobs) {
       if (job.preset == presets[i]) {
         run_dirs.push_back(job.run_dir);
-        noise_sets.push_back(job.mode == ExtrinsicsMode::kGroundTruth ? -1 : job.noise_set);
+        noise_sets.push_back(job.settings.mode == ExtrinsicsMode::kGroundTruth ? -1 : job.settings.noise_set);
       }
     }
     EvalReportOptions report;

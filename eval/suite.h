@@ -9,10 +9,11 @@
 //   <out>/suite.json                                   aggregated metrics per preset and mode
 //   <out>/table.md, <out>/report.html                  Table I layout with the paper's figures
 // Datasets go to <data>/<preset>[_quick]_s<seed>/ (default <data> = <out>/data).
-// Resume: a run folder whose run.json is complete (and covers the frames asked for) is not run
-// again; a dataset whose frames (all, or the first --frames) exist is not rendered again.
+// Resume: a run folder whose run.json is complete and records the settings asked for (RunSettings)
+// is not run again; one made with other settings is; a dataset whose frames (all, or the first --frames) exist is not rendered again.
 
 #include "eval/metrics.h"
+#include "vo/pipeline.h"
 
 #include <nlohmann/json.hpp>
 
@@ -36,9 +37,25 @@ struct SuiteOptions {
   std::string out_dir;
   uint64_t scene_seed = 0;           // scene / render seed
   uint64_t vo_seed = 0;              // RANSAC seed of every run
+  int max_new_features = -1;         // VoOptions::max_new_features of every run; < 0: its default
   bool plots = true;
   bool quiet = false;
 };
+
+// What a suite run must have been made with to be reused: its frames, mode, noise set, RANSAC seed
+// and front-end detection limit, as recorded in its run.json.
+struct RunSettings {
+  ExtrinsicsMode mode = ExtrinsicsMode::kGroundTruth;
+  int noise_set = 0;
+  int frame_end = 0;  // the run covers frames [0, frame_end)
+  uint64_t seed = 0;
+  int max_new_features = 0;
+};
+
+// Whether the run in `run_dir` is complete (run.json, trajectory, frames and extrinsics files) and
+// was made with `want`. A complete run made with other settings sets `*mismatch` to
+// "field: recorded vs wanted" (e.g. "seed: 1 vs 0") and must be redone; it stays empty otherwise.
+bool RunReusable(const std::string& run_dir, const RunSettings& want, std::string* mismatch);
 
 // Mean and sample standard deviation (n - 1; 0 for n = 1) of one metric over the noise sets.
 struct Stat {

@@ -1,7 +1,14 @@
 #include "eval/gate.h"
 #include "eval/suite.h"
 
+#include "datasets/io.h"
+#include "datasets/run.h"
+
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
 
 namespace rovo {
 namespace {
@@ -28,6 +35,60 @@ TEST(Stat, MeanAndSampleStd) {
   EXPECT_NEAR(s.std, std::sqrt(5.0 / 3.0), 1e-15);
   EXPECT_EQ(ComputeStat({7.0}).std, 0.0);
   EXPECT_EQ(ComputeStat({}).n, 0);
+}
+
+// A complete run folder whose run.json records `info`.
+std::string WriteRunFolder(const nlohmann::json& info) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("rovo_suite_resume_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (const std::string& file : {RunTrajectoryPath(dir.string()), RunFramesPath(dir.string()),
+                                  RunExtrinsicsPath(dir.string())}) {
+    std::ofstream(file) << "\n";
+  }
+  std::ofstream(RunInfoPath(dir.string())) << info.dump();
+  return dir.string();
+}
+
+TEST(Suite, ReusesOnlyRunsMadeWithTheSameSettings) {
+  nlohmann::json info = {{"mode", "online"}, {"dataset", "/data/x"}, {"frames", {0, 60}}, {"noise_set", 1},
+                         {"seed", 0},        {"max_new_features", 150}};
+  RunSettings want;
+  want.mode = ExtrinsicsMode::kOnline;
+  want.noise_set = 1;
+  want.frame_end = 60;
+  want.seed = 0;
+  want.max_new_features = 150;
+  std::string mismatch = "stale";
+  const std::string dir = WriteRunFolder(info);
+  EXPECT_TRUE(RunReusable(dir, want, &mismatch));
+  EXPECT_EQ(mismatch, "");
+
+  want.max_new_features = 0;
+  EXPECT_FALSE(RunReusable(dir, want, &mismatch));
+  EXPECT_EQ(mismatch, "max_new_features: 150 vs 0");
+  // A run.json from before the limit was recorded counts as "no limit".
+  info.erase("max_new_features");
+  WriteRunFolder(info);
+  EXPECT_TRUE(RunReusable(dir, want, &mismatch));
+
+  want.seed = 3;
+  EXPECT_FALSE(RunReusable(dir, want, &mismatch));
+  EXPECT_EQ(mismatch, "seed: 0 vs 3");
+  want.seed = 0;
+  want.mode = ExtrinsicsMode::kNoisy;
+  EXPECT_FALSE(RunReusable(dir, want, &mismatch));
+  EXPECT_EQ(mismatch, "mode: \"online\" vs \"noisy\"");
+  want.mode = ExtrinsicsMode::kOnline;
+  // Other frames, or a missing output file, make the run incomplete: redone, but no mismatch.
+  want.frame_end = 30;
+  EXPECT_FALSE(RunReusable(dir, want, &mismatch));
+  EXPECT_EQ(mismatch, "");
+  want.frame_end = 60;
+  std::filesystem::remove(RunExtrinsicsPath(dir));
+  EXPECT_FALSE(RunReusable(dir, want, &mismatch));
+  std::filesystem::remove_all(dir);
 }
 
 std::vector<PresetSummary> SamplePresets() {
