@@ -1,5 +1,6 @@
 #include "vo/interview_matching.h"
 
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
@@ -79,9 +80,14 @@ namespace {
 //   zncc = (n S_ab - S_a S_b) / sqrt((n S_aa - S_a^2) (n S_bb - S_b^2)),  n = patch_px^2.
 struct ReferencePatch {
   std::vector<uint8_t> values;  // row-major
+  // For side <= kSimdSide: the values as int16 in rows of kSimdSide, zero beyond `side` (the SIMD form).
+  std::vector<int16_t> padded;
   int side = 0;
   int64_t sum = 0, variance_n2 = 0;  // S_a and n S_aa - S_a^2
 };
+
+// Patch rows up to this many pixels take one 16-byte load each (OpenCV's universal intrinsics).
+constexpr int kSimdSide = 16;
 
 // Top-left corner of the patch around the nearest pixel of p; false when the patch leaves the image.
 bool PatchCorner(const cv::Mat& image, const Eigen::Vector2d& p, int side, int* x0, int* y0) {
@@ -115,6 +121,13 @@ bool LoadReference(const cv::Mat& image, const Eigen::Vector2d& p, int side, Ref
   const int n = side * side;
   patch->sum = sum;
   patch->variance_n2 = n * sum2 - sum * sum;
+  patch->padded.clear();
+  if (side <= kSimdSide) {
+    patch->padded.assign(static_cast<size_t>(side) * kSimdSide, 0);
+    for (int r = 0; r < side; ++r) {
+      std::copy_n(patch->values.data() + r * side, side, patch->padded.data() + r * kSimdSide);
+    }
+  }
   return !Flat(patch->variance_n2, n);
 }
 
@@ -125,14 +138,41 @@ std::optional<double> ZnccWithReference(const ReferencePatch& reference, const c
   int x0, y0;
   if (!PatchCorner(image, p, side, &x0, &y0)) return std::nullopt;
   int32_t ab = 0, sb = 0, sb2 = 0;  // at most 121 * 255^2 < 2^23 for an 11 px patch
-  const uint8_t* a = reference.values.data();
-  for (int r = 0; r < side; ++r, a += side) {
-    const uint8_t* row = image.ptr<uint8_t>(y0 + r) + x0;
-    for (int c = 0; c < side; ++c) {
-      const int32_t b = row[c];
-      ab += a[c] * b;
-      sb += b;
-      sb2 += b * b;
+#if CV_SIMD128
+  if (!reference.padded.empty() && x0 + kSimdSide <= image.cols) {
+    // One 16-byte load per row, the bytes beyond `side` masked to zero (the reference's padding is
+    // zero too): the same integer sums as the scalar loop below. Per lane at most 16 rows * 2 * 255^2
+    // < 2^31 (products) and 16 * 2 * 255 < 2^16 (sums).
+    static const uint8_t kOnes[2 * kSimdSide] = {255, 255, 255, 255, 255, 255, 255, 255, 255, 255, 255,
+                                                 255, 255, 255, 255, 255};
+    const cv::v_uint8x16 keep = cv::v_load(kOnes + kSimdSide - side);
+    cv::v_int32x4 ab4 = cv::v_setzero_s32(), bb4 = cv::v_setzero_s32();
+    cv::v_uint16x8 sum8 = cv::v_setzero_u16();
+    const int16_t* a = reference.padded.data();
+    for (int r = 0; r < side; ++r, a += kSimdSide) {
+      const cv::v_uint8x16 b = cv::v_load(image.ptr<uint8_t>(y0 + r) + x0) & keep;
+      cv::v_uint16x8 lo, hi;
+      cv::v_expand(b, lo, hi);
+      const cv::v_int16x8 slo = cv::v_reinterpret_as_s16(lo), shi = cv::v_reinterpret_as_s16(hi);
+      ab4 += cv::v_dotprod(slo, cv::v_load(a)) + cv::v_dotprod(shi, cv::v_load(a + 8));
+      bb4 += cv::v_dotprod(slo, slo) + cv::v_dotprod(shi, shi);
+      sum8 += lo + hi;
+    }
+    ab = cv::v_reduce_sum(ab4);
+    sb2 = cv::v_reduce_sum(bb4);
+    sb = static_cast<int32_t>(cv::v_reduce_sum(sum8));
+  } else
+#endif
+  {
+    const uint8_t* a = reference.values.data();
+    for (int r = 0; r < side; ++r, a += side) {
+      const uint8_t* row = image.ptr<uint8_t>(y0 + r) + x0;
+      for (int c = 0; c < side; ++c) {
+        const int32_t b = row[c];
+        ab += a[c] * b;
+        sb += b;
+        sb2 += b * b;
+      }
     }
   }
   const int n = side * side;
@@ -143,6 +183,16 @@ std::optional<double> ZnccWithReference(const ReferencePatch& reference, const c
 }
 
 }  // namespace
+
+std::vector<std::optional<double>> ZnccAtPixels(const cv::Mat& image_a, cv::Point a, const cv::Mat& image_b,
+                                                const std::vector<cv::Point>& b, int patch_px) {
+  if (patch_px > 45) throw std::invalid_argument("ZnccAtPixels: patch_px must be <= 45");
+  std::vector<std::optional<double>> zncc(b.size());
+  ReferencePatch reference;
+  if (!LoadReference(image_a, Eigen::Vector2d(a.x, a.y), patch_px, &reference)) return zncc;
+  for (size_t k = 0; k < b.size(); ++k) zncc[k] = ZnccWithReference(reference, image_b, Eigen::Vector2d(b[k].x, b[k].y));
+  return zncc;
+}
 
 bool UniqueAlongEpipolarCurve(const cv::Mat& patch_image, cv::Point2f patch_centre, const Eigen::Vector3d& centre_fixed,
                               const Eigen::Vector3d& bearing_fixed, const MatchView& view,

@@ -103,6 +103,11 @@ std::optional<double> RectifiedY(const Eigen::Vector3d& bearing, const Eigen::Ve
 // ZNCC of the patch_px x patch_px patches (bilinear) around a and b; nullopt when a patch leaves its
 // image or is flat.
 std::optional<double> Zncc(const cv::Mat& image_a, cv::Point2f a, const cv::Mat& image_b, cv::Point2f b, int patch_px);
+// The same at whole pixels (odd patch_px <= 45, 8-bit images), the patch around a against the
+// patches around each of b, in exact integer sums: the form filter 8's scan evaluates (SIMD rows for
+// patches up to 16 px). Equals Zncc at those pixels up to rounding.
+std::vector<std::optional<double>> ZnccAtPixels(const cv::Mat& image_a, cv::Point a, const cv::Mat& image_b,
+                                                const std::vector<cv::Point>& b, int patch_px);
 
 // Filter 8 for one direction: scans `patch_of` (a square patch of `patch_image` around
 // `patch_centre`) along the epipolar curve of (centre_fixed, bearing_fixed) in `view`, around the

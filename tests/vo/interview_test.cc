@@ -136,6 +136,66 @@ TEST(InterviewFilters, Zncc) {
   EXPECT_FALSE(Zncc(flat, {30, 30}, a, {30, 30}, 11).has_value());
 }
 
+// ZNCC of the side x side patches around two pixels, in doubles from the mean-subtracted values.
+double PlainZncc(const cv::Mat& a, cv::Point pa, const cv::Mat& b, cv::Point pb, int side) {
+  const int half = side / 2, n = side * side;
+  double ma = 0, mb = 0;
+  for (int r = -half; r <= half; ++r) {
+    for (int c = -half; c <= half; ++c) {
+      ma += a.at<uint8_t>(pa.y + r, pa.x + c);
+      mb += b.at<uint8_t>(pb.y + r, pb.x + c);
+    }
+  }
+  ma /= n;
+  mb /= n;
+  double ab = 0, aa = 0, bb = 0;
+  for (int r = -half; r <= half; ++r) {
+    for (int c = -half; c <= half; ++c) {
+      const double da = a.at<uint8_t>(pa.y + r, pa.x + c) - ma, db = b.at<uint8_t>(pb.y + r, pb.x + c) - mb;
+      ab += da * db;
+      aa += da * da;
+      bb += db * db;
+    }
+  }
+  return ab / std::sqrt(aa * bb);
+}
+
+// The integer ZNCC of filter 8's scan (SIMD rows for patches up to 16 px, scalar beyond, and at the
+// right edge where a 16-byte row load would leave the image) equals the plain ZNCC, and the float
+// Zncc up to getRectSubPix's rounding.
+TEST(InterviewFilters, ZnccAtPixelsEqualsZncc) {
+  cv::Mat a(70, 90, CV_8UC1), b(70, 90, CV_8UC1);
+  cv::RNG rng(11);
+  rng.fill(a, cv::RNG::UNIFORM, 0, 256);
+  rng.fill(b, cv::RNG::UNIFORM, 0, 256);
+  cv::GaussianBlur(b, b, cv::Size(3, 3), 0.8);
+  b = 0.6 * b + 0.4 * a;  // correlated, not identical
+  int compared = 0, right_edge = 0;
+  for (const int side : {3, 7, 11, 15, 17, 25}) {
+    const int half = side / 2;
+    for (int trial = 0; trial < 300; ++trial) {
+      // Each centre inside the image by at least the float Zncc's margin (half + 1).
+      const cv::Point pa(rng.uniform(half + 2, a.cols - half - 2), rng.uniform(half + 2, a.rows - half - 2));
+      const cv::Point pb(trial % 3 == 0 ? b.cols - half - 2 : rng.uniform(half + 2, b.cols - half - 2),
+                         rng.uniform(half + 2, b.rows - half - 2));
+      const auto exact = ZnccAtPixels(a, pa, b, {pb}, side).at(0);
+      const auto reference = Zncc(a, cv::Point2f(pa), b, cv::Point2f(pb), side);
+      ASSERT_TRUE(exact.has_value());
+      ASSERT_TRUE(reference.has_value());
+      EXPECT_NEAR(*exact, PlainZncc(a, pa, b, pb, side), 1e-12) << "side " << side << " at " << pa << ", " << pb;
+      EXPECT_NEAR(*exact, *reference, 2e-3) << "side " << side << " at " << pa << ", " << pb;
+      ++compared;
+      right_edge += pb.x - half + 16 > b.cols;
+    }
+  }
+  EXPECT_EQ(compared, 1800);
+  EXPECT_GT(right_edge, 100);  // the scalar fallback ran too
+  EXPECT_NEAR(*ZnccAtPixels(a, {30, 30}, a, {{30, 30}}, 11).at(0), 1.0, 1e-12);
+  EXPECT_FALSE(ZnccAtPixels(a, {4, 30}, b, {{30, 30}}, 11).at(0).has_value());  // patch leaves the image
+  const cv::Mat flat(70, 90, CV_8UC1, cv::Scalar(90));
+  EXPECT_FALSE(ZnccAtPixels(a, {30, 30}, flat, {{30, 30}}, 11).at(0).has_value());
+}
+
 // Filter 8 on a rectified pair: cameras a at the origin and b 1 m to its right (+x), both looking
 // along +y (z up), pinhole f = 100 px, so epipolar curves are image rows. b's image is a's shifted
 // by the disparity of a point 5 m away; a copy of the matched patch elsewhere on the same row (a
