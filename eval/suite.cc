@@ -73,7 +73,6 @@ std::string FmtStat(const std::optional<Stat>& stat, int runs, const char* forma
   return s + ShortCount(stat, runs);
 }
 
-
 // Complete: the first `max_frames` frames (all when <= 0) have every camera's image.
 bool DatasetComplete(const std::string& dataset_dir, int max_frames) {
   std::error_code ec;
@@ -257,7 +256,7 @@ nlohmann::json SuiteToJson(const std::vector<PresetSummary>& presets, const Suit
   j["noise_sets"] = options.noise_sets;
   j["scene_seed"] = options.scene_seed;
   j["vo_seed"] = options.vo_seed;
-  j["max_new_features"] = options.max_new_features >= 0 ? options.max_new_features : VoOptions{}.max_new_features;
+  j["max_new_features"] = options.MaxNewFeatures();
   j["presets"] = nlohmann::json::object();
   for (const PresetSummary& p : presets) {
     nlohmann::json pj;
@@ -320,7 +319,6 @@ std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
   }
 
   // 2. VO runs.
-  const int max_new_features = options.max_new_features >= 0 ? options.max_new_features : VoOptions{}.max_new_features;
   std::vector<VoJob> jobs;
   std::vector<int> frame_ends;      // per preset: runs cover frames [0, end)
   std::vector<int> dataset_frames;  // per preset: frames of the dataset
@@ -336,7 +334,7 @@ std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
     const fs::path runs = fs::path(options.out_dir) / "runs" / presets[i];
     const int end = frame_ends[i];
     const auto settings = [&](ExtrinsicsMode mode, int noise_set) {
-      return RunSettings{mode, noise_set, end, options.vo_seed, max_new_features};
+      return RunSettings{mode, noise_set, end, options.vo_seed, options.MaxNewFeatures()};
     };
     jobs.push_back({presets[i], dataset_dirs[i], (runs / "gt").string(), settings(ExtrinsicsMode::kGroundTruth, 0)});
     for (int k = 0; k < options.noise_sets; ++k) {

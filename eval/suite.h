@@ -38,6 +38,7 @@ struct SuiteOptions {
   uint64_t scene_seed = 0;           // scene / render seed
   uint64_t vo_seed = 0;              // RANSAC seed of every run
   int max_new_features = -1;         // VoOptions::max_new_features of every run; < 0: its default
+  int MaxNewFeatures() const { return max_new_features >= 0 ? max_new_features : VoOptions{}.max_new_features; }
   bool plots = true;
   bool quiet = false;
 };
