@@ -92,7 +92,8 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
       ->check(CLI::Range(0, 1000000));
   cmd->add_option("--max-new-features", args->options.max_new_features,
                   "New detections per view and frame at most, while the view has tracks (0: fill up to the target "
-                  "count; e.g. 150: front-end about a fifth cheaper, accuracy measured on 300 frames only, README)")
+                  "count of 600). 150 makes the front-end about a fifth cheaper and the trajectories slightly less "
+                  "accurate (README: speed, whole sequences and quick forms)")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
   cmd->add_option("--keyframe-distance", args->options.keyframe_distance_m,
