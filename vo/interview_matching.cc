@@ -141,11 +141,11 @@ std::optional<double> ZnccWithReference(const ReferencePatch& reference, const c
 #if CV_SIMD128
   if (!reference.padded.empty() && x0 + kSimdSide <= image.cols) {
     // One 16-byte load per row, the bytes beyond `side` masked to zero (the reference's padding is
-    // zero too): the same integer sums as the scalar loop below. Per lane at most 16 rows * 2 * 255^2
-    // < 2^31 (products) and 16 * 2 * 255 < 2^16 (sums).
-    static const uint8_t kOnes[2 * kSimdSide] = {255, 255, 255, 255, 255, 255, 255, 255, 255, 255, 255,
-                                                 255, 255, 255, 255, 255};
-    const cv::v_uint8x16 keep = cv::v_load(kOnes + kSimdSide - side);
+    // zero too): the same integer sums as the scalar loop below. Per lane at most 16 rows * 4 * 255^2
+    // < 2^31 (products) and 16 rows * 2 * 255 < 2^16 (sums).
+    static const uint8_t kMask[2 * kSimdSide] = {255, 255, 255, 255, 255, 255, 255, 255, 255, 255, 255,
+                                                 255, 255, 255, 255, 255};  // then 16 zeros
+    const cv::v_uint8x16 keep = cv::v_load(kMask + kSimdSide - side);  // `side` bytes 255, then 0
     cv::v_int32x4 ab4 = cv::v_setzero_s32(), bb4 = cv::v_setzero_s32();
     cv::v_uint16x8 sum8 = cv::v_setzero_u16();
     const int16_t* a = reference.padded.data();
