@@ -72,74 +72,95 @@ void CachedRotation(const double* phi, Eigen::Matrix3d* rotation, Eigen::Matrix3
   if (right_jacobian) *right_jacobian = e.right_jacobian;
 }
 
-// r = b - u,  u = q / |q|,  q = R_c (R_r X + t_r) + t_c,  p = R_r X + t_r.
+Eigen::Matrix<double, 3, 2> TangentBasis(const Eigen::Vector3d& bearing) {
+  // Cross with the coordinate axis least aligned with the bearing: never near-parallel.
+  int axis = 0;
+  bearing.cwiseAbs().minCoeff(&axis);
+  const Eigen::Vector3d e1 = bearing.cross(Eigen::Vector3d::Unit(axis)).normalized();
+  Eigen::Matrix<double, 3, 2> basis;
+  basis.col(0) = e1;
+  basis.col(1) = bearing.cross(e1).normalized();
+  return basis;
+}
+
+// r = B^T u,  u = q / |q|,  q = R_c p + t_c,  p = R_r X + t_r,  B = TangentBasis(b).
 // Unknowns: rig_from_world (phi_r, t_r), cam_from_rig (phi_c, t_c), point_in_world X. With
-// dr/dq = -(I - u u^T) / |q| =: -P:
-//   dr/dX = -P R_c R_r,   dr/dt_r = -P R_c,   dr/dt_c = -P,
-//   dr/dphi_c = P R_c [p]x Jr(phi_c),   dr/dphi_r = P R_c R_r [X]x Jr(phi_r).
-// Analytic: about 4x cheaper than the same residual in 15-dimensional autodiff Jets. Jacobians are
-// written where `jacobians[k]` is non-null: [0] phi_r, [1] t_r, [2] phi_c, [3] t_c, [4] X; the cam
-// Jacobian `cam_jr` is needed only for [2].
-bool EvaluateBearing(const Eigen::Vector3d& bearing, const double* rig_aa, const double* rig_t_data,
-                     const Eigen::Matrix3d& cam_rotation, const Eigen::Vector3d& cam_t, const Eigen::Matrix3d* cam_jr,
-                     const double* point_data, double* residuals, double* const* jacobians) {
+// dr/dq = B^T (I - u u^T) / |q| =: M (2x3):
+//   dr/dX = M R_c R_r,   dr/dt_r = M R_c,   dr/dt_c = M,
+//   dr/dphi_c = -M R_c [p]x Jr(phi_c),   dr/dphi_r = -M R_c R_r [X]x Jr(phi_r).
+// Analytic: about 4x cheaper than the same residual in autodiff Jets. Each Jacobian is written when
+// its pointer is non-null: `jac_rig` 2x6 and `jac_cam` 2x6 (phi, t), `jac_point` 2x3, row-major; the
+// cam Jacobian `cam_jr` is needed only for `jac_cam`.
+bool EvaluateBearing(const Eigen::Matrix<double, 3, 2>& basis, const double* rig, const Eigen::Matrix3d& cam_rotation,
+                     const Eigen::Vector3d& cam_t, const Eigen::Matrix3d* cam_jr, const double* point_data,
+                     double* residuals, double* jac_rig, double* jac_cam, double* jac_point) {
   Eigen::Matrix3d rig_rotation, rig_jr;
-  CachedRotation(rig_aa, &rig_rotation, jacobians && jacobians[0] ? &rig_jr : nullptr);
-  const Eigen::Map<const Eigen::Vector3d> rig_t(rig_t_data), point_in_world(point_data);
+  CachedRotation(rig, &rig_rotation, jac_rig ? &rig_jr : nullptr);
+  const Eigen::Map<const Eigen::Vector3d> rig_t(rig + 3), point_in_world(point_data);
   const Eigen::Vector3d in_rig = rig_rotation * point_in_world + rig_t;
   const Eigen::Vector3d in_cam = cam_rotation * in_rig + cam_t;
   const double norm = in_cam.norm();
   if (!(norm > 0.0)) return false;
   const Eigen::Vector3d u = in_cam / norm;
-  Eigen::Map<Eigen::Vector3d> residual(residuals);
-  residual = bearing - u;
-  if (!jacobians) return true;
-  const Eigen::Matrix3d projector = (Eigen::Matrix3d::Identity() - u * u.transpose()) / norm;  // P
-  const Eigen::Matrix3d p_rc = projector * cam_rotation;                                       // P R_c
-  using RowMajor3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
-  auto block = [&](int k) { return Eigen::Map<RowMajor3>(jacobians[k]); };
-  if (jacobians[0]) block(0) = p_rc * rig_rotation * Hat(point_in_world) * rig_jr;
-  if (jacobians[1]) block(1) = -p_rc;
-  if (jacobians[2]) block(2) = p_rc * Hat(in_rig) * *cam_jr;
-  if (jacobians[3]) block(3) = -projector;
-  if (jacobians[4]) block(4) = -p_rc * rig_rotation;
+  Eigen::Map<Eigen::Vector2d> residual(residuals);
+  residual = basis.transpose() * u;
+  if (!jac_rig && !jac_cam && !jac_point) return true;
+  // M = B^T (I - u u^T) / |q| without forming the 3x3 projector.
+  const Eigen::Matrix<double, 2, 3> m = (basis.transpose() - (basis.transpose() * u) * u.transpose()) / norm;
+  const Eigen::Matrix<double, 2, 3> m_rc = m * cam_rotation;  // M R_c
+  using RowMajor26 = Eigen::Matrix<double, 2, 6, Eigen::RowMajor>;
+  using RowMajor23 = Eigen::Matrix<double, 2, 3, Eigen::RowMajor>;
+  const Eigen::Matrix<double, 2, 3> m_rc_rr = m_rc * rig_rotation;  // M R_c R_r
+  if (jac_rig) {
+    Eigen::Map<RowMajor26> j(jac_rig);
+    j.leftCols<3>() = -m_rc_rr * Hat(point_in_world) * rig_jr;
+    j.rightCols<3>() = m_rc;
+  }
+  if (jac_cam) {
+    Eigen::Map<RowMajor26> j(jac_cam);
+    j.leftCols<3>() = -m_rc * Hat(in_rig) * *cam_jr;
+    j.rightCols<3>() = m;
+  }
+  if (jac_point) {
+    Eigen::Map<RowMajor23> j(jac_point);
+    j = m_rc_rr;
+  }
   return true;
 }
 
-// The residual above over the blocks (phi_r, t_r, phi_c, t_c, X): online extrinsics.
-class BearingResidual final : public ceres::SizedCostFunction<3, 3, 3, 3, 3, 3> {
+// The residual above over the blocks (rig_from_world, cam_from_rig, X): online extrinsics.
+class BearingResidual final : public ceres::SizedCostFunction<2, 6, 6, 3> {
  public:
-  explicit BearingResidual(const Eigen::Vector3d& bearing_in_cam) : bearing_(bearing_in_cam) {}
+  explicit BearingResidual(const Eigen::Vector3d& bearing_in_cam) : basis_(TangentBasis(bearing_in_cam)) {}
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     Eigen::Matrix3d cam_rotation, cam_jr;
-    CachedRotation(parameters[2], &cam_rotation, jacobians && jacobians[2] ? &cam_jr : nullptr);
-    return EvaluateBearing(bearing_, parameters[0], parameters[1], cam_rotation,
-                           Eigen::Map<const Eigen::Vector3d>(parameters[3]), &cam_jr, parameters[4], residuals,
-                           jacobians);
+    const bool want_cam = jacobians && jacobians[1];
+    CachedRotation(parameters[1], &cam_rotation, want_cam ? &cam_jr : nullptr);
+    return EvaluateBearing(basis_, parameters[0], cam_rotation, Eigen::Map<const Eigen::Vector3d>(parameters[1] + 3),
+                           &cam_jr, parameters[2], residuals, jacobians ? jacobians[0] : nullptr,
+                           want_cam ? jacobians[1] : nullptr, jacobians ? jacobians[2] : nullptr);
   }
 
  private:
-  Eigen::Vector3d bearing_;
+  Eigen::Matrix<double, 3, 2> basis_;
 };
 
-// The same residual with cam_from_rig held fixed (GTExt, NoisyExt): blocks (phi_r, t_r, X) only,
-// which spares the solver two constant blocks per residual.
-class FixedCameraBearingResidual final : public ceres::SizedCostFunction<3, 3, 3, 3> {
+// The same residual with cam_from_rig held fixed (GTExt, NoisyExt): blocks (rig_from_world, X) only,
+// which spares the solver a constant block per residual.
+class FixedCameraBearingResidual final : public ceres::SizedCostFunction<2, 6, 3> {
  public:
   FixedCameraBearingResidual(const Eigen::Vector3d& bearing_in_cam, const Eigen::Matrix3d& cam_rotation,
                              const Eigen::Vector3d& cam_t)
-      : bearing_(bearing_in_cam), cam_rotation_(cam_rotation), cam_t_(cam_t) {}
+      : basis_(TangentBasis(bearing_in_cam)), cam_rotation_(cam_rotation), cam_t_(cam_t) {}
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    double* all[5] = {nullptr, nullptr, nullptr, nullptr, nullptr};
-    if (jacobians) all[0] = jacobians[0], all[1] = jacobians[1], all[4] = jacobians[2];
-    return EvaluateBearing(bearing_, parameters[0], parameters[1], cam_rotation_, cam_t_, nullptr, parameters[2],
-                           residuals, jacobians ? all : nullptr);
+    return EvaluateBearing(basis_, parameters[0], cam_rotation_, cam_t_, nullptr, parameters[1], residuals,
+                           jacobians ? jacobians[0] : nullptr, nullptr, jacobians ? jacobians[1] : nullptr);
   }
 
  private:
-  Eigen::Vector3d bearing_;
+  Eigen::Matrix<double, 3, 2> basis_;
   Eigen::Matrix3d cam_rotation_;
   Eigen::Vector3d cam_t_;
 };
@@ -150,17 +171,17 @@ ceres::CostFunction* CreateBearingResidual(const Eigen::Vector3d& bearing_in_cam
 
 namespace {
 
-// r = s * (|c_j - c_i| - L0), c = -R^T t = -R(-aa) t.
+// r = s * (|c_j - c_i| - L0), c = -R^T t = -R(-aa) t; each block is (aa, t) of one cam_from_rig.
 struct BaselineCost {
   BaselineCost(double length, double weight) : length0(length), scale(weight) {}
 
   template <typename T>
-  bool operator()(const T* aa_i, const T* t_i, const T* aa_j, const T* t_j, T* residual) const {
+  bool operator()(const T* cam_i, const T* cam_j, T* residual) const {
     T c_i[3], c_j[3];
-    const T minus_aa_i[3] = {-aa_i[0], -aa_i[1], -aa_i[2]};
-    const T minus_aa_j[3] = {-aa_j[0], -aa_j[1], -aa_j[2]};
-    ceres::AngleAxisRotatePoint(minus_aa_i, t_i, c_i);
-    ceres::AngleAxisRotatePoint(minus_aa_j, t_j, c_j);
+    const T minus_aa_i[3] = {-cam_i[0], -cam_i[1], -cam_i[2]};
+    const T minus_aa_j[3] = {-cam_j[0], -cam_j[1], -cam_j[2]};
+    ceres::AngleAxisRotatePoint(minus_aa_i, cam_i + 3, c_i);
+    ceres::AngleAxisRotatePoint(minus_aa_j, cam_j + 3, c_j);
     T d2 = T(0.0);
     for (int r = 0; r < 3; ++r) d2 += (c_j[r] - c_i[r]) * (c_j[r] - c_i[r]);
     residual[0] = T(scale) * (ceres::sqrt(d2) - T(length0));
@@ -168,18 +189,21 @@ struct BaselineCost {
   }
 
   static ceres::CostFunction* Create(double length, double weight) {
-    return new ceres::AutoDiffCostFunction<BaselineCost, 1, 3, 3, 3, 3>(new BaselineCost(length, weight));
+    return new ceres::AutoDiffCostFunction<BaselineCost, 1, 6, 6>(new BaselineCost(length, weight));
   }
 
   double length0, scale;
 };
 
-struct PoseParams {
-  Eigen::Vector3d aa, t;
-};
+// One pose or extrinsic as a parameter block: (angle-axis in radians, translation).
+using PoseParams = Eigen::Matrix<double, 6, 1>;
 
-PoseParams ToParams(const Rigid3& x) { return {x.AxisAngle(), x.translation}; }
-Rigid3 FromParams(const PoseParams& p) { return Rigid3::FromAxisAngle(p.aa, p.t); }
+PoseParams ToParams(const Rigid3& x) {
+  PoseParams p;
+  p << x.AxisAngle(), x.translation;
+  return p;
+}
+Rigid3 FromParams(const PoseParams& p) { return Rigid3::FromAxisAngle(p.head<3>(), p.tail<3>()); }
 
 // Random-walk prior of online extrinsics between BA runs:
 //   r = [ log(R * R0^T) / sigma_rot ; (c - c0) / sigma_centre ],  c = -R^T t,
@@ -193,7 +217,9 @@ struct ExtrinsicPriorCost {
         inv_sigma_centre(1.0 / sigma_centre_m) {}
 
   template <typename T>
-  bool operator()(const T* aa, const T* t, T* residual) const {
+  bool operator()(const T* cam, T* residual) const {
+    const T* aa = cam;
+    const T* t = cam + 3;
     T q[4], q0i[4], dq[4];
     ceres::AngleAxisToQuaternion(aa, q);
     for (int k = 0; k < 4; ++k) q0i[k] = T(q0_inverse[k]);
@@ -208,7 +234,7 @@ struct ExtrinsicPriorCost {
   }
 
   static ceres::CostFunction* Create(const Rigid3& cam_from_rig0, double sigma_rot_rad, double sigma_centre_m) {
-    return new ceres::AutoDiffCostFunction<ExtrinsicPriorCost, 6, 3, 3>(
+    return new ceres::AutoDiffCostFunction<ExtrinsicPriorCost, 6, 6>(
         new ExtrinsicPriorCost(cam_from_rig0, sigma_rot_rad, sigma_centre_m));
   }
 
@@ -269,7 +295,7 @@ LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& option
   // A camera held fixed (all of them without online calibration, camera 0 always) enters its
   // residuals as constants (FixedCameraBearingResidual); the others as parameter blocks.
   std::vector<Eigen::Matrix3d> cam_rotations(num_cams);
-  for (int j = 0; j < num_cams; ++j) RotationAndRightJacobian(cams[j].aa.data(), &cam_rotations[j], nullptr);
+  for (int j = 0; j < num_cams; ++j) RotationAndRightJacobian(cams[j].data(), &cam_rotations[j], nullptr);
   const auto camera_free = [&](int j) { return options.optimize_extrinsics && j != 0; };
   std::vector<char> pose_used(num_poses, 0), cam_used(num_cams, 0), point_used(problem.points_in_world.size(), 0);
   for (const LocalBaObservation& o : problem.observations) {
@@ -278,34 +304,29 @@ LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& option
     ceres::LossFunction* loss = multi ? &loss_multi : &loss_single;
     double* point = problem.points_in_world[o.point_index].data();
     if (camera_free(o.camera)) {
-      ceres_problem.AddResidualBlock(CreateBearingResidual(o.bearing_in_cam), loss, poses[o.pose_index].aa.data(),
-                                     poses[o.pose_index].t.data(), cams[o.camera].aa.data(), cams[o.camera].t.data(),
-                                     point);
+      ceres_problem.AddResidualBlock(CreateBearingResidual(o.bearing_in_cam), loss, poses[o.pose_index].data(),
+                                     cams[o.camera].data(), point);
     } else {
       ceres_problem.AddResidualBlock(
-          new FixedCameraBearingResidual(o.bearing_in_cam, cam_rotations[o.camera], cams[o.camera].t), loss,
-          poses[o.pose_index].aa.data(), poses[o.pose_index].t.data(), point);
+          new FixedCameraBearingResidual(o.bearing_in_cam, cam_rotations[o.camera], cams[o.camera].tail<3>()), loss,
+          poses[o.pose_index].data(), point);
     }
     pose_used[o.pose_index] = cam_used[o.camera] = point_used[o.point_index] = 1;
     ++report.num_residuals;
   }
-  if (pose_used[0]) {
-    ceres_problem.SetParameterBlockConstant(poses[0].aa.data());
-    ceres_problem.SetParameterBlockConstant(poses[0].t.data());
-  }
+  if (pose_used[0]) ceres_problem.SetParameterBlockConstant(poses[0].data());
   if (options.optimize_extrinsics && options.baseline_weight > 0.0) {
     for (size_t p = 0; p < baselines.size(); ++p) {
       const int a = static_cast<int>(p), b = static_cast<int>((p + 1) % num_cams);
       if (!cam_used[a] || !cam_used[b]) continue;
       ceres_problem.AddResidualBlock(BaselineCost::Create(baselines[p], options.baseline_weight), nullptr,
-                                     cams[a].aa.data(), cams[a].t.data(), cams[b].aa.data(), cams[b].t.data());
+                                     cams[a].data(), cams[b].data());
     }
   }
   // Fixed cameras that a baseline term brought in stay constant.
   for (int j = 0; j < num_cams; ++j) {
-    if (camera_free(j) || !ceres_problem.HasParameterBlock(cams[j].aa.data())) continue;
-    ceres_problem.SetParameterBlockConstant(cams[j].aa.data());
-    ceres_problem.SetParameterBlockConstant(cams[j].t.data());
+    if (camera_free(j) || !ceres_problem.HasParameterBlock(cams[j].data())) continue;
+    ceres_problem.SetParameterBlockConstant(cams[j].data());
   }
 
   if (options.optimize_extrinsics && options.extrinsic_prior_deg > 0.0) {
@@ -315,7 +336,7 @@ LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& option
           ExtrinsicPriorCost::Create(problem.cam_from_rig[j],
                                      options.extrinsic_prior_deg * M_PI / 180.0 / options.observation_sigma_rad,
                                      options.extrinsic_prior_m / options.observation_sigma_rad),
-          nullptr, cams[j].aa.data(), cams[j].t.data());
+          nullptr, cams[j].data());
     }
   }
 
@@ -325,14 +346,10 @@ LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& option
     if (point_used[i]) ordering->AddElementToGroup(problem.points_in_world[i].data(), 0);
   }
   for (int i = 0; i < num_poses; ++i) {
-    if (!pose_used[i]) continue;
-    ordering->AddElementToGroup(poses[i].aa.data(), 1);
-    ordering->AddElementToGroup(poses[i].t.data(), 1);
+    if (pose_used[i]) ordering->AddElementToGroup(poses[i].data(), 1);
   }
   for (int j = 0; j < num_cams; ++j) {
-    if (!ceres_problem.HasParameterBlock(cams[j].aa.data())) continue;
-    ordering->AddElementToGroup(cams[j].aa.data(), 1);
-    ordering->AddElementToGroup(cams[j].t.data(), 1);
+    if (ceres_problem.HasParameterBlock(cams[j].data())) ordering->AddElementToGroup(cams[j].data(), 1);
   }
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_SCHUR;

@@ -6,8 +6,10 @@
 #include <ceres/rotation.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
 #include <random>
+#include <vector>
 
 namespace rovo {
 namespace {
@@ -15,18 +17,37 @@ namespace {
 // The bearing residual written with autodiff, as the reference for the analytic one.
 struct AutodiffBearing {
   template <typename T>
-  bool operator()(const T* rig_aa, const T* rig_t, const T* cam_aa, const T* cam_t, const T* x, T* r) const {
+  bool operator()(const T* rig, const T* cam, const T* x, T* r) const {
     T in_rig[3], in_cam[3];
-    ceres::AngleAxisRotatePoint(rig_aa, x, in_rig);
-    for (int k = 0; k < 3; ++k) in_rig[k] += rig_t[k];
-    ceres::AngleAxisRotatePoint(cam_aa, in_rig, in_cam);
-    for (int k = 0; k < 3; ++k) in_cam[k] += cam_t[k];
+    ceres::AngleAxisRotatePoint(rig, x, in_rig);
+    for (int k = 0; k < 3; ++k) in_rig[k] += rig[3 + k];
+    ceres::AngleAxisRotatePoint(cam, in_rig, in_cam);
+    for (int k = 0; k < 3; ++k) in_cam[k] += cam[3 + k];
     const T norm = ceres::sqrt(in_cam[0] * in_cam[0] + in_cam[1] * in_cam[1] + in_cam[2] * in_cam[2]);
-    for (int k = 0; k < 3; ++k) r[k] = T(bearing(k)) - in_cam[k] / norm;
+    for (int c = 0; c < 2; ++c) {
+      r[c] = T(0.0);
+      for (int k = 0; k < 3; ++k) r[c] += T(basis(k, c)) * in_cam[k] / norm;
+    }
     return true;
   }
-  Eigen::Vector3d bearing;
+  Eigen::Matrix<double, 3, 2> basis;
 };
+
+TEST(LocalBa, TangentBasisIsOrthonormalAndPerpendicular) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Eigen::Vector3d> bearings = {Eigen::Vector3d::UnitX(), -Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(),
+                                           -Eigen::Vector3d::UnitZ()};
+  for (int k = 0; k < 200; ++k) bearings.push_back(Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized());
+  for (const Eigen::Vector3d& b : bearings) {
+    const Eigen::Matrix<double, 3, 2> basis = TangentBasis(b);
+    EXPECT_NEAR((basis.transpose() * basis - Eigen::Matrix2d::Identity()).norm(), 0.0, 1e-12);
+    EXPECT_NEAR((basis.transpose() * b).norm(), 0.0, 1e-12);
+    // The residual of a bearing rotated by an angle a away from b has norm sin(a).
+    const Eigen::Vector3d off = std::cos(0.3) * b + std::sin(0.3) * basis.col(0);
+    EXPECT_NEAR((basis.transpose() * off).norm(), std::sin(0.3), 1e-12);
+  }
+}
 
 TEST(LocalBa, AnalyticBearingJacobiansMatchAutodiff) {
   std::mt19937_64 rng(11);
@@ -35,27 +56,29 @@ TEST(LocalBa, AnalyticBearingJacobiansMatchAutodiff) {
   for (int trial = 0; trial < 200; ++trial) {
     // Rotations from tiny (series branch) to near pi; points in front of and behind the camera.
     const double rot_scale = trial % 4 == 0 ? 1e-6 : 1.7;
-    Eigen::Vector3d rig_aa = random_vector(rot_scale), rig_t = random_vector(5.0);
-    Eigen::Vector3d cam_aa = random_vector(rot_scale), cam_t = random_vector(0.5);
+    Eigen::Matrix<double, 6, 1> rig, cam;
+    rig << random_vector(rot_scale), random_vector(5.0);
+    cam << random_vector(rot_scale), random_vector(0.5);
     Eigen::Vector3d x = random_vector(20.0);
     const Eigen::Vector3d bearing = random_vector(1.0).normalized();
     std::unique_ptr<ceres::CostFunction> analytic(CreateBearingResidual(bearing));
-    ceres::AutoDiffCostFunction<AutodiffBearing, 3, 3, 3, 3, 3, 3> reference(new AutodiffBearing{bearing});
-    const double* params[5] = {rig_aa.data(), rig_t.data(), cam_aa.data(), cam_t.data(), x.data()};
-    double r_a[3], r_b[3], j_a[5][9], j_b[5][9];
-    double* jac_a[5] = {j_a[0], j_a[1], j_a[2], j_a[3], j_a[4]};
-    double* jac_b[5] = {j_b[0], j_b[1], j_b[2], j_b[3], j_b[4]};
+    ceres::AutoDiffCostFunction<AutodiffBearing, 2, 6, 6, 3> reference(new AutodiffBearing{TangentBasis(bearing)});
+    const double* params[3] = {rig.data(), cam.data(), x.data()};
+    double r_a[2], r_b[2], j_a[3][12], j_b[3][12];
+    double* jac_a[3] = {j_a[0], j_a[1], j_a[2]};
+    double* jac_b[3] = {j_b[0], j_b[1], j_b[2]};
     ASSERT_TRUE(analytic->Evaluate(params, r_a, jac_a));
     ASSERT_TRUE(reference.Evaluate(params, r_b, jac_b));
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(r_a[k], r_b[k], 1e-12);
-    for (int b = 0; b < 5; ++b) {
-      for (int k = 0; k < 9; ++k) EXPECT_NEAR(j_a[b][k], j_b[b][k], 1e-9) << "trial " << trial << " block " << b;
+    for (int k = 0; k < 2; ++k) EXPECT_NEAR(r_a[k], r_b[k], 1e-12);
+    const int sizes[3] = {12, 12, 6};
+    for (int b = 0; b < 3; ++b) {
+      for (int k = 0; k < sizes[b]; ++k) EXPECT_NEAR(j_a[b][k], j_b[b][k], 1e-9) << "trial " << trial << " block " << b;
     }
     // Blocks without a Jacobian request (constant blocks) are skipped, the others unchanged.
-    double j_c[9];
-    double* partial[5] = {nullptr, nullptr, nullptr, nullptr, j_c};
+    double j_c[6];
+    double* partial[3] = {nullptr, nullptr, j_c};
     ASSERT_TRUE(analytic->Evaluate(params, r_a, partial));
-    for (int k = 0; k < 9; ++k) EXPECT_NEAR(j_c[k], j_b[4][k], 1e-9);
+    for (int k = 0; k < 6; ++k) EXPECT_NEAR(j_c[k], j_b[2][k], 1e-9);
   }
 }
 
