@@ -96,6 +96,13 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
                   "accurate (README: speed, whole sequences and quick forms)")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
+  cmd->add_option("--warp-below", args->options.warp_below_deg,
+                  "Degrees below the rig plane that the hybrid warp reaches; features are tracked and detected only "
+                  "inside it (recorded in run.json). 25 makes the full-size front-end about 18 % cheaper (the road "
+                  "beside the vehicle, where fresh features die at once) at neutral full-size accuracy, but costs "
+                  "accuracy at small image sizes (README: speed)")
+      ->check(CLI::Range(1.0, 85.0))
+      ->capture_default_str();
   cmd->add_option("--keyframe-distance", args->options.keyframe_distance_m,
                   "Rig travel in metres that makes a keyframe (and a local BA); 0: the default, recorded in run.json")
       ->check(CLI::Range(0.0, 100.0));

@@ -197,12 +197,14 @@ HybridProjection::HybridProjection(const Camera& camera, const Rigid3& cam_from_
   };
   const double s_min = psi_left_ - extent(normal_left_, -tangent_left_);
   const double s_max = psi_right_ + extent(normal_right_, tangent_right_);
-  const double y_max = std::tan(std::clamp(options.vertical_half_fov_deg, 1.0, 85.0) * kDegToRad);
+  const auto rows = [&](double angle_deg) {
+    return static_cast<int>(std::ceil(std::tan(std::clamp(angle_deg, 1.0, 85.0) * kDegToRad) * focal_));
+  };
+  const int rows_above = rows(options.vertical_fov_above_deg), rows_below = rows(options.vertical_fov_below_deg);
   width_ = static_cast<int>(std::ceil((s_max - s_min) * focal_)) + 1;
-  const int half_height = static_cast<int>(std::ceil(y_max * focal_));
-  height_ = 2 * half_height + 1;
+  height_ = rows_above + rows_below + 1;
   cx_ = -s_min * focal_;
-  cy_ = half_height;
+  cy_ = rows_above;
   BuildMaps();
 }
 

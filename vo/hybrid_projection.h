@@ -31,7 +31,8 @@
 // sqrt|det| of the Jacobian of the fisheye projection w.r.t. two orthogonal angles) averaged over the
 // two plane-tangent directions, i.e. the centres of the overlaps; so the warped image samples the
 // overlaps at the fisheye's own density. Horizontally each plane extends to min(max_plane_angle,
-// the camera's FOV edge along the horizon); vertically |y| <= tan(vertical_half_fov).
+// the camera's FOV edge along the horizon); vertically -tan(vertical_fov_above) <= y <=
+// tan(vertical_fov_below) (y > 0 is below the rig plane).
 //
 // Online extrinsics: the virtual frame (up, forward, plane normals) is stored in the CAMERA frame;
 // the warp maps depend only on it and the intrinsics. When cam_from_rig changes, the front-end
@@ -56,7 +57,8 @@ struct HybridProjectionOptions {
   double focal_px = 0.0;               // warped focal length; 0 = automatic (see above)
   double focal_scale = 1.0;            // multiplies the automatic focal length
   double max_plane_angle_deg = 65.0;   // each plane spans at most this far beyond its tangent point
-  double vertical_half_fov_deg = 50.0; // |y| <= tan(this)
+  double vertical_fov_above_deg = 50.0;  // the warp reaches this far above the rig plane
+  double vertical_fov_below_deg = 50.0;  // and this far below it
   double rebuild_threshold_deg = 1.0;  // see "Online extrinsics" above
 };
 

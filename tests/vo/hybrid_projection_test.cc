@@ -266,6 +266,47 @@ TEST(HybridProjection, LayoutChangeMeasuresCameraRotation) {
 }
 
 // Warp() (fixed-point remap) reproduces the float map's bilinear samples of a smooth image.
+// The warp reaches vertical_fov_above_deg above and vertical_fov_below_deg below the rig plane
+// (checked at the plane's tangent line, where y = -tan(elevation)); rows above and below differ.
+TEST(HybridProjection, VerticalExtentsAboveAndBelowTheRigPlane) {
+  const Rig rig = MakeRigPreset("rovo4").Scaled(0.5);
+  const auto layouts = ComputeHybridLayouts(rig);
+  HybridProjectionOptions options;
+  options.vertical_fov_above_deg = 50.0;
+  options.vertical_fov_below_deg = 25.0;
+  const HybridProjection cut(rig.cameras[0].camera, rig.cameras[0].cam_from_rig, layouts[0], options);
+  const HybridProjection full(rig.cameras[0].camera, rig.cameras[0].cam_from_rig, layouts[0]);
+  ASSERT_NEAR(cut.focal_px(), full.focal_px(), 1e-9);
+  EXPECT_EQ(cut.width(), full.width());
+  const int rows_above = static_cast<int>(std::ceil(std::tan(50.0 * kDeg) * cut.focal_px()));
+  const int rows_below = static_cast<int>(std::ceil(std::tan(25.0 * kDeg) * cut.focal_px()));
+  EXPECT_EQ(cut.height(), rows_above + rows_below + 1);
+  EXPECT_EQ(full.height(), 2 * rows_above + 1);
+  const Eigen::Vector3d m = layouts[0].right_normal_in_rig, up = layouts[0].up_in_rig;
+  const auto in_image = [&](const HybridProjection& p, double elevation_deg) {
+    const Eigen::Vector3d d = std::cos(elevation_deg * kDeg) * m + std::sin(elevation_deg * kDeg) * up;
+    const auto px = p.WarpedFromBearing(rig.cameras[0].cam_from_rig.RotationMatrix() * d);
+    EXPECT_TRUE(px.has_value()) << elevation_deg;
+    if (px) {
+      EXPECT_NEAR(px->y(), rows_above - cut.focal_px() * std::tan(elevation_deg * kDeg), 1e-6);
+    }
+    return px && p.InWarpedImage(*px);
+  };
+  EXPECT_TRUE(in_image(cut, 49.5));
+  EXPECT_FALSE(in_image(cut, 50.5));
+  EXPECT_TRUE(in_image(cut, -24.5));
+  EXPECT_FALSE(in_image(cut, -25.5));
+  EXPECT_TRUE(in_image(full, -49.5));
+  // The cut warp is the full one's top rows: the same fisheye source up to the maps' interpolation
+  // between exact nodes (< 0.02 px each).
+  for (int v = 0; v < cut.height(); v += 7) {
+    for (int u = 0; u < cut.width(); u += 7) {
+      ASSERT_NEAR(cut.map_x().at<float>(v, u), full.map_x().at<float>(v, u), 0.04) << u << "," << v;
+      ASSERT_NEAR(cut.map_y().at<float>(v, u), full.map_y().at<float>(v, u), 0.04) << u << "," << v;
+    }
+  }
+}
+
 TEST(HybridProjection, WarpSamplesTheFisheyeImage) {
   const auto projections = HybridProjection::ForRig(MakeRigPreset("omnimvs4"));
   const HybridProjection& p = projections[0];
