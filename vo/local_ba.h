@@ -6,7 +6,9 @@
 // over the rig poses rig_from_world_t of the window, the landmarks X_i (point_in_world) and, in
 // online mode, cam_from_rig_j of cameras 1..N-1. pi0(p) = p/|p|, B = TangentBasis(b) spans the plane
 // perpendicular to the observed bearing b, so the 2-vector residual has norm sin(angle(b, pi0)) (the
-// paper's angular error to first order) with no redundant third value; rho = Cauchy, w_ij =
+// paper's angular error to first order) with no redundant third value. |sin| grows with the angle only
+// up to 90 deg; observations enter the map only within the back-end's rejection bound (2 deg at most), far
+// from that. rho = Cauchy, w_ij =
 // multi_camera_weight for points seen by >= 2 cameras (they carry the metric scale), else 1.
 // c_j = -R_j^T t_j is camera j's centre in the rig frame (cam_from_rig_j = (R_j, t_j)) and L0_ij its
 // initial distance to its neighbour (ring order 0-1, 1-2, ..., N-1-0): without it the rig could
