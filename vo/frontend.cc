@@ -95,6 +95,7 @@ TrackerOptions TrackerOptionsFrom(const FrontendOptions& options) {
   tracker.klt_epsilon_px = options.klt_epsilon_px;
   tracker.klt_predict_flow = options.klt_predict_flow;
   tracker.klt_predicted_levels = options.klt_predicted_levels;
+  tracker.upright_descriptors = options.upright_descriptors;
   return tracker;
 }
 

@@ -536,8 +536,11 @@ std::vector<Rigid3> BootstrapExtrinsics(const VoOptions& options, const Rig& rig
   for (int round = 0; round < options.online_bootstrap_rounds; ++round) {
     // The full default warp, not VoOptions::warp_below_deg: the start-up calibration needs the
     // overlaps' matches below the rig plane too (measured on the quick forms: with the warp cut to
-    // 30-35 deg it left cameras 1-3.5 deg off; with 50 deg at most 0.44 deg).
-    Frontend probe(rig.WithExtrinsics(cam_from_rig), FrontendOptions{});
+    // 30-35 deg it left cameras 1-3.5 deg off; with 50 deg at most 0.44 deg). Oriented descriptors:
+    // with extrinsics degrees off, neighbouring warped views are rotated against each other.
+    FrontendOptions probe_options;
+    probe_options.upright_descriptors = false;
+    Frontend probe(rig.WithExtrinsics(cam_from_rig), probe_options);
     probe.SetMatchingOptions(LoosenedMatching(probe.options().matching, uncertainty_deg, probe.projection(0).focal_px()));
     const FrontendFrame frame = probe.Process(images);
     ExtrinsicBootstrapOptions bopt;

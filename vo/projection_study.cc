@@ -223,6 +223,7 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
 
   FrontendOptions frontend_options;
   frontend_options.matching = options.frontend_matching;
+  frontend_options.upright_descriptors = options.upright_descriptors;
   Frontend frontend(rig, frontend_options);
   const std::vector<HybridLayout> layouts = ComputeHybridLayouts(rig);
   std::vector<std::pair<int, int>> pairs;
@@ -504,7 +505,9 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
      << bins_row("hybrid, front-end", frontend_error_bins) << "\n";
   md << "Method: the same tracker (FAST + " << frontend_options.min_feature_distance_px
      << " px minimum distance, pyramidal KLT with forward-backward check, re-detection to the target, ORB "
-        "descriptors recomputed every frame) on both image kinds. Descriptor distance: Hamming distance between a "
+        "descriptors recomputed every frame, "
+     << (options.upright_descriptors ? "upright (angle 0)" : "at the intensity-centroid orientation")
+     << ") on both image kinds. Descriptor distance: Hamming distance between a "
         "track's ORB descriptor at its first frame and at every later frame it is alive, averaged over all such "
         "pairs. Matches: mutual nearest ORB neighbours between neighbouring views among the features whose "
         "direction lies inside both views' hybrid images (same scene area for both arms); the second row keeps "
@@ -529,6 +532,7 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
   json["features_per_view"] = options.features_per_view;
   json["epipolar_deg"] = options.epipolar_deg;
   json["inlier_px"] = options.inlier_px;
+  json["upright_descriptors"] = options.upright_descriptors;
   json["error_bin_edges_px"] = std::vector<double>(std::begin(kErrorBinEdges), std::end(kErrorBinEdges));
   const auto arm_json = [&](const Arm& arm, double hamming, double step, double age, int64_t tracks, double ratio_value) {
     return nlohmann::json{{"mean_hamming_first_vs_later", hamming},
@@ -600,6 +604,9 @@ void AddProjectionStudyCommand(CliGroups& groups) {
   cmd->add_option("--fe-uniqueness-deg", m.uniqueness_range_deg, "Front-end column: epipolar uniqueness half-range")
       ->capture_default_str();
   cmd->add_flag("!--fe-no-uniqueness", m.use_uniqueness, "Front-end column: no epipolar uniqueness scan");
+  cmd->add_flag("!--oriented", options->upright_descriptors,
+                "ORB descriptors at the intensity-centroid orientation in both arms instead of upright (angle 0, the "
+                "front-end's default)");
   cmd->add_flag("--quiet", options->quiet, "No progress output");
   cmd->callback([options] {
     const ProjectionStudyResult r = RunProjectionStudy(*options);

@@ -69,6 +69,8 @@ struct ProjectionStudyOptions {
   double epipolar_deg = 1.0;    // epipolar consistency for part (b)
   double inlier_px = 2.0;       // ground-truth reprojection tolerance, fisheye pixels
   InterviewMatchOptions frontend_matching;  // filters of the front-end column (defaults = the front-end's)
+  // TrackerOptions::upright_descriptors for both arms and the front-end column (default: the front-end's).
+  bool upright_descriptors = FrontendOptions{}.upright_descriptors;
   bool quiet = false;
 };
 

@@ -256,7 +256,8 @@ void ViewTracker::DetectAndDescribe(const std::function<uint64_t()>& next_id) {
   for (size_t i = 0; i < points_.size(); ++i) {
     points_[i].angle_deg = IntensityCentroidAngleDeg(image_, points_[i].px);
     points_[i].has_descriptor = false;
-    cv::KeyPoint kp(points_[i].px, 31.0f, points_[i].angle_deg, 0.0f, 0, static_cast<int>(i));
+    const float descriptor_angle = options_.upright_descriptors ? 0.0f : points_[i].angle_deg;
+    cv::KeyPoint kp(points_[i].px, 31.0f, descriptor_angle, 0.0f, 0, static_cast<int>(i));
     keypoints.push_back(kp);
   }
   static thread_local cv::Ptr<cv::ORB> orb = cv::ORB::create(500, 1.2f, 1, 19, 0, 2, cv::ORB::HARRIS_SCORE, 31);

@@ -42,6 +42,10 @@ struct TrackerOptions {
   bool klt_predict_flow = true;
   int klt_predicted_levels = 0;
   int border_px = 20;                // features keep this distance from invalid pixels and image edges (ORB patch)
+  // ORB descriptors at angle 0 (upright BRIEF) instead of at the intensity-centroid orientation;
+  // angle_deg is still computed (the inter-view orientation filter). Rectified-like views agree on
+  // "up", so they need no rotation invariance; raw fisheye views do not agree.
+  bool upright_descriptors = false;
 };
 
 struct TrackedPoint {

@@ -1,6 +1,7 @@
 #include "vo/tracking.h"
 
 #include <gtest/gtest.h>
+#include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
@@ -217,6 +218,50 @@ TEST(Tracking, DescriptorsAreStableUnderSmallShiftAndOrientationFollowsRotation)
   const float b = IntensityCentroidAngleDeg(rotated, centre);
   double diff = std::fmod(a - b + 720.0, 360.0);  // OpenCV rotates counter-clockwise on screen
   EXPECT_NEAR(diff, 30.0, 3.0);
+}
+
+// Upright descriptors (angle 0) skip the intensity-centroid angle, whose noise moves oriented ORB
+// bits: under a sub-pixel shift (what tracking between rectified-like views sees) they change less.
+TEST(Tracking, UprightDescriptorsAreSteadierUnderSubpixelShift) {
+  const cv::Mat image = TexturedImage(640, 480, 9);
+  const cv::Mat mask(480, 640, CV_8UC1, cv::Scalar(255));
+  const auto mean_change = [&](bool upright) {
+    TrackerOptions options;
+    options.upright_descriptors = upright;
+    ViewTracker tracker(options);
+    tracker.Track(image, mask);
+    tracker.DetectAndDescribe(Counter);
+    std::map<uint64_t, cv::Mat> descriptors;
+    for (const TrackedPoint& p : tracker.points()) descriptors[p.track_id] = p.descriptor.clone();
+    tracker.Track(Shifted(image, 0.45, -0.35), mask);
+    tracker.DetectAndDescribe(Counter);
+    double sum = 0;
+    int count = 0;
+    for (const TrackedPoint& p : tracker.points()) {
+      if (!descriptors.count(p.track_id) || !p.has_descriptor) continue;
+      sum += HammingDistance(descriptors[p.track_id], p.descriptor);
+      ++count;
+    }
+    EXPECT_GT(count, 100);
+    return sum / std::max(count, 1);
+  };
+  const double oriented = mean_change(false), upright = mean_change(true);
+  EXPECT_LT(upright, 0.8 * oriented) << "oriented " << oriented << ", upright " << upright;
+
+  // Upright descriptors are ORB's at angle 0; the orientation is still measured (inter-view filter).
+  TrackerOptions options;
+  options.upright_descriptors = true;
+  ViewTracker tracker(options);
+  tracker.Track(image, mask);
+  tracker.DetectAndDescribe(Counter);
+  ASSERT_FALSE(tracker.points().empty());
+  const TrackedPoint& p = tracker.points().front();
+  std::vector<cv::KeyPoint> keypoint = {cv::KeyPoint(p.px, 31.0f, 0.0f)};
+  cv::Mat expected;
+  cv::ORB::create(500, 1.2f, 1, 19, 0, 2, cv::ORB::HARRIS_SCORE, 31)->compute(image, keypoint, expected);
+  ASSERT_EQ(expected.rows, 1);
+  EXPECT_EQ(HammingDistance(expected, p.descriptor), 0);
+  EXPECT_FLOAT_EQ(p.angle_deg, IntensityCentroidAngleDeg(image, p.px));
 }
 
 TEST(Tracking, HammingDistanceCountsBits) {
