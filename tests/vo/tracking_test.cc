@@ -190,25 +190,34 @@ TEST(Tracking, LimitsNewDetectionsOnlyWhileTheViewHasTracks) {
   EXPECT_GE(static_cast<int>(tracker.points().size()), 250);
 }
 
-TEST(Tracking, DescriptorsAreStableUnderSmallShiftAndOrientationFollowsRotation) {
-  ViewTracker tracker;
-  const cv::Mat image = TexturedImage(640, 480, 4);
-  const cv::Mat mask(480, 640, CV_8UC1, cv::Scalar(255));
+// Mean Hamming distance between each track's descriptor on `image` and on `image` shifted by
+// (dx, dy), over the tracks KLT keeps; `count` receives their number.
+double MeanDescriptorChangeUnderShift(const TrackerOptions& options, const cv::Mat& image, double dx, double dy,
+                                      int* count) {
+  const cv::Mat mask(image.size(), CV_8UC1, cv::Scalar(255));
+  ViewTracker tracker(options);
   tracker.Track(image, mask);
   tracker.DetectAndDescribe(Counter);
   std::map<uint64_t, cv::Mat> descriptors;
   for (const TrackedPoint& p : tracker.points()) descriptors[p.track_id] = p.descriptor.clone();
-  tracker.Track(Shifted(image, 0.4, 0.3), mask);
+  tracker.Track(Shifted(image, dx, dy), mask);
   tracker.DetectAndDescribe(Counter);
   double sum = 0;
-  int count = 0;
+  *count = 0;
   for (const TrackedPoint& p : tracker.points()) {
     if (!descriptors.count(p.track_id) || !p.has_descriptor) continue;
     sum += HammingDistance(descriptors[p.track_id], p.descriptor);
-    ++count;
+    ++*count;
   }
+  return sum / std::max(*count, 1);
+}
+
+TEST(Tracking, DescriptorsAreStableUnderSmallShiftAndOrientationFollowsRotation) {
+  const cv::Mat image = TexturedImage(640, 480, 4);
+  int count = 0;
+  const double mean_change = MeanDescriptorChangeUnderShift(TrackerOptions{}, image, 0.4, 0.3, &count);
   ASSERT_GT(count, 100);
-  EXPECT_LT(sum / count, 30.0);  // random descriptors would be ~128 apart
+  EXPECT_LT(mean_change, 30.0);  // random descriptors would be ~128 apart
 
   // Rotating the image by 30 deg about a point rotates its ORB orientation by 30 deg.
   const cv::Point2f centre(320, 240);
@@ -228,22 +237,10 @@ TEST(Tracking, UprightDescriptorsAreSteadierUnderSubpixelShift) {
   const auto mean_change = [&](bool upright) {
     TrackerOptions options;
     options.upright_descriptors = upright;
-    ViewTracker tracker(options);
-    tracker.Track(image, mask);
-    tracker.DetectAndDescribe(Counter);
-    std::map<uint64_t, cv::Mat> descriptors;
-    for (const TrackedPoint& p : tracker.points()) descriptors[p.track_id] = p.descriptor.clone();
-    tracker.Track(Shifted(image, 0.45, -0.35), mask);
-    tracker.DetectAndDescribe(Counter);
-    double sum = 0;
     int count = 0;
-    for (const TrackedPoint& p : tracker.points()) {
-      if (!descriptors.count(p.track_id) || !p.has_descriptor) continue;
-      sum += HammingDistance(descriptors[p.track_id], p.descriptor);
-      ++count;
-    }
+    const double change = MeanDescriptorChangeUnderShift(options, image, 0.45, -0.35, &count);
     EXPECT_GT(count, 100);
-    return sum / std::max(count, 1);
+    return change;
   };
   const double oriented = mean_change(false), upright = mean_change(true);
   EXPECT_LT(upright, 0.8 * oriented) << "oriented " << oriented << ", upright " << upright;
