@@ -62,7 +62,7 @@ struct VoArgs {
   std::string extrinsics = "gt";
   std::string frames;
   bool realtime = false;
-  CLI::Option* warp_below = nullptr;    // given explicitly, it overrides --realtime
+  CLI::Option* warp_below = nullptr;  // given explicitly, it overrides --realtime
   CLI::Option* max_new_features = nullptr;
 };
 
@@ -101,19 +101,22 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
                   "OnlineExt: frames during which the calibration settles and observations up to 2 deg off are kept; "
                   "afterwards the RANSAC threshold rejects them, as in GTExt (default 50, recorded in run.json)")
       ->check(CLI::Range(0, 1000000));
-  args->max_new_features = cmd->add_option("--max-new-features", args->options.max_new_features,
-                  "New detections per view and frame at most, while the view has tracks (0: fill up to the target "
-                  "count of 600). 150 makes the front-end about a fifth cheaper and the trajectories slightly less "
-                  "accurate (README: speed, whole sequences and quick forms)")
-      ->check(CLI::Range(0, 100000))
-      ->capture_default_str();
-  args->warp_below = cmd->add_option("--warp-below", args->options.warp_below_deg,
-                  "Degrees below the rig plane that the hybrid warp reaches; features are tracked and detected only "
-                  "inside it (recorded in run.json). 25 makes the full-size front-end about 18 % cheaper (the road "
-                  "beside the vehicle, where fresh features die at once) at neutral full-size accuracy, but costs "
-                  "accuracy at small image sizes (README: speed)")
-      ->check(CLI::Range(1.0, 85.0))
-      ->capture_default_str();
+  args->max_new_features =
+      cmd->add_option("--max-new-features", args->options.max_new_features,
+                      "New detections per view and frame at most, while the view has tracks (0: fill up to the target "
+                      "count of 600). 150 makes the front-end about a fifth cheaper and the trajectories slightly less "
+                      "accurate (README: speed, whole sequences and quick forms)")
+          ->check(CLI::Range(0, 100000))
+          ->capture_default_str();
+  args->warp_below =
+      cmd->add_option(
+             "--warp-below", args->options.warp_below_deg,
+             "Degrees below the rig plane that the hybrid warp reaches; features are tracked and detected only "
+             "inside it (recorded in run.json). 25 makes the full-size front-end about 18 % cheaper (the road "
+             "beside the vehicle, where fresh features die at once) at neutral full-size accuracy, but costs "
+             "accuracy at small image sizes (README: speed)")
+          ->check(CLI::Range(1.0, 85.0))
+          ->capture_default_str();
   cmd->add_option("--keyframe-distance", args->options.keyframe_distance_m,
                   "Rig travel in metres that makes a keyframe (and a local BA); 0: the default, recorded in run.json")
       ->check(CLI::Range(0.0, 100.0));

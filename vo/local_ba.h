@@ -15,8 +15,8 @@
 // grow or shrink and metric scale would be lost.
 // Gauge: the oldest rig pose (index 0) is fixed; camera 0's cam_from_rig is fixed (rig.h).
 // Parametrisation: one 6-vector block per pose and extrinsic, (angle-axis in radians, translation);
-// Ceres DENSE_SCHUR with landmarks eliminated first (its <2, 3, 6> specialisation). Bounded time: max_iterations (and an optional wall-time limit, which
-// trades determinism for latency). Deterministic for a fixed input with num_threads = 1.
+// Ceres DENSE_SCHUR with landmarks eliminated first (its <2, 3, 6> specialisation). Bounded time:
+// max_iterations (and an optional wall-time limit, which trades determinism for latency). Deterministic for a fixed input with num_threads = 1.
 
 #include "datasets/rigid3.h"
 

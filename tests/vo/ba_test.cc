@@ -1,7 +1,3 @@
-#include "vo/local_ba.h"
-
-#include "synthetic_rig.h"
-
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 #include <gtest/gtest.h>
@@ -10,6 +6,9 @@
 #include <memory>
 #include <random>
 #include <vector>
+
+#include "synthetic_rig.h"
+#include "vo/local_ba.h"
 
 namespace rovo {
 namespace {
@@ -36,8 +35,8 @@ struct AutodiffBearing {
 TEST(LocalBa, TangentBasisIsOrthonormalAndPerpendicular) {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::vector<Eigen::Vector3d> bearings = {Eigen::Vector3d::UnitX(), -Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(),
-                                           -Eigen::Vector3d::UnitZ()};
+  std::vector<Eigen::Vector3d> bearings = {Eigen::Vector3d::UnitX(), -Eigen::Vector3d::UnitY(),
+                                           Eigen::Vector3d::UnitZ(), -Eigen::Vector3d::UnitZ()};
   for (int k = 0; k < 200; ++k) bearings.push_back(Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized());
   for (const Eigen::Vector3d& b : bearings) {
     const Eigen::Matrix<double, 3, 2> basis = TangentBasis(b);

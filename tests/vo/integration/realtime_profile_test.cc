@@ -1,12 +1,12 @@
 // `rovo vo --realtime` sets the real-time front-end settings unless they are given explicitly, and
 // run.json records the values the run used.
-#include "datasets/run.h"
-
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+
+#include "datasets/run.h"
 
 namespace rovo {
 namespace {
@@ -24,8 +24,8 @@ TEST(VoCli, RealtimeProfileSetsItsDefaultsAndYieldsToExplicitValues) {
             0);
   const auto run = [&](const std::string& name, const std::string& flags) {
     const std::string out = (root / name).string();
-    EXPECT_EQ(RunCommand(std::string(ROVO_BINARY) + " vo " + dataset + " --frames 0:4 --quiet " + flags + " --out " + out),
-              0)
+    EXPECT_EQ(
+        RunCommand(std::string(ROVO_BINARY) + " vo " + dataset + " --frames 0:4 --quiet " + flags + " --out " + out), 0)
         << flags;
     return ReadRun(out);
   };
