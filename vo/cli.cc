@@ -75,6 +75,13 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
       ->capture_default_str();
   cmd->add_option("--noise-set", args->options.noise_set, "Index of the perturbed extrinsic set in dataset.json")
       ->capture_default_str();
+  cmd->add_option("--draw-seed", args->options.draw_seed,
+                  "noisy/online: start from a fresh perturbation draw with this seed instead of a stored set "
+                  "(sigma --draw-sigma on roll, pitch and yaw of every camera; recorded in run.json)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--draw-sigma", args->options.draw_sigma_deg, "Sigma of a --draw-seed draw in degrees")
+      ->check(CLI::Range(0.0, 45.0))
+      ->capture_default_str();
   cmd->add_option("--seed", args->options.seed, "RANSAC seed (recorded in run.json)")->capture_default_str();
   cmd->add_option("--frames", args->frames, "Frame range A:B (B exclusive; default: all frames)");
   cmd->add_option("--threads", args->options.threads, "Worker threads of the front-end (0: all cores)")

@@ -588,7 +588,14 @@ VoSummary RunVo(const VoOptions& options) {
   }
   // Starting extrinsics.
   std::vector<Rigid3> cam_from_rig = info.rig.Extrinsics();
-  if (options.mode != ExtrinsicsMode::kGroundTruth) {
+  if (options.mode != ExtrinsicsMode::kGroundTruth && options.draw_seed >= 0) {
+    if (!(options.draw_sigma_deg >= 0.0)) {
+      throw std::invalid_argument("vo: --draw-sigma must be non-negative (degrees), got " +
+                                  std::to_string(options.draw_sigma_deg));
+    }
+    cam_from_rig =
+        PerturbExtrinsics(info.rig, options.draw_sigma_deg, 0.0, static_cast<uint64_t>(options.draw_seed)).cam_from_rig;
+  } else if (options.mode != ExtrinsicsMode::kGroundTruth) {
     if (options.noise_set < 0 || options.noise_set >= static_cast<int>(info.perturbed.size())) {
       throw std::invalid_argument(DatasetJsonPath(options.dataset_dir) + ": perturbed[" +
                                   std::to_string(options.noise_set) + "] does not exist (the dataset has " +
@@ -735,6 +742,8 @@ VoSummary RunVo(const VoOptions& options) {
   j["dataset_seed"] = info.seed;
   j["seed"] = options.seed;
   j["noise_set"] = options.noise_set;
+  j["draw_seed"] = options.draw_seed;
+  j["draw_sigma_deg"] = options.draw_sigma_deg;
   j["frames"] = {begin, end};
   j["threads"] = options.threads;
   j["sampling"] = options.sampling;

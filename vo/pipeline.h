@@ -40,6 +40,11 @@ struct VoOptions {
   std::string out_dir;             // run folder
   ExtrinsicsMode mode = ExtrinsicsMode::kGroundTruth;
   int noise_set = 0;               // which perturbed set of dataset.json (noisy/online)
+  // A fresh perturbation draw instead of a stored set (noisy/online): when draw_seed >= 0 the starting
+  // extrinsics are PerturbExtrinsics(ground-truth rig, draw_sigma_deg, 0, draw_seed) (datasets/rig.h),
+  // the paper's protocol (roll, pitch, yaw of every camera, camera 0 included; centres kept).
+  int64_t draw_seed = -1;
+  double draw_sigma_deg = 5.0;
   uint64_t seed = 0;               // RANSAC seed
   int threads = 0;                 // 0 = all cores
   int frame_begin = 0;
