@@ -8,7 +8,7 @@ PACKAGES=(
   libembree-dev libtbb-dev
   libopenimageio-dev openimageio-tools
   libopencv-dev
-  libeigen3-dev libceres-dev
+  libeigen3-dev libceres-dev libopengv-dev
   nlohmann-json3-dev libyaml-cpp-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib python3-numpy

@@ -107,26 +107,30 @@ std::string FindPlotScript(const std::string& name) {
   return "";
 }
 
-std::vector<std::string> RunReportPlots(const std::string& report_dir, bool quiet) {
-  const std::string script = FindPlotScript("plot_report.py");
+bool RunPlotScript(const std::string& name, const std::string& folder, bool quiet) {
+  const std::string script = FindPlotScript(name);
   const std::string python = FindPython();
   auto warn = [&](const std::string& message) {
-    if (!quiet) std::fprintf(stderr, "rovo: warning: %s; the report has no plots\n", message.c_str());
+    if (!quiet) std::fprintf(stderr, "rovo: warning: %s; no plots in %s\n", message.c_str(), folder.c_str());
+    return false;
   };
   if (script.empty()) {
-    warn("eval/plots/plot_report.py not found (looked in " + std::string(ROVO_SOURCE_DIR) + " and next to rovo)");
-  } else if (python.empty()) {
-    warn("/usr/bin/python3 not found");
-  } else {
-    const std::string command = ShellQuote(python) + " " + ShellQuote(script) + " " + ShellQuote(report_dir) +
-                                (quiet ? " >/dev/null 2>&1" : " >&2");
-    const int status = std::system(command.c_str());
-    if (status == -1 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-      const int code = (status != -1 && WIFEXITED(status)) ? WEXITSTATUS(status) : -1;
-      warn(code == 3 ? std::string("python3 has no matplotlib (apt-get install python3-matplotlib)")
-                     : "plot script failed (exit status " + std::to_string(code) + ")");
-    }
+    return warn("eval/plots/" + name + " not found (looked in " + std::string(ROVO_SOURCE_DIR) + " and next to rovo)");
   }
+  if (python.empty()) return warn("/usr/bin/python3 not found");
+  const std::string command = ShellQuote(python) + " " + ShellQuote(script) + " " + ShellQuote(folder) +
+                              (quiet ? " >/dev/null 2>&1" : " >&2");
+  const int status = std::system(command.c_str());
+  if (status == -1 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    const int code = (status != -1 && WIFEXITED(status)) ? WEXITSTATUS(status) : -1;
+    return warn(code == 3 ? std::string("python3 has no matplotlib (apt-get install python3-matplotlib)")
+                          : "plot script failed (exit status " + std::to_string(code) + ")");
+  }
+  return true;
+}
+
+std::vector<std::string> RunReportPlots(const std::string& report_dir, bool quiet) {
+  RunPlotScript("plot_report.py", report_dir, quiet);
   std::vector<std::string> pngs;
   std::error_code ec;
   const fs::path plots_dir = fs::path(report_dir) / "plots";

@@ -12,6 +12,10 @@ namespace rovo {
 // Empty when not found.
 std::string FindPlotScript(const std::string& name);
 
+// Runs eval/plots/<name> on `folder` (the script's one argument). Prints a warning (unless quiet)
+// and returns false when python3, matplotlib or the script is missing or the script fails.
+bool RunPlotScript(const std::string& name, const std::string& folder, bool quiet);
+
 // Runs plot_report.py on an eval report folder (report.h layout); the script writes
 // <report_dir>/plots/*.png. Returns the PNGs written, sorted. When python3, matplotlib or the
 // script is missing, prints a warning (unless quiet) and returns what exists: the report goes on

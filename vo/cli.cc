@@ -94,10 +94,14 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
       ->check(CLI::IsMember({"multiview", "single-view"}))
       ->capture_default_str();
   cmd->add_option("--online-prior", args->options.online_prior_deg,
-                  "OnlineExt: bound on the starting extrinsics' rotation error in degrees; the start-up "
-                  "calibration at the first frame matches with filters this loose (0: no start-up calibration, "
-                  "BA only: an ablation, which does not correct errors of degrees)")
+                  "OnlineExt: bound on the starting extrinsics' rotation error in degrees, used only when the "
+                  "start-up calibration's prior-free ring stage fails (its loose-filter refinement then starts this "
+                  "loose); 0: no start-up calibration, BA only (an ablation, which does not correct errors of degrees)")
       ->check(CLI::Range(0.0, 45.0))
+      ->capture_default_str();
+  cmd->add_option("--online-startup-shots", args->options.online_startup_shots,
+                  "OnlineExt: synchronous shots (every 10 frames from the first) pooled by the start-up calibration")
+      ->check(CLI::Range(1, 100))
       ->capture_default_str();
   cmd->add_option("--tau", args->options.ransac_tau_deg,
                   "RANSAC inlier threshold in degrees: the angle between observed and predicted bearing, the same "

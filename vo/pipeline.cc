@@ -3,6 +3,8 @@
 #include "datasets/dataset.h"
 #include "datasets/io.h"
 #include "datasets/progress.h"
+#include "vo/image_loader.h"
+#include "vo/startup_calibration.h"
 #include "rovo/version.h"
 
 #include <opencv2/imgcodecs.hpp>
@@ -451,117 +453,6 @@ BackendFrameResult VoBackend::ProcessFrame(int frame, const FrontendFrame& front
 
 namespace {
 
-// The images of one frame; a missing or unreadable file becomes a black image (the frame is then
-// reported lost by the back-end) and is named in `problems`.
-// The views are decoded in parallel.
-std::vector<cv::Mat> LoadFrameImages(const std::string& dataset_dir, const Rig& rig, int frame,
-                                     std::string* problems) {
-  const int n = rig.NumCameras();
-  std::vector<cv::Mat> images(n);
-  std::vector<std::string> missing(n), wrong_size(n);
-  tbb::parallel_for(0, n, [&](int j) {
-    const RigCamera& cam = rig.cameras[j];
-    const std::string path = ImagePath(dataset_dir, cam.name, frame);
-    images[j] = cv::imread(path, cv::IMREAD_GRAYSCALE);
-    if (images[j].empty()) {
-      missing[j] = path + ": missing or unreadable";
-      images[j] = cv::Mat::zeros(cam.camera.height, cam.camera.width, CV_8UC1);
-    } else if (images[j].cols != cam.camera.width || images[j].rows != cam.camera.height) {
-      wrong_size[j] = path + ": image is " + std::to_string(images[j].cols) + "x" + std::to_string(images[j].rows) +
-                      " but dataset.json rig.cameras[" + cam.name + "] says " + std::to_string(cam.camera.width) +
-                      "x" + std::to_string(cam.camera.height);
-    }
-  });
-  for (int j = 0; j < n; ++j) {
-    if (!wrong_size[j].empty()) throw std::runtime_error(wrong_size[j]);
-    if (!missing[j].empty()) *problems += (problems->empty() ? "" : "; ") + missing[j];
-  }
-  return images;
-}
-
-struct LoadedFrame {
-  std::vector<cv::Mat> images;
-  std::string problems;
-};
-
-// Reads frame f+1's images on a second thread while frame f is processed (PNG decoding costs about
-// 30 CPU-ms per full-size view; it overlaps the front-end's and the BA's less parallel stretches).
-class ImagePrefetcher {
- public:
-  ImagePrefetcher(const std::string& dataset_dir, const Rig& rig, int begin, int end)
-      : dataset_dir_(dataset_dir), rig_(rig), end_(end) {
-    Start(begin);
-  }
-  ~ImagePrefetcher() {
-    if (next_.valid()) next_.wait();
-  }
-  // The images of `frame` (the frames must be requested in order); starts reading the next one.
-  LoadedFrame Get(int frame) {
-    LoadedFrame loaded = next_.get();  // rethrows a read error
-    Start(frame + 1);
-    return loaded;
-  }
-
- private:
-  void Start(int frame) {
-    if (frame >= end_) return;
-    next_ = std::async(std::launch::async, [this, frame] {
-      LoadedFrame loaded;
-      loaded.images = LoadFrameImages(dataset_dir_, rig_, frame, &loaded.problems);
-      return loaded;
-    });
-  }
-  std::string dataset_dir_;
-  const Rig& rig_;
-  int end_;
-  std::future<LoadedFrame> next_;
-};
-
-// Inter-view filters loosened for an extrinsic rotation uncertainty of `uncertainty_deg`: the
-// epipolar angle grows with it, the rectified y-distance by the warped focal length times its tangent.
-InterviewMatchOptions LoosenedMatching(InterviewMatchOptions matching, double uncertainty_deg, double focal_px) {
-  matching.max_epipolar_angle_deg = std::max(matching.max_epipolar_angle_deg, uncertainty_deg);
-  matching.max_y_distance_px += focal_px * std::tan(uncertainty_deg * M_PI / 180.0);
-  return matching;
-}
-
-// OnlineExt start-up: rounds of (match at the first frame with filters loosened to the current
-// uncertainty -> CalibrateExtrinsicsFromFrame -> rebuild the warps), shrinking the uncertainty.
-std::vector<Rigid3> BootstrapExtrinsics(const VoOptions& options, const Rig& rig, std::vector<Rigid3> cam_from_rig) {
-  std::string problems;
-  const std::vector<cv::Mat> images = LoadFrameImages(options.dataset_dir, rig, options.frame_begin, &problems);
-  if (!problems.empty()) return cam_from_rig;  // the main loop reports the frame
-  const std::vector<double> baselines = RingBaselineLengths(cam_from_rig);
-  double uncertainty_deg = options.online_prior_deg;
-  for (int round = 0; round < options.online_bootstrap_rounds; ++round) {
-    // The full default warp, not VoOptions::warp_below_deg: the start-up calibration needs the
-    // overlaps' matches below the rig plane too (measured on the quick forms: with the warp cut to
-    // 30-35 deg it left cameras 1-3.5 deg off; with 50 deg at most 0.44 deg). Oriented descriptors:
-    // with extrinsics degrees off, neighbouring warped views are rotated against each other.
-    FrontendOptions probe_options;
-    probe_options.upright_descriptors = false;
-    Frontend probe(rig.WithExtrinsics(cam_from_rig), probe_options);
-    probe.SetMatchingOptions(LoosenedMatching(probe.options().matching, uncertainty_deg, probe.projection(0).focal_px()));
-    const FrontendFrame frame = probe.Process(images);
-    ExtrinsicBootstrapOptions bopt;
-    bopt.max_error_deg = uncertainty_deg;
-    const ExtrinsicBootstrapReport report = CalibrateExtrinsicsFromFrame(frame, cam_from_rig, baselines, bopt);
-    if (!options.quiet) {
-      std::fprintf(stderr,
-                   "vo online: start-up calibration round %d: uncertainty %.2f deg, %d shared points (>= %d per "
-                   "overlap), median error %.3f -> %.3f deg, largest change %.3f deg%s\n",
-                   round + 1, uncertainty_deg, report.num_points, report.points_per_pair_min,
-                   report.median_error_deg_before, report.median_error_deg_after, report.max_change_deg,
-                   report.usable ? "" : " (not usable: kept)");
-    }
-    if (!report.usable) break;
-    cam_from_rig = report.cam_from_rig;
-    uncertainty_deg = std::max(0.5, std::min(0.5 * uncertainty_deg, 3.0 * report.max_change_deg));
-    if (report.max_change_deg < 0.02) break;
-  }
-  return cam_from_rig;
-}
-
 nlohmann::json PoseJson(const Rigid3& x) {
   return {{"translation", {x.translation.x(), x.translation.y(), x.translation.z()}},
           {"rotation_xyzw", {x.rotation.x(), x.rotation.y(), x.rotation.z(), x.rotation.w()}}};
@@ -634,8 +525,16 @@ VoSummary RunVo(const VoOptions& options) {
   // Online: each keyframe BA may move an extrinsic by about this much (random-walk prior, local_ba.h):
   // measured on cloudy_urban quick, it halves the wander of the estimate between windows.
   backend_options.ba.extrinsic_prior_deg = 0.005;
+  StartupCalibrationReport startup;
   if (options.mode == ExtrinsicsMode::kOnline && options.online_prior_deg > 0.0) {
-    cam_from_rig = BootstrapExtrinsics(options, info.rig, cam_from_rig);
+    StartupCalibrationOptions sopt;
+    sopt.shots = options.online_startup_shots;
+    sopt.fallback_prior_deg = options.online_prior_deg;
+    sopt.refine_rounds = options.online_bootstrap_rounds;
+    auto load = [&](int frame) { return LoadFrameImages(options.dataset_dir, info.rig, frame); };
+    startup = CalibrateAtStartup(info.rig, cam_from_rig, load, begin, end, {}, sopt, options.quiet);
+    if (!startup.converged) std::fprintf(stderr, "vo online: WARNING: start-up calibration not converged: %s\n", startup.status.c_str());
+    cam_from_rig = startup.cam_from_rig;
   }
   FrontendOptions frontend_options;
   frontend_options.max_new_features_per_view = options.max_new_features;
@@ -654,9 +553,7 @@ VoSummary RunVo(const VoOptions& options) {
   if (options.preload_images) {
     Progress load_progress("vo: decoding images", end - begin, "frames", options.quiet);
     for (int frame = begin; frame < end; ++frame) {
-      LoadedFrame loaded;
-      loaded.images = LoadFrameImages(options.dataset_dir, info.rig, frame, &loaded.problems);
-      preloaded.push_back(std::move(loaded));
+      preloaded.push_back(LoadFrameImages(options.dataset_dir, info.rig, frame));
       load_progress.Add();
     }
     load_progress.Finish();
@@ -754,6 +651,7 @@ VoSummary RunVo(const VoOptions& options) {
   j["online_prior_deg"] = options.online_prior_deg;
   j["max_new_features"] = options.max_new_features;
   j["warp_below_deg"] = options.warp_below_deg;
+  if (options.mode == ExtrinsicsMode::kOnline && options.online_prior_deg > 0.0) j["startup_calibration"] = startup.ToJson();
   j["backend"] = {{"ransac_tau_deg", backend_options.ransac.tau_rad * 180.0 / M_PI},
                   {"ransac_max_iterations", backend_options.ransac.max_iterations},
                   {"ransac_confidence", backend_options.ransac.confidence},

@@ -56,6 +56,9 @@ struct VoOptions {
   // loosens the inter-view filters for the start-up calibration (extrinsic_bootstrap.h); 0 = none.
   double online_prior_deg = 15.0;
   int online_bootstrap_rounds = 6;
+  // OnlineExt: synchronous shots pooled by the start-up calibration's ring stage (startup_calibration.h),
+  // every StartupCalibrationOptions::shot_spacing frames from the first.
+  int online_startup_shots = 1;
   // RANSAC inlier threshold (MultiViewRansacOptions::tau_rad) in degrees: one angle for every rig,
   // as the paper's cost is angular (max(0, tau - angle)). Until 2026-11-21 it was 2 pixels at the
   // image centre: 0.29 deg on the full-size rovo4 lenses but 0.60 deg on canyon_multifov's, whose

@@ -1,6 +1,7 @@
 // The `rovo` command: parses the command line and hands off to the parts' commands.
 
 #include "datasets/cli_groups.h"
+#include "eval/calibration_study.h"
 #include "rovo/version.h"
 
 #include <CLI/CLI.hpp>
@@ -31,6 +32,7 @@ int main(int argc, char** argv) {
   rovo::AddRenderCommands(groups);
   rovo::AddVoCommands(groups);
   rovo::AddEvalCommands(groups);
+  rovo::AddCalibrationStudyCommand(groups.study);
 
   try {
     app.parse(argc, argv);

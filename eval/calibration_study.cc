@@ -1,0 +1,257 @@
+#include "eval/calibration_study.h"
+
+#include "datasets/cli_groups.h"
+#include "datasets/dataset.h"
+#include "datasets/io.h"
+#include "datasets/progress.h"
+#include "datasets/rig.h"
+#include "datasets/run.h"
+#include "eval/plots.h"
+#include "rovo/version.h"
+#include "vo/image_loader.h"
+#include "vo/pipeline.h"
+#include "vo/startup_calibration.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+namespace rovo {
+namespace fs = std::filesystem;
+namespace {
+
+Rigid3 Rigid3FromRunJson(const nlohmann::json& j) {
+  const auto& q = j.at("rotation_xyzw");
+  const auto& t = j.at("translation");
+  return Rigid3(Eigen::Quaterniond(q[3].get<double>(), q[0].get<double>(), q[1].get<double>(), q[2].get<double>()),
+                Eigen::Vector3d(t[0].get<double>(), t[1].get<double>(), t[2].get<double>()));
+}
+
+std::string RunDir(const CalibrationStudyOptions& o, uint64_t seed) {
+  return (fs::path(o.out_dir) / "runs" / ("draw_" + std::to_string(seed))).string();
+}
+
+// Whether the run folder holds a finished OnlineExt run of this draw with these settings.
+bool RunReusable(const std::string& dir, uint64_t seed, int frame_end, int startup_shots) {
+  std::error_code ec;
+  if (!fs::exists(RunInfoPath(dir), ec) || !fs::exists(RunExtrinsicsPath(dir), ec)) return false;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(ReadFile(RunInfoPath(dir)));
+    return j.value("draw_seed", int64_t{-1}) == static_cast<int64_t>(seed) && j.at("frames")[1] == frame_end &&
+           j.value("online_startup_shots", 1) == startup_shots && j.contains("startup_calibration");
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+// Error at a frame of the run (the last record at or before it); -1 when the run ends before it.
+double ErrorAtFrame(const std::map<int, std::vector<Rigid3>>& by_frame, int frame, const std::vector<Rigid3>& truth) {
+  if (by_frame.empty() || by_frame.rbegin()->first < frame) return -1.0;
+  auto it = by_frame.upper_bound(frame);
+  --it;
+  return ExtrinsicErrorDeg(it->second, truth);
+}
+
+CalibrationDraw RunDraw(const CalibrationStudyOptions& o, const DatasetInfo& info, uint64_t seed) {
+  CalibrationDraw d;
+  d.seed = seed;
+  const std::vector<Rigid3> truth = info.rig.Extrinsics();
+  const std::vector<Rigid3> drawn = PerturbExtrinsics(info.rig, o.sigma_deg, 0.0, seed).cam_from_rig;
+  d.before_deg = ExtrinsicErrorDeg(drawn, truth);
+  if (o.shot_only) {
+    StartupCalibrationOptions sopt;
+    sopt.shots = 1;
+    auto load = [&](int frame) { return LoadFrameImages(o.dataset_dir, info.rig, frame); };
+    const StartupCalibrationReport r = CalibrateAtStartup(info.rig, drawn, load, o.shot, o.shot + 1, {}, sopt, true);
+    d.startup_deg = ExtrinsicErrorDeg(r.cam_from_rig, truth);
+    d.startup_converged = r.converged;
+    d.startup_status = r.status;
+    d.converged = d.startup_deg < o.shot_converged_deg;
+    return d;
+  }
+  const int frame_end = o.frames > 0 ? std::min(o.frames, info.frame_count) : info.frame_count;
+  const std::string dir = RunDir(o, seed);
+  if (!RunReusable(dir, seed, frame_end, o.startup_shots)) {
+    VoOptions v;
+    v.dataset_dir = o.dataset_dir;
+    v.out_dir = dir;
+    v.mode = ExtrinsicsMode::kOnline;
+    v.draw_seed = static_cast<int64_t>(seed);
+    v.draw_sigma_deg = o.sigma_deg;
+    v.frame_end = frame_end;
+    v.threads = o.threads;
+    v.online_startup_shots = o.startup_shots;
+    v.quiet = true;
+    RunVo(v);
+  }
+  const RunData run = ReadRun(dir);
+  const nlohmann::json& startup = run.info.at("startup_calibration");
+  std::vector<Rigid3> after;
+  for (const auto& x : startup.at("cam_from_rig")) after.push_back(Rigid3FromRunJson(x));
+  d.startup_deg = ExtrinsicErrorDeg(after, truth);
+  d.startup_converged = startup.at("converged").get<bool>();
+  d.startup_status = startup.at("status").get<std::string>();
+  std::map<int, std::vector<Rigid3>> by_frame;
+  for (const ExtrinsicsRecord& r : run.extrinsics) {
+    auto& v = by_frame[r.frame];
+    if (static_cast<int>(v.size()) <= r.camera) v.resize(r.camera + 1);
+    v[r.camera] = r.cam_from_rig;
+  }
+  d.at50_deg = ErrorAtFrame(by_frame, 50, truth);
+  d.at100_deg = ErrorAtFrame(by_frame, 100, truth);
+  d.end_deg = ErrorAtFrame(by_frame, by_frame.empty() ? 0 : by_frame.rbegin()->first, truth);
+  d.converged = d.end_deg >= 0.0 && d.end_deg < o.converged_deg;
+  return d;
+}
+
+std::string Deg(double v) {
+  if (v < 0.0) return "-";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3f", v);
+  return buf;
+}
+
+std::string ReproduceCommand(const CalibrationStudyOptions& o) {
+  std::ostringstream s;
+  if (o.shot_only) {
+    s << "rovo study calibration " << o.dataset_dir << " --shot-only --shot " << o.shot << " --draws 1 --seed {seed}";
+  } else {
+    s << "rovo vo " << o.dataset_dir << " --extrinsics online --draw-seed {seed} --draw-sigma " << o.sigma_deg;
+    if (o.frames > 0) s << " --frames 0:" << o.frames;
+    if (o.startup_shots != 1) s << " --online-startup-shots " << o.startup_shots;
+    s << " --out run_{seed}";
+  }
+  return s.str();
+}
+
+void WriteOutputs(const CalibrationStudyOptions& o, const DatasetInfo& info, const CalibrationStudyResult& result) {
+  std::ostringstream csv;
+  csv << "seed,before_deg,startup_deg,at50_deg,at100_deg,end_deg,startup_converged,converged\n";
+  nlohmann::json rows = nlohmann::json::array();
+  std::vector<uint64_t> failures;
+  for (const CalibrationDraw& d : result.draws) {
+    csv << d.seed << ',' << d.before_deg << ',' << d.startup_deg << ',' << d.at50_deg << ',' << d.at100_deg << ','
+        << d.end_deg << ',' << (d.startup_converged ? 1 : 0) << ',' << (d.converged ? 1 : 0) << '\n';
+    rows.push_back({{"seed", d.seed}, {"before_deg", d.before_deg}, {"startup_deg", d.startup_deg},
+                    {"at50_deg", d.at50_deg}, {"at100_deg", d.at100_deg}, {"end_deg", d.end_deg},
+                    {"startup_converged", d.startup_converged}, {"startup_status", d.startup_status},
+                    {"converged", d.converged}});
+    if (!d.converged) failures.push_back(d.seed);
+  }
+  const double bound = o.shot_only ? o.shot_converged_deg : o.converged_deg;
+  const nlohmann::json j = {
+      {"generator", "rovo study calibration"}, {"version", ROVO_VERSION},
+      {"dataset", o.dataset_dir}, {"dataset_seed", info.seed},
+      {"sigma_deg", o.sigma_deg}, {"first_seed", o.first_seed}, {"draws", o.draws},
+      {"frames", o.frames}, {"shot_only", o.shot_only}, {"shot", o.shot}, {"startup_shots", o.startup_shots},
+      {"converged_below_deg", bound}, {"converged", result.converged},
+      {"rate", result.draws.empty() ? 0.0 : static_cast<double>(result.converged) / result.draws.size()},
+      {"failed_seeds", failures}, {"reproduce", result.reproduce}, {"per_draw", rows}};
+  WriteFileAtomic((fs::path(o.out_dir) / "calibration.csv").string(), csv.str());
+  WriteJsonFileAtomic((fs::path(o.out_dir) / "calibration.json").string(), j);
+}
+
+std::string Table(const CalibrationStudyOptions& o, const CalibrationStudyResult& result) {
+  std::ostringstream s;
+  s << "| draw seed | before | after start-up | frame 50 | frame 100 | end | start-up verdict |\n"
+    << "|---|---|---|---|---|---|---|\n";
+  for (const CalibrationDraw& d : result.draws) {
+    s << "| " << d.seed << " | " << Deg(d.before_deg) << " | " << Deg(d.startup_deg) << " | " << Deg(d.at50_deg)
+      << " | " << Deg(d.at100_deg) << " | " << Deg(d.end_deg) << " | " << (d.startup_converged ? "converged" : d.startup_status)
+      << " |\n";
+  }
+  s << "\nExtrinsic error: largest over cameras i >= 1 of the rotation angle of est(cam_i_from_cam0) "
+       "true(cam_i_from_cam0)^-1, degrees.\n";
+  s << "Converged (" << (o.shot_only ? "start-up" : "end of run") << " < "
+    << (o.shot_only ? o.shot_converged_deg : o.converged_deg) << " deg): " << result.converged << " of "
+    << result.draws.size() << ".\n";
+  if (result.converged < static_cast<int>(result.draws.size())) {
+    s << "Reproduce a failure: `" << result.reproduce << "` with {seed} one of:";
+    for (const CalibrationDraw& d : result.draws) {
+      if (!d.converged) s << " " << d.seed;
+    }
+    s << "\n";
+  }
+  return s.str();
+}
+
+}  // namespace
+
+double ExtrinsicErrorDeg(const std::vector<Rigid3>& est, const std::vector<Rigid3>& truth) {
+  if (est.size() != truth.size() || est.empty()) throw std::invalid_argument("ExtrinsicErrorDeg: camera counts differ");
+  double worst = 0.0;
+  for (size_t i = 1; i < est.size(); ++i) {
+    const Eigen::Quaterniond e = est[i].rotation * est[0].rotation.inverse();
+    const Eigen::Quaterniond t = truth[i].rotation * truth[0].rotation.inverse();
+    worst = std::max(worst, RotationDistanceDeg(e, t));
+  }
+  return worst;
+}
+
+CalibrationStudyResult RunCalibrationStudy(const CalibrationStudyOptions& o) {
+  if (o.draws < 1) throw std::invalid_argument("study calibration: --draws must be at least 1");
+  if (!(o.sigma_deg >= 0.0)) throw std::invalid_argument("study calibration: --sigma must be non-negative");
+  const DatasetInfo info = ReadDatasetInfo(o.dataset_dir);
+  if (o.shot < 0 || o.shot >= info.frame_count) {
+    throw std::invalid_argument("study calibration: --shot " + std::to_string(o.shot) + " is not a frame of " +
+                                DatasetJsonPath(o.dataset_dir) + " (frame_count " + std::to_string(info.frame_count) + ")");
+  }
+  if (!o.shot_only && info.frame_count > 0 && !fs::exists(GroundTruthPath(o.dataset_dir))) {
+    // The OnlineExt runs need no ground truth, but say what the numbers are measured against.
+    if (!o.quiet) std::fprintf(stderr, "study calibration: no ground-truth poses; errors are against dataset.json's rig\n");
+  }
+  EnsureWritableDir(o.out_dir);
+  CalibrationStudyResult result;
+  result.reproduce = ReproduceCommand(o);
+  Progress progress("study calibration", o.draws, "draws", o.quiet);
+  for (int k = 0; k < o.draws; ++k) {
+    result.draws.push_back(RunDraw(o, info, o.first_seed + static_cast<uint64_t>(k)));
+    result.converged += result.draws.back().converged ? 1 : 0;
+    progress.Add();
+  }
+  progress.Finish();
+  WriteOutputs(o, info, result);
+  const std::string table = Table(o, result);
+  WriteFileAtomic((fs::path(o.out_dir) / "calibration.md").string(), table);
+  RunPlotScript("plot_calibration.py", o.out_dir, o.quiet);
+  return result;
+}
+
+void AddCalibrationStudyCommand(CLI::App* study) {
+  auto options = std::make_shared<CalibrationStudyOptions>();
+  CLI::App* cmd = study->add_subcommand(
+      "calibration",
+      "Convergence of OnlineExt's extrinsic calibration over fresh seeded perturbation draws: per draw the "
+      "extrinsic error before, after the start-up calibration, at frames 50 and 100 and at the end; the rate; a CDF "
+      "plot; the seeds of failures with the command that reproduces each");
+  cmd->add_option("dataset", options->dataset_dir, "Dataset folder")->required();
+  cmd->add_option("--out", options->out_dir, "Output folder (calibration.md/.csv/.json, cdf.png, runs/)")->required();
+  cmd->add_option("--draws", options->draws, "Perturbation draws")->check(CLI::Range(1, 100000))->capture_default_str();
+  cmd->add_option("--sigma", options->sigma_deg, "Sigma of roll, pitch and yaw per camera (degrees)")
+      ->check(CLI::Range(0.0, 45.0))
+      ->capture_default_str();
+  cmd->add_option("--seed", options->first_seed, "Seed of the first draw; draw k has seed + k")->capture_default_str();
+  cmd->add_option("--frames", options->frames, "OnlineExt runs over the first N frames (0: all)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_flag("--shot-only", options->shot_only,
+                "Start-up calibration only, on one synchronous shot (no VO; no ground-truth poses needed)");
+  cmd->add_option("--shot", options->shot, "The frame of --shot-only")->check(CLI::NonNegativeNumber)->capture_default_str();
+  cmd->add_option("--startup-shots", options->startup_shots, "rovo vo --online-startup-shots of the runs")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  cmd->add_option("--threads", options->threads, "Threads of each run (0: all cores)")->capture_default_str();
+  cmd->add_flag("--quiet", options->quiet, "No progress output");
+  cmd->callback([options] {
+    const CalibrationStudyResult result = RunCalibrationStudy(*options);
+    std::printf("%s", Table(*options, result).c_str());
+  });
+}
+
+}  // namespace rovo

@@ -1,0 +1,65 @@
+#pragma once
+// `rovo study calibration`: how often OnlineExt's extrinsic calibration converges, over fresh seeded
+// perturbation draws (the paper's protocol, datasets/rig.h PerturbExtrinsics), not the dataset's
+// stored noise sets.
+//
+// Per draw (seed = first_seed + index): the extrinsic error (../shared/DESIGN.md: the largest over
+// cameras i >= 1 of the angle of est(cam_i_from_cam0) true(cam_i_from_cam0)^-1, against the
+// dataset's rig) of the draw itself, after the start-up calibration, at frames 50 and 100 of the
+// OnlineExt run and at its end. `shot_only` runs the start-up calibration alone on one synchronous
+// shot (no VO: also for datasets without ground-truth poses, such as real captures, where the
+// reference is the dataset's own calibration).
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "datasets/rigid3.h"
+
+namespace CLI {
+class App;
+}
+
+namespace rovo {
+
+struct CalibrationStudyOptions {
+  std::string dataset_dir;
+  std::string out_dir;
+  int draws = 20;
+  double sigma_deg = 5.0;
+  uint64_t first_seed = 1000;    // draw k has seed first_seed + k (rovo vo --draw-seed)
+  int frames = 0;                // > 0: the OnlineExt runs cover the first N frames; 0: all
+  bool shot_only = false;        // start-up calibration on one shot, no VO
+  int shot = 0;                  // the shot (first frame)
+  int startup_shots = 1;         // VoOptions::online_startup_shots
+  int threads = 0;
+  double converged_deg = 0.1;    // the run's final error below: converged
+  double shot_converged_deg = 0.5;  // shot_only: the start-up error below: converged
+  bool quiet = false;
+};
+
+struct CalibrationDraw {
+  uint64_t seed = 0;
+  double before_deg = 0.0;
+  double startup_deg = 0.0;
+  double at50_deg = -1.0, at100_deg = -1.0, end_deg = -1.0;  // < 0: the run is shorter / shot only
+  bool startup_converged = false;   // the start-up calibration's own verdict
+  std::string startup_status;
+  bool converged = false;           // the study's verdict (error below the bound)
+};
+
+struct CalibrationStudyResult {
+  std::vector<CalibrationDraw> draws;
+  int converged = 0;
+  std::string reproduce;            // command template for one draw ("{seed}" replaced)
+};
+
+// The extrinsic error in degrees (above) of `est` against `truth` (cam_from_rig per camera).
+double ExtrinsicErrorDeg(const std::vector<Rigid3>& est, const std::vector<Rigid3>& truth);
+
+CalibrationStudyResult RunCalibrationStudy(const CalibrationStudyOptions& options);
+
+// Adds `rovo study calibration` under `study`.
+void AddCalibrationStudyCommand(CLI::App* study);
+
+}  // namespace rovo

@@ -1,0 +1,47 @@
+#pragma once
+// Reading a dataset frame's images for the VO: one decoder call per view, in parallel, and a
+// prefetcher that decodes frame f + 1 on a second thread while frame f is processed.
+
+#include "datasets/rig.h"
+
+#include <opencv2/core.hpp>
+
+#include <future>
+#include <string>
+#include <vector>
+
+namespace rovo {
+
+struct LoadedFrame {
+  std::vector<cv::Mat> images;  // 8-bit gray, one per camera
+  // Cameras whose image is missing or unreadable (their image is black: the back-end then loses the
+  // frame or sees the other views only) and the message naming the file of each.
+  std::vector<int> missing_cameras;
+  std::string problems;
+};
+
+// The images of one frame. A missing or unreadable file becomes a black image and is named in
+// `problems`; an image of the wrong size throws, naming the file and dataset.json's field.
+LoadedFrame LoadFrameImages(const std::string& dataset_dir, const Rig& rig, int frame);
+
+// Reads frame f+1's images on a second thread while frame f is processed (PNG decoding costs about
+// 30 CPU-ms per full-size view; it overlaps the front-end's and the BA's less parallel stretches).
+class ImagePrefetcher {
+ public:
+  // Frames [begin, end) are requested in order; end <= begin reads nothing.
+  ImagePrefetcher(const std::string& dataset_dir, const Rig& rig, int begin, int end);
+  ~ImagePrefetcher();
+  ImagePrefetcher(const ImagePrefetcher&) = delete;
+  ImagePrefetcher& operator=(const ImagePrefetcher&) = delete;
+  // The images of `frame`; starts reading the next one. Rethrows a read error.
+  LoadedFrame Get(int frame);
+
+ private:
+  void Start(int frame);
+  std::string dataset_dir_;
+  const Rig& rig_;
+  int end_;
+  std::future<LoadedFrame> next_;
+};
+
+}  // namespace rovo

@@ -1,0 +1,102 @@
+#pragma once
+// Extrinsic calibration of a ring of wide-FOV cameras without an extrinsic prior (the first stage of
+// OnlineExt's start-up calibration, startup_calibration.h).
+//
+// The start-up calibration must work from any sigma = 5 deg perturbation draw, where neighbouring
+// cameras are off by up to 25-30 deg relative to each other, so the given (nominal) extrinsics may
+// only choose where to look, never which match to keep. Per ring pair (a, b) of neighbouring cameras:
+//   1. Overlap views. Each camera's image is resampled onto one longitude/latitude grid around the
+//      pair's overlap direction m (the horizontal bisector of the two nominal optical axes; latitude
+//      about the rig's up axis), through that camera's nominal rotation. Both views then show the
+//      overlap with the same mapping, rotated against each other only by the extrinsic error, and the
+//      bearing of a view pixel in its camera is exact whatever that error is.
+//   2. Oriented ORB in both views (inside the lens and the optional static mask), brute-force Hamming
+//      matching with the ratio test and a mutual check. A match whose two nominal rig-frame bearings
+//      differ by more than max_prior_angle_deg is dropped: a gross-outlier bound, above any error of
+//      a sigma = 5 deg draw.
+//   3. The matches of every frame given (AddFrame) are pooled: the cameras' relative pose is the
+//      same in every synchronous shot. A 5-point relative-pose RANSAC on the bearings (OpenGV,
+//      Stewenius) and a non-linear refinement on its inliers give
+//          R_ba = rotation of cam_b_from_cam_a   (x_in_b = R_ba x_in_a + t_ba).
+// Ring: with R_j = rotation of cam_j_from_cam0 (camera 0 is the gauge, R_0 = I), the pair rotations
+// are averaged by
+//     min over R_1..R_{N-1} of  sum_(a,b) w_ab |Log(R_b R_a^T R_ba^T)|^2,   w_ab = inliers of (a, b)
+// (Ceres), started by chaining the pairs from camera 0. Loop closure, |Log(prod of R_ba around the
+// ring)|, checks the pairs' consistency. The result keeps every camera's centre in the rig frame
+// (the perturbation protocol turns cameras about their centres).
+
+#include "datasets/rig.h"
+#include "datasets/rigid3.h"
+
+#include <opencv2/core.hpp>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace rovo {
+
+struct RingCalibrationOptions {
+  double view_half_width_deg = 65.0;   // longitude extent of an overlap view (each side of m)
+  double view_half_height_deg = 60.0;  // latitude extent (each side of the horizon)
+  int orb_features = 3000;             // per overlap view
+  int orb_fast_threshold = 10;
+  double max_ratio = 0.8;              // best / second-best Hamming distance
+  int max_descriptor_distance = 80;
+  double max_prior_angle_deg = 40.0;   // gross-outlier bound on the nominal rig-frame bearings
+  double max_parallax_deg = 5.0;       // rotation-only RANSAC threshold (parallax of near points)
+  double ransac_threshold_px = 1.0;    // epipolar threshold, in overlap-view pixels
+  int ransac_iterations = 2000;
+  int min_inliers = 25;                // fewer: the pair is not estimated
+  double max_loop_error_deg = 5.0;     // larger loop-closure error of the pairs: not converged
+  double max_pair_disagreement_deg = 3.0;  // a pair further from the joint ring solution: not converged
+  double prior_sigma_deg = 5.0;        // joint refinement: camera 0's prior (the common rotation)
+  void Check() const;
+};
+
+struct RingPairEstimate {
+  int camera_a = 0, camera_b = 0;
+  int matches = 0;                     // pooled over frames, after the ratio, mutual and prior checks
+  int inliers = 0;
+  bool usable = false;
+  Eigen::Quaterniond camb_from_cama = Eigen::Quaterniond::Identity();  // R_ba
+  double change_deg = 0.0;             // angle between R_ba and the nominal one
+};
+
+struct RingCalibrationReport {
+  bool converged = false;
+  std::string reason;                  // why not, when not converged
+  int frames = 0;
+  std::vector<RingPairEstimate> pairs;
+  double loop_error_deg = -1.0;        // < 0: the ring is not closed (a pair missing, or N < 3)
+  double max_pair_disagreement_deg = 0.0;  // largest angle between a pair's own and the joint rotation
+  std::vector<Rigid3> cam_from_rig;    // calibrated (camera 0 and every centre unchanged)
+};
+
+// Ring neighbours: the cameras sorted by the yaw of their nominal optical axis, each paired with the
+// next (and the last with the first when N >= 3). Pairs whose axes are further apart than the
+// lenses' field of view allows an overlap are left out.
+std::vector<std::pair<int, int>> RingPairs(const Rig& rig);
+
+class RingCalibrator {
+ public:
+  // `rig`: the lenses and the nominal extrinsics (only used to choose the overlap views).
+  // `static_masks`: empty, or one 8-bit mask per camera of its image size (0 = invalid pixel).
+  RingCalibrator(const Rig& rig, const std::vector<cv::Mat>& static_masks = {},
+                 const RingCalibrationOptions& options = {});
+  ~RingCalibrator();
+
+  // One synchronous shot (8-bit gray or BGR, one image per camera): its overlap matches are pooled.
+  void AddFrame(const std::vector<cv::Mat>& images);
+  RingCalibrationReport Solve() const;
+
+  // The overlap view of pair `pair_index` for camera `side` (0 = a, 1 = b) at the last AddFrame, for
+  // drawing and tests.
+  const cv::Mat& overlap_view(int pair_index, int side) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rovo

@@ -1,0 +1,157 @@
+#include "vo/startup_calibration.h"
+
+#include "vo/extrinsic_bootstrap.h"
+#include "vo/frontend.h"
+#include "vo/local_ba.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace rovo {
+namespace {
+
+// Inter-view filters loosened for an extrinsic rotation uncertainty of `uncertainty_deg`: the
+// epipolar angle grows with it, the rectified y-distance by the warped focal length times its tangent.
+InterviewMatchOptions LoosenedMatching(InterviewMatchOptions matching, double uncertainty_deg, double focal_px) {
+  matching.max_epipolar_angle_deg = std::max(matching.max_epipolar_angle_deg, uncertainty_deg);
+  matching.max_y_distance_px += focal_px * std::tan(uncertainty_deg * M_PI / 180.0);
+  return matching;
+}
+
+double LargestChangeDeg(const std::vector<Rigid3>& a, const std::vector<Rigid3>& b) {
+  double worst = 0.0;
+  for (size_t j = 0; j < a.size(); ++j) worst = std::max(worst, RotationDistanceDeg(a[j].rotation, b[j].rotation));
+  return worst;
+}
+
+// Stage 2: rounds of (match at the shot with filters loosened to the current uncertainty ->
+// CalibrateExtrinsicsFromFrame -> rebuild the warps), shrinking the uncertainty.
+std::vector<Rigid3> RefineOnShot(const Rig& rig, std::vector<Rigid3> cam_from_rig, const std::vector<cv::Mat>& images,
+                                 double uncertainty_deg, int max_rounds, bool quiet,
+                                 std::vector<StartupRound>* rounds) {
+  const std::vector<double> baselines = RingBaselineLengths(cam_from_rig);
+  for (int round = 0; round < max_rounds; ++round) {
+    // The full default warp, not VoOptions::warp_below_deg: the calibration needs the overlaps' matches
+    // below the rig plane too. Oriented descriptors: with extrinsics off, neighbouring warped views are
+    // rotated against each other.
+    FrontendOptions probe_options;
+    probe_options.upright_descriptors = false;
+    Frontend probe(rig.WithExtrinsics(cam_from_rig), probe_options);
+    probe.SetMatchingOptions(LoosenedMatching(probe.options().matching, uncertainty_deg, probe.projection(0).focal_px()));
+    const FrontendFrame frame = probe.Process(images);
+    ExtrinsicBootstrapOptions bopt;
+    bopt.max_error_deg = uncertainty_deg;
+    const ExtrinsicBootstrapReport report = CalibrateExtrinsicsFromFrame(frame, cam_from_rig, baselines, bopt);
+    rounds->push_back({uncertainty_deg, report.num_points, report.points_per_pair_min, report.median_error_deg_before,
+                       report.median_error_deg_after, report.max_change_deg, report.usable});
+    if (!quiet) {
+      std::fprintf(stderr,
+                   "vo online: start-up refinement round %d: uncertainty %.2f deg, %d shared points (>= %d per "
+                   "overlap), median error %.3f -> %.3f deg, largest change %.3f deg%s\n",
+                   round + 1, uncertainty_deg, report.num_points, report.points_per_pair_min,
+                   report.median_error_deg_before, report.median_error_deg_after, report.max_change_deg,
+                   report.usable ? "" : " (not usable: kept)");
+    }
+    if (!report.usable) break;
+    cam_from_rig = report.cam_from_rig;
+    uncertainty_deg = std::max(0.5, std::min(0.5 * uncertainty_deg, 3.0 * report.max_change_deg));
+    if (report.max_change_deg < 0.02) break;
+  }
+  return cam_from_rig;
+}
+
+void PrintRing(const RingCalibrationReport& ring) {
+  std::fprintf(stderr, "vo online: start-up ring calibration over %d shot(s):", ring.frames);
+  for (const RingPairEstimate& p : ring.pairs) {
+    std::fprintf(stderr, " %d-%d %d/%d inliers, moved %.2f deg;", p.camera_a, p.camera_b, p.inliers, p.matches,
+                 p.change_deg);
+  }
+  std::fprintf(stderr, " loop error %.3f deg%s%s\n", ring.loop_error_deg, ring.converged ? "" : ": FAILED, ",
+               ring.reason.c_str());
+}
+
+}  // namespace
+
+nlohmann::json StartupCalibrationReport::ToJson() const {
+  nlohmann::json pairs = nlohmann::json::array();
+  for (const RingPairEstimate& p : ring.pairs) {
+    pairs.push_back({{"cameras", {p.camera_a, p.camera_b}},
+                     {"matches", p.matches},
+                     {"inliers", p.inliers},
+                     {"usable", p.usable},
+                     {"change_deg", p.change_deg}});
+  }
+  nlohmann::json round_list = nlohmann::json::array();
+  for (const StartupRound& r : rounds) {
+    round_list.push_back({{"uncertainty_deg", r.uncertainty_deg},
+                          {"points", r.points},
+                          {"points_per_pair_min", r.points_per_pair_min},
+                          {"median_error_deg_before", r.median_error_deg_before},
+                          {"median_error_deg_after", r.median_error_deg_after},
+                          {"max_change_deg", r.max_change_deg},
+                          {"usable", r.usable}});
+  }
+  nlohmann::json extrinsics = nlohmann::json::array();
+  for (const Rigid3& x : cam_from_rig) extrinsics.push_back(Rigid3ToJson(x));
+  return {{"converged", converged},
+          {"status", status},
+          {"shots", shots},
+          {"ring", {{"converged", ring.converged},
+                    {"reason", ring.reason},
+                    {"loop_error_deg", ring.loop_error_deg},
+                    {"pairs", pairs}}},
+          {"refinement_rounds", round_list},
+          {"cam_from_rig", extrinsics}};
+}
+
+StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Rigid3>& cam_from_rig,
+                                            const std::function<LoadedFrame(int)>& load, int first_frame,
+                                            int end_frame, const std::vector<cv::Mat>& static_masks,
+                                            const StartupCalibrationOptions& options, bool quiet) {
+  StartupCalibrationReport report;
+  report.cam_from_rig = cam_from_rig;
+  RingCalibrator ring(rig.WithExtrinsics(cam_from_rig), static_masks, options.ring);
+  std::vector<cv::Mat> first_images;
+  for (int k = 0; k < std::max(1, options.shots); ++k) {
+    const int frame = first_frame + k * std::max(1, options.shot_spacing);
+    if (frame >= end_frame) break;
+    LoadedFrame loaded = load(frame);
+    if (!loaded.missing_cameras.empty()) {
+      if (!quiet) std::fprintf(stderr, "vo online: start-up calibration skips frame %d: %s\n", frame, loaded.problems.c_str());
+      continue;
+    }
+    ring.AddFrame(loaded.images);
+    report.shots.push_back(frame);
+    if (first_images.empty()) first_images = std::move(loaded.images);
+  }
+  if (report.shots.empty()) {
+    report.status = "no shot with every camera's image";
+    return report;
+  }
+  report.ring = ring.Solve();
+  if (!quiet) PrintRing(report.ring);
+  const std::vector<Rigid3> start = report.ring.converged ? report.ring.cam_from_rig : cam_from_rig;
+  const double uncertainty = report.ring.converged ? options.refine_start_deg : options.fallback_prior_deg;
+  std::vector<Rigid3> refined = start;
+  if (options.refine) {
+    refined = RefineOnShot(rig, start, first_images, uncertainty, options.refine_rounds, quiet, &report.rounds);
+  }
+  if (!report.ring.converged) {
+    report.cam_from_rig = refined;
+    report.status = "ring stage failed (" + report.ring.reason + "); the loose-filter refinement alone may be wrong";
+    return report;
+  }
+  const double moved = LargestChangeDeg(refined, start);
+  if (moved > options.max_refine_change_deg) {
+    report.cam_from_rig = start;
+    report.status = "refinement moved a camera " + std::to_string(moved) + " deg from the ring result; ring result kept";
+    return report;
+  }
+  report.cam_from_rig = refined;
+  report.converged = true;
+  report.status = "converged";
+  return report;
+}
+
+}  // namespace rovo

@@ -1,0 +1,68 @@
+#pragma once
+// OnlineExt's start-up calibration: from extrinsics that may be off by any sigma = 5 deg draw to
+// within a fraction of a degree, before the local BA takes over (local_ba.h).
+//
+//   1. Ring stage (ring_calibration.h), no extrinsic prior: the rotation of each ring pair from
+//      descriptor matches over its whole overlap (5-point RANSAC on bearings), pooled over `shots`
+//      synchronous shots, averaged around the ring into cam_j_from_cam0.
+//   2. Refinement (extrinsic_bootstrap.h): rounds of the front-end's inter-view matching at the first
+//      shot with filters loosened to the current uncertainty and a one-pose BA with the rig's
+//      baseline lengths, the uncertainty shrinking with the change of each round.
+// When the ring stage cannot calibrate (too few matches, an open or inconsistent ring) the
+// refinement runs alone from `fallback_prior_deg`, and the report says "not converged" with the
+// reason: the caller writes it to run.json and stderr.
+
+#include "datasets/rig.h"
+#include "datasets/rigid3.h"
+#include "vo/image_loader.h"
+#include "vo/ring_calibration.h"
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace rovo {
+
+struct StartupCalibrationOptions {
+  int shots = 1;                      // synchronous shots pooled by the ring stage
+  int shot_spacing = 10;              // frames between two shots
+  RingCalibrationOptions ring;
+  bool refine = false;                // stage 2 (off: measured worse than the ring stage alone)
+  double refine_start_deg = 2.0;      // stage 2's first uncertainty after a converged ring stage
+  double fallback_prior_deg = 15.0;   // stage 2's first uncertainty when the ring stage fails
+  int refine_rounds = 6;
+  // A refinement that moves a camera further than this from the ring stage's result is not trusted
+  // (the ring result is kept and the report says so).
+  double max_refine_change_deg = 3.0;
+};
+
+struct StartupRound {
+  double uncertainty_deg = 0.0;
+  int points = 0;
+  int points_per_pair_min = 0;
+  double median_error_deg_before = 0.0, median_error_deg_after = 0.0;
+  double max_change_deg = 0.0;
+  bool usable = false;
+};
+
+struct StartupCalibrationReport {
+  bool converged = false;
+  std::string status;                 // "converged", or why not
+  std::vector<int> shots;             // frames used by the ring stage
+  RingCalibrationReport ring;
+  std::vector<StartupRound> rounds;   // stage 2
+  std::vector<Rigid3> cam_from_rig;   // the result (the start when nothing could be done)
+  nlohmann::json ToJson() const;
+};
+
+// `rig`: lenses and names; `cam_from_rig`: the starting extrinsics. `load(frame)` returns a frame's
+// images; the shots are first_frame, first_frame + shot_spacing, ... below end_frame.
+StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Rigid3>& cam_from_rig,
+                                            const std::function<LoadedFrame(int)>& load, int first_frame,
+                                            int end_frame, const std::vector<cv::Mat>& static_masks,
+                                            const StartupCalibrationOptions& options, bool quiet);
+
+}  // namespace rovo
