@@ -123,7 +123,7 @@ void AddDatasetCommands(CliGroups& groups) {
   });
 
   struct ImportOptions {
-    std::string yaml, out;
+    std::string yaml, out, images, masks;
   };
   auto import_options = std::make_shared<ImportOptions>();
   CLI::App* import = dataset->add_subcommand(
@@ -131,8 +131,20 @@ void AddDatasetCommands(CliGroups& groups) {
       "Convert an OmniMVS config.yaml rig calibration to rig.json (frame change to REP-103, inverse polynomials "
       "refitted; prints how far the file's own inverse polynomials were off)");
   import->add_option("yaml", import_options->yaml, "OmniMVS config.yaml")->required()->check(CLI::ExistingFile);
-  import->add_option("--out,-o", import_options->out, "Output rig.json")->required();
+  import->add_option("--out,-o", import_options->out,
+                     "Output rig.json, or with --images the dataset folder")->required();
+  import->add_option("--images", import_options->images,
+                     "Import the whole capture: the folder the config's dataset.img_fmt is relative to (a dataset "
+                     "without ground-truth poses)")->check(CLI::ExistingDirectory);
+  import->add_option("--masks", import_options->masks,
+                     "With --images: a folder of static masks cam<i>.png (0 = invalid: rig body, operator)")
+      ->check(CLI::ExistingDirectory);
   import->callback([import_options] {
+    if (!import_options->images.empty()) {
+      std::printf("%s", ImportOmniMvsCapture(import_options->yaml, import_options->images, import_options->masks,
+                                             import_options->out).c_str());
+      return;
+    }
     std::string report;
     const Rig imported = ReadOmniMvsConfig(import_options->yaml, &report);
     std::printf("%s", report.c_str());

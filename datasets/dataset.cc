@@ -374,6 +374,8 @@ DatasetInfo ParseDatasetJson(JsonChecker& check, const json& root) {
   info.frame_count = static_cast<int>(check.Integer(root, "", "frame_count", 0, 1, 100000000));
   info.has_depth = check.Bool(root, "", "has_depth");
   info.has_masks = check.Bool(root, "", "has_masks");
+  if (root.is_object() && root.contains("has_ground_truth")) info.has_ground_truth = check.Bool(root, "", "has_ground_truth");
+  if (root.is_object() && root.contains("has_static_masks")) info.has_static_masks = check.Bool(root, "", "has_static_masks");
   if (const json* rig = check.Member(root, "", "rig")) info.rig = ParseRig(check, *rig, "/rig");
   if (const json* perturbed = check.Member(root, "", "perturbed")) {
     if (!perturbed->is_array()) {
@@ -456,6 +458,9 @@ std::set<int> FrameFilesIn(const std::string& folder, const std::string& extensi
 
 std::string DatasetJsonPath(const std::string& dir) { return JoinPath(dir, "dataset.json"); }
 std::string GroundTruthPath(const std::string& dir) { return JoinPath(dir, "groundtruth.tum"); }
+std::string StaticMaskPath(const std::string& dir, const std::string& camera_name) {
+  return JoinPath(JoinPath(dir, "static_masks"), camera_name + ".png");
+}
 std::string ImagePath(const std::string& dir, const std::string& camera_name, int frame) {
   return (fs::path(dir) / camera_name / FrameFileName(frame, "png")).string();
 }
@@ -529,6 +534,8 @@ void WriteDatasetInfo(const std::string& dir, const DatasetInfo& info) {
   root["frame_count"] = info.frame_count;
   root["has_depth"] = info.has_depth;
   root["has_masks"] = info.has_masks;
+  root["has_ground_truth"] = info.has_ground_truth;
+  root["has_static_masks"] = info.has_static_masks;
   root["rig"] = RigToJson(info.rig);
   json perturbed = json::array();
   for (const PerturbedExtrinsics& set : info.perturbed) {
@@ -573,7 +580,9 @@ std::vector<ValidationIssue> ValidateDataset(const std::string& dir) {
   // groundtruth.tum: every line parses, unit quaternions, increasing timestamps, one per frame.
   const std::string gt_path = GroundTruthPath(dir);
   int gt_lines = -1;
-  if (!fs::exists(gt_path)) {
+  if (json_ok && !info.has_ground_truth) {
+    // A capture without ground truth: nothing to check (a file present is ignored).
+  } else if (!fs::exists(gt_path)) {
     issues.push_back({gt_path, "file", "missing ground truth (world_from_rig per frame, TUM format)"});
   } else {
     try {
@@ -613,6 +622,17 @@ std::vector<ValidationIssue> ValidateDataset(const std::string& dir) {
   if (gt_lines >= 0 && info.frame_count > 0 && gt_lines != info.frame_count) {
     issues.push_back({gt_path, "lines", std::to_string(gt_lines) + " poses but dataset.json /frame_count is " +
                                             std::to_string(info.frame_count)});
+  }
+
+  if (json_ok && info.has_static_masks) {
+    for (const RigCamera& rc : info.rig.cameras) {
+      const std::string path = StaticMaskPath(dir, rc.name);
+      if (!fs::exists(path)) {
+        issues.push_back({path, "file", "missing static mask of camera " + rc.name + " (dataset.json has_static_masks)"});
+      } else {
+        CheckImage(path, "header", rc.camera.width, rc.camera.height, 1, &issues);
+      }
+    }
   }
 
   // Images (and depth/masks when declared): present, readable, the rig camera's size; no extras.

@@ -26,6 +26,11 @@ struct DatasetInfo {
   std::vector<PerturbedExtrinsics> perturbed;  // NoisyExt starting points
   bool has_depth = false;
   bool has_masks = false;
+  // Real captures: no ground-truth poses (groundtruth.tum absent; the rig is the capture's own
+  // calibration), and optional static masks (static_masks/<camera>.png, 0 = invalid: rig body,
+  // vehicle, operator), honoured by the start-up calibration's detector.
+  bool has_ground_truth = true;
+  bool has_static_masks = false;
 };
 
 // Paths inside a dataset folder.
@@ -34,6 +39,7 @@ std::string GroundTruthPath(const std::string& dir);
 std::string ImagePath(const std::string& dir, const std::string& camera_name, int frame);  // camN/NNNNNN.png
 std::string DepthPath(const std::string& dir, const std::string& camera_name, int frame);  // depth/camN/NNNNNN.exr
 std::string MaskPath(const std::string& dir, const std::string& camera_name, int frame);   // masks/camN/NNNNNN.png
+std::string StaticMaskPath(const std::string& dir, const std::string& camera_name);      // static_masks/camN.png
 
 // Reads and checks dataset.json (throws std::runtime_error naming file and field).
 DatasetInfo ReadDatasetInfo(const std::string& dir);

@@ -1,11 +1,15 @@
 #include "datasets/omnimvs.h"
 
 #include "datasets/ocam.h"
+#include "datasets/dataset.h"
+#include "datasets/io.h"
+#include "rovo/version.h"
 
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <stdexcept>
 
 namespace rovo {
@@ -256,6 +260,101 @@ Rig MakeRovo4RealRig() {
         ConvertCamera(kItbtCameras[i], i, "rovo4_real cameras[" + std::to_string(i) + "]", nullptr));
   }
   return rig;
+}
+
+}  // namespace rovo
+
+namespace rovo {
+
+OmniMvsCapture ReadOmniMvsCapture(const std::string& yaml_path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(yaml_path);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(yaml_path + ": cannot parse YAML: " + e.what());
+  }
+  OmniMvsCapture capture;
+  const YAML::Node dataset = root["dataset"];
+  std::string field = "dataset";
+  try {
+    if (dataset) {
+      field = "dataset.img_fmt";
+      if (dataset["img_fmt"]) capture.img_fmt = dataset["img_fmt"].as<std::string>();
+      field = "dataset.start";
+      if (dataset["start"]) capture.start = dataset["start"].as<int>();
+      field = "dataset.end";
+      capture.end = dataset["end"] ? dataset["end"].as<int>() : capture.start;
+      field = "dataset.step";
+      if (dataset["step"]) capture.step = dataset["step"].as<int>();
+    }
+    const YAML::Node cameras = root["cameras"];
+    for (size_t i = 0; cameras && i < cameras.size(); ++i) {
+      field = "cameras[" + std::to_string(i) + "].cam_id";
+      capture.cam_ids.push_back(cameras[i]["cam_id"] ? cameras[i]["cam_id"].as<int>() : static_cast<int>(i) + 1);
+    }
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(yaml_path + ": " + field + ": " + e.what());
+  }
+  if (capture.step < 1 || capture.end < capture.start) {
+    throw std::runtime_error(yaml_path + ": dataset: start " + std::to_string(capture.start) + ", end " +
+                             std::to_string(capture.end) + ", step " + std::to_string(capture.step) +
+                             " is not a non-empty range");
+  }
+  if (capture.img_fmt.find("%") == std::string::npos) {
+    throw std::runtime_error(yaml_path + ": dataset.img_fmt: `" + capture.img_fmt + "` has no printf fields");
+  }
+  return capture;
+}
+
+std::string ImportOmniMvsCapture(const std::string& yaml_path, const std::string& images_dir,
+                                 const std::string& masks_dir, const std::string& out_dir) {
+  namespace fs = std::filesystem;
+  std::string report;
+  DatasetInfo info;
+  info.rig = ReadOmniMvsConfig(yaml_path, &report);
+  const OmniMvsCapture capture = ReadOmniMvsCapture(yaml_path);
+  if (capture.cam_ids.size() != info.rig.cameras.size()) {
+    throw std::runtime_error(yaml_path + ": cameras: cam_id count differs from the camera count");
+  }
+  info.generator = "rovo dataset import-omnimvs";
+  info.generator_version = ROVO_VERSION;
+  info.preset = "";
+  info.scene_hash = "";
+  info.frame_rate = 1.0;
+  info.has_ground_truth = false;
+  info.has_static_masks = !masks_dir.empty();
+  std::vector<int> indices;
+  for (int k = capture.start; k <= capture.end; k += capture.step) indices.push_back(k);
+  info.frame_count = static_cast<int>(indices.size());
+  fs::create_directories(out_dir);
+  for (size_t c = 0; c < info.rig.cameras.size(); ++c) {
+    const std::string& name = info.rig.cameras[c].name;
+    fs::create_directories(fs::path(out_dir) / name);
+    for (size_t f = 0; f < indices.size(); ++f) {
+      char relative[512];
+      std::snprintf(relative, sizeof relative, capture.img_fmt.c_str(), capture.cam_ids[c], indices[f]);
+      const fs::path source = fs::path(images_dir) / relative;
+      if (!fs::is_regular_file(source)) {
+        throw std::runtime_error(source.string() + ": missing (camera " + std::to_string(capture.cam_ids[c]) +
+                                 ", frame index " + std::to_string(indices[f]) + ", from " + yaml_path +
+                                 ": dataset.img_fmt)");
+      }
+      if (source.extension() != ".png") throw std::runtime_error(source.string() + ": only PNG images are imported");
+      const std::string target = ImagePath(out_dir, name, static_cast<int>(f));
+      WriteFileAtomic(target, ReadFile(source.string()));
+    }
+    if (info.has_static_masks) {
+      const fs::path mask = fs::path(masks_dir) / (name + ".png");
+      if (!fs::is_regular_file(mask)) throw std::runtime_error(mask.string() + ": missing static mask of camera " + name);
+      fs::create_directories(fs::path(out_dir) / "static_masks");
+      WriteFileAtomic(StaticMaskPath(out_dir, name), ReadFile(mask.string()));
+    }
+  }
+  for (int k = 0; k < 3; ++k) info.perturbed.push_back(PerturbExtrinsics(info.rig, 5.0, 0.0, 1000003ull + k));
+  WriteDatasetInfo(out_dir, info);
+  report += "imported " + std::to_string(info.frame_count) + " frames x " + std::to_string(info.rig.NumCameras()) +
+            " cameras into " + out_dir + " (no ground-truth poses" + (info.has_static_masks ? ", static masks" : "") + ")\n";
+  return report;
 }
 
 }  // namespace rovo

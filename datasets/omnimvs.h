@@ -49,3 +49,25 @@ Rig ReadOmniMvsConfig(const std::string& yaml_path, std::string* report);
 Rig MakeRovo4RealRig();
 
 }  // namespace rovo
+
+namespace rovo {
+
+// A capture in an OmniMVS config's layout: `dataset: {img_fmt, start, end, step}` (img_fmt is a
+// printf pattern of the camera id and the frame index, e.g. "cam%d/%05d.png") and each camera's
+// `cam_id`.
+struct OmniMvsCapture {
+  std::string img_fmt = "cam%d/%05d.png";
+  int start = 1, end = 1, step = 1;  // frame indices start, start + step, ... <= end
+  std::vector<int> cam_ids;          // per camera, in the file's order
+};
+OmniMvsCapture ReadOmniMvsCapture(const std::string& yaml_path);
+
+// Imports a whole capture as a dataset without ground-truth poses (datasets/FORMAT.md): the rig from
+// the config (ReadOmniMvsConfig), images copied from `images_dir` (PNG, gray or RGB), frame k of the
+// dataset = the capture's k-th index; `masks_dir` (optional) holds cam<i>.png per camera (0 = invalid)
+// copied as static masks. Also writes three perturbed sets (sigma 5 deg, seeds recorded). Returns a
+// report of what was imported. Throws naming the file and field on missing or wrong input.
+std::string ImportOmniMvsCapture(const std::string& yaml_path, const std::string& images_dir,
+                                 const std::string& masks_dir, const std::string& out_dir);
+
+}  // namespace rovo

@@ -148,6 +148,11 @@ std::vector<RunEvaluation> EvaluateAndReport(const std::string& dataset_dir, con
                                              const std::string& out_dir, const EvalReportOptions& options) {
   if (run_dirs.empty()) throw std::invalid_argument("rovo eval: no run folders given");
   const DatasetInfo info = ReadDatasetInfo(dataset_dir);
+  if (!info.has_ground_truth) {
+    throw std::runtime_error(DatasetJsonPath(dataset_dir) + ": has_ground_truth is false: rovo eval scores runs "
+                             "against ground-truth poses, which this dataset (a capture) does not have; rovo vo runs "
+                             "on it, and rovo study calibration --shot-only measures against its own calibration");
+  }
   const Trajectory gt = ReadTum(GroundTruthPath(dataset_dir));
   if (gt.empty()) throw std::runtime_error(GroundTruthPath(dataset_dir) + ": no poses");
   const std::vector<Rigid3> gt_cam_from_rig = info.rig.Extrinsics();

@@ -139,7 +139,8 @@ StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Ri
   }
   if (!report.ring.converged) {
     report.cam_from_rig = refined;
-    report.status = "ring stage failed (" + report.ring.reason + "); the loose-filter refinement alone may be wrong";
+    report.status = "ring stage failed (" + report.ring.reason + ")" +
+                    (options.refine ? "; the loose-filter refinement alone may be wrong" : "; starting extrinsics kept");
     return report;
   }
   const double moved = LargestChangeDeg(refined, start);
