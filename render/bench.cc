@@ -171,7 +171,7 @@ void RunRenderBenchmark(const RenderBenchOptions& options) {
   const Scene scene = SceneForOptions(options.scene_dir.empty() ? options.preset : "", false, options.seed,
                                       options.scene_dir);
   const double scene_seconds = Seconds(t_scene);
-  const Rig rig = RigForOptions("", scene, options.scale);
+  const Rig rig = RigForOptions("", scene, options.scale, options.scene_dir);
   const int frames = std::min<int>(options.frames, static_cast<int>(scene.rig_trajectory.size()));
   const int spp_default = options.spp > 0 ? options.spp : kDefaultSpp;
 
