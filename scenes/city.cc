@@ -669,6 +669,296 @@ void AddBuilding(MeshBuilder& b, const BuildingPlan& p, const FacadeLayout& fl, 
   }
 }
 
+// Texture indices of the generated textures (in scene.textures).
+struct CityTextures {
+  int num_facades = 0, num_storefronts = 0, num_awnings = 0;  // facades first, then storefronts
+  int road = 0, intersection = 0, sidewalk = 0, concrete = 0, ground = 0, bark = 0, foliage = 0, sign = 0, awning = 0;
+  CarTextures car;
+};
+
+// Generates every texture in parallel (each from its own seed, so the result does not depend on threads).
+CityTextures GenerateTextures(Scene& scene, const CityStyle& st, uint64_t texture_seed, bool quick) {
+  CityTextures t;
+  t.num_facades = quick ? std::max(4, st.facade_textures / 3) : st.facade_textures;
+  t.num_storefronts = quick ? std::max(3, st.storefront_textures / 2) : st.storefront_textures;
+  t.num_awnings = quick ? 3 : 6;
+  std::vector<std::function<Texture()>> jobs;
+  for (int i = 0; i < t.num_facades; ++i) jobs.push_back([=] { return MakeFacadeTexture(texture_seed, i); });
+  for (int i = 0; i < t.num_storefronts; ++i) jobs.push_back([=] { return MakeStorefrontTexture(texture_seed, i); });
+  const auto next = [&jobs] { return static_cast<int>(jobs.size()); };
+  t.road = next();
+  for (int i = 0; i < 2; ++i) jobs.push_back([=] { return MakeRoadTexture(texture_seed, i, st.road_width_m, st.parking_lane_m); });
+  t.intersection = next();
+  jobs.push_back([=] { return MakeIntersectionTexture(texture_seed, st.road_width_m); });
+  t.sidewalk = next();
+  jobs.push_back([=] { return MakeSidewalkTexture(texture_seed); });
+  t.concrete = next();
+  jobs.push_back([=] { return MakeConcreteTexture(texture_seed); });
+  t.ground = next();
+  jobs.push_back([=] { return MakeGroundTexture(texture_seed); });
+  t.car.side = next();
+  jobs.push_back([=] { return MakeCarSideTexture(texture_seed); });
+  t.car.end = next();
+  jobs.push_back([=] { return MakeCarEndTexture(texture_seed); });
+  t.car.glass = next();
+  jobs.push_back([=] { return MakeCarGlassTexture(texture_seed); });
+  t.bark = next();
+  jobs.push_back([=] { return MakeBarkTexture(texture_seed); });
+  t.foliage = next();
+  jobs.push_back([=] { return MakeFoliageTexture(texture_seed); });
+  t.sign = next();
+  for (int k = 0; k < kSignKinds; ++k) jobs.push_back([=] { return MakeSignTexture(texture_seed, k); });
+  t.awning = next();
+  for (int k = 0; k < t.num_awnings; ++k) jobs.push_back([=] { return MakeAwningTexture(texture_seed, k); });
+  scene.textures.resize(jobs.size());
+  tbb::parallel_for(size_t{0}, jobs.size(), [&](size_t i) { scene.textures[i] = jobs[i](); });
+  return t;
+}
+
+// Materials shared by the whole city (material indices).
+struct CityMaterials {
+  int road[2] = {0, 0};
+  int intersection = 0, sidewalk = 0, curb = 0, roof = 0, ground = 0, metal = 0, lamp = 0, bark = 0, foliage = 0;
+};
+
+CityMaterials AddSharedMaterials(Scene& scene, const CityTextures& t) {
+  CityMaterials m;
+  m.road[0] = AddMaterial(scene, "road_0", {1, 1, 1}, t.road);
+  m.road[1] = AddMaterial(scene, "road_1", {1, 1, 1}, t.road + 1);
+  m.intersection = AddMaterial(scene, "intersection", {1, 1, 1}, t.intersection);
+  m.sidewalk = AddMaterial(scene, "sidewalk", {1, 1, 1}, t.sidewalk);
+  m.curb = AddMaterial(scene, "curb", {0.95f, 0.95f, 0.95f}, t.concrete);
+  m.roof = AddMaterial(scene, "roof", {0.8f, 0.78f, 0.75f}, t.concrete);
+  m.ground = AddMaterial(scene, "ground", {1, 1, 1}, t.ground);
+  m.metal = AddMaterial(scene, "pole_metal", {0.25f, 0.27f, 0.28f}, -1);
+  m.lamp = AddMaterial(scene, "lamp", {0.9f, 0.9f, 0.8f}, -1);
+  m.bark = AddMaterial(scene, "bark", {1, 1, 1}, t.bark);
+  m.foliage = AddMaterial(scene, "foliage", {1, 1, 1}, t.foliage);
+  return m;
+}
+
+// Ground beyond the city.
+void AddGround(Scene& scene, const StreetGrid& g, int m_ground) {
+  MeshBuilder b("ground");
+  const Eigen::Vector2d lo(g.MinX() - 1500, g.MinY() - 1500), hi(g.MaxX() + 1500, g.MaxY() + 1500);
+  b.Floor(lo, hi, -0.02, kGroundTileMetres, m_ground);
+  AddStatic(scene, "ground", AddMesh(scene, b.Finish()), Rigid3::Identity());
+}
+
+// Roads: segments between intersections (u along the street, v across from the left curb) and
+// intersection squares.
+void AddRoads(Scene& scene, const StreetGrid& g, const CityMaterials& m, SceneRng& rng) {
+  const double W = g.road_width_m, hw = 0.5 * W;
+  MeshBuilder b("roads");
+  const int nx = static_cast<int>(g.xs.size()), ny = static_cast<int>(g.ys.size());
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i) {  // along +x at y = ys[j]
+      const double x0 = g.xs[i] + hw, x1 = g.xs[i + 1] - hw, y = g.ys[j];
+      const float u0 = static_cast<float>(rng.Uniform(0, 1)), u1 = u0 + static_cast<float>((x1 - x0) / W);
+      b.Quad(MeshBuilder::P(x0, y - hw, 0), MeshBuilder::P(x1, y - hw, 0), MeshBuilder::P(x1, y + hw, 0),
+             MeshBuilder::P(x0, y + hw, 0), {u0, 1}, {u1, 1}, {u1, 0}, {u0, 0}, m.road[rng.UniformInt(0, 1)]);
+    }
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j + 1 < ny; ++j) {  // along +y at x = xs[i]; left curb is at -x
+      const double y0 = g.ys[j] + hw, y1 = g.ys[j + 1] - hw, x = g.xs[i];
+      const float u0 = static_cast<float>(rng.Uniform(0, 1)), u1 = u0 + static_cast<float>((y1 - y0) / W);
+      b.Quad(MeshBuilder::P(x + hw, y0, 0), MeshBuilder::P(x + hw, y1, 0), MeshBuilder::P(x - hw, y1, 0),
+             MeshBuilder::P(x - hw, y0, 0), {u0, 1}, {u1, 1}, {u1, 0}, {u0, 0}, m.road[rng.UniformInt(0, 1)]);
+    }
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j) {
+      const double x = g.xs[i], y = g.ys[j];
+      b.Quad(MeshBuilder::P(x - hw, y - hw, 0), MeshBuilder::P(x + hw, y - hw, 0), MeshBuilder::P(x + hw, y + hw, 0),
+             MeshBuilder::P(x - hw, y + hw, 0), {0, 1}, {1, 1}, {1, 0}, {0, 0}, m.intersection);
+    }
+  AddStatic(scene, "roads", AddMesh(scene, b.Finish()), Rigid3::Identity());
+}
+
+// Sidewalk slabs with curbs, one per block.
+void AddSidewalks(Scene& scene, const std::vector<Box2>& blocks, const CityMaterials& m) {
+  MeshBuilder b("sidewalks");
+  for (const Box2& blk : blocks) {
+    b.Floor(blk.min, blk.max, kCurbHeight, kSidewalkTileMetres, m.sidewalk);
+    const Eigen::Vector2d c[4] = {blk.min, {blk.max.x(), blk.min.y()}, blk.max, {blk.min.x(), blk.max.y()}};
+    // Corners counter-clockwise seen from above: walking them in order keeps the block on the
+    // left, so each curb face's outward normal is on the right of a->b (as Wall expects).
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector2d a = c[k], bb = c[(k + 1) % 4];
+      b.Wall(a, bb, 0.0, kCurbHeight, 0.0, kRoofTileMetres, 0.0, kRoofTileMetres, m.curb);
+    }
+  }
+  AddStatic(scene, "sidewalks", AddMesh(scene, b.Finish()), Rigid3::Identity());
+}
+
+// Buildings (AddBuilding): storefronts, facades, relief, balconies, awnings, rooflines.
+void AddBuildings(Scene& scene, const CityLayout& L, const CityTextures& t, const CityMaterials& m,
+                  uint64_t layout_seed, uint64_t texture_seed) {
+  ArchitectureMaterials am;
+  am.roof = m.roof;
+  am.metal = AddMaterial(scene, "rooftop_metal", {0.62f, 0.64f, 0.66f}, t.concrete);
+  const Vec3f trims[] = {{0.95f, 0.93f, 0.88f}, {0.7f, 0.7f, 0.72f}, {0.85f, 0.78f, 0.65f}, {0.45f, 0.43f, 0.42f}};
+  for (size_t i = 0; i < 4; ++i)
+    am.trim.push_back(AddMaterial(scene, "trim_" + std::to_string(i), trims[i], t.concrete));
+  am.roof_tiles.push_back(AddMaterial(scene, "roof_tiles_0", {0.62f, 0.3f, 0.2f}, t.concrete));
+  am.roof_tiles.push_back(AddMaterial(scene, "roof_tiles_1", {0.3f, 0.32f, 0.36f}, t.concrete));
+  const Vec3f rails[] = {{0.12f, 0.12f, 0.13f}, {0.85f, 0.85f, 0.83f}, {0.3f, 0.42f, 0.42f}};
+  for (size_t i = 0; i < 3; ++i) am.railing.push_back(AddMaterial(scene, "railing_" + std::to_string(i), rails[i], -1));
+  for (int i = 0; i < t.num_awnings; ++i)
+    am.awning.push_back(AddMaterial(scene, "awning_" + std::to_string(i), {1, 1, 1}, t.awning + i));
+  SceneRng arch(SubSeed(layout_seed, "architecture"));
+  MeshBuilder b("buildings");
+  for (size_t k = 0; k < L.buildings.size(); ++k) {
+    const BuildingPlan& p = L.buildings[k];
+    const std::string name = "building_" + std::to_string(k);
+    const int m_facade = AddMaterial(scene, name + "_facade", p.tint, p.facade);
+    const int m_shop = AddMaterial(scene, name + "_shop", p.tint, t.num_facades + p.storefront);
+    AddBuilding(b, p, GetFacadeLayout(texture_seed, p.facade), m_facade, m_shop, am, L.style, arch);
+  }
+  AddStatic(scene, "buildings", AddMesh(scene, b.Finish()), Rigid3::Identity());
+}
+
+// Street light mesh: arm along +x (towards the road).
+int AddStreetLightMesh(Scene& scene, const CityMaterials& m) {
+  MeshBuilder b("street_light");
+  b.Prism({0, 0, 0}, 0.09f, 0.0f, 6.5f, 8, m.metal, m.metal);
+  const int arm[5] = {m.metal, m.metal, m.metal, m.metal, m.metal};
+  b.Box({0, -0.05f, 6.3f}, {1.6f, 0.05f, 6.42f}, arm);
+  const int lamp[5] = {m.metal, m.metal, m.metal, m.metal, m.metal};
+  b.Box({1.3f, -0.18f, 6.15f}, {1.9f, 0.18f, 6.3f}, lamp);
+  b.Floor({1.35, -0.15}, {1.85, 0.15}, 6.149, 1.0, m.lamp);
+  return AddMesh(scene, b.Finish());
+}
+
+// Tree variant v: a trunk and a crown (octahedron subdivided twice, vertices jittered; spherical UVs).
+int AddTreeMesh(Scene& scene, const CityMaterials& m, uint64_t layout_seed, int v) {
+  MeshBuilder b("tree_" + std::to_string(v));
+  const float crown = 1.7f + 0.4f * v, centre = 4.3f + 0.3f * v;
+  b.Prism({0, 0, 0}, 0.14f + 0.03f * v, 0.0f, centre, 6, m.bark, m.bark);
+  std::vector<Vec3f> tris = {{1, 0, 0},  {0, 1, 0},  {0, 0, 1},  {0, 1, 0},  {-1, 0, 0}, {0, 0, 1},
+                             {-1, 0, 0}, {0, -1, 0}, {0, 0, 1},  {0, -1, 0}, {1, 0, 0},  {0, 0, 1},
+                             {0, 1, 0},  {1, 0, 0},  {0, 0, -1}, {-1, 0, 0}, {0, 1, 0},  {0, 0, -1},
+                             {0, -1, 0}, {-1, 0, 0}, {0, 0, -1}, {1, 0, 0},  {0, -1, 0}, {0, 0, -1}};
+  for (int level = 0; level < 2; ++level) {
+    std::vector<Vec3f> next;
+    for (size_t t = 0; t < tris.size(); t += 3) {
+      const Vec3f a = tris[t], bb = tris[t + 1], c = tris[t + 2];
+      const Vec3f ab = (a + bb).normalized(), bc = (bb + c).normalized(), ca = (c + a).normalized();
+      next.insert(next.end(), {a, ab, ca, ab, bb, bc, ca, bc, c, ab, bc, ca});
+    }
+    tris = next;
+  }
+  auto jitter = [&](const Vec3f& d) {
+    // Deterministic per direction: hash the quantized direction so shared vertices move together.
+    const int64_t key =
+        std::lround(d.x() * 1000) * 1000003 + std::lround(d.y() * 1000) * 1009 + std::lround(d.z() * 1000);
+    SceneRng r(SubSeed(layout_seed ^ static_cast<uint64_t>(key), "crown", static_cast<uint64_t>(v)));
+    const float scale = crown * static_cast<float>(r.Uniform(0.8, 1.15));
+    return Vec3f(d.x() * scale, d.y() * scale, d.z() * scale * 0.85f + centre + 0.6f);
+  };
+  auto uv = [](const Vec3f& d) {
+    return Vec2f(static_cast<float>(2.0 * (std::atan2(d.y(), d.x()) / (2 * M_PI) + 0.5)),
+                 static_cast<float>(2.0 * std::acos(std::clamp(d.z(), -1.0f, 1.0f)) / M_PI));
+  };
+  for (size_t t = 0; t < tris.size(); t += 3) {
+    b.Tri(jitter(tris[t]), jitter(tris[t + 1]), jitter(tris[t + 2]), uv(tris[t]), uv(tris[t + 1]), uv(tris[t + 2]),
+          m.foliage);
+  }
+  return AddMesh(scene, b.Finish());
+}
+
+// Road sign kind k: pole and a 0.6 m plate whose face (sign texture) looks along the mesh's +x.
+int AddSignMesh(Scene& scene, const CityMaterials& m, const CityTextures& t, int k) {
+  MeshBuilder b("sign_" + std::to_string(k));
+  const int m_face = AddMaterial(scene, "sign_" + std::to_string(k), {1, 1, 1}, t.sign + k);
+  b.Prism({-0.05f, 0, 0}, 0.04f, 0.0f, 2.9f, 6, m.metal, m.metal);
+  const int plate[5] = {m.metal, m_face, m.metal, m.metal, m.metal};
+  b.Box({0.0f, -0.3f, 2.3f}, {0.025f, 0.3f, 2.9f}, plate);
+  return AddMesh(scene, b.Finish());
+}
+
+// One sign at about half of the block corners, 0.7 m from both curbs, facing traffic on one of
+// the two streets.
+void PlaceSigns(Scene& scene, const CityLayout& L, const int (&mesh_sign)[kSignKinds], SceneRng& rng) {
+  const StreetGrid& g = L.grid;
+  int signs = 0;
+  for (const Box2& blk : L.blocks) {
+    const bool inner_x = blk.min.x() > g.MinX() && blk.max.x() < g.MaxX();
+    const bool inner_y = blk.min.y() > g.MinY() && blk.max.y() < g.MaxY();
+    if (!inner_x && !inner_y) continue;  // outer corner blocks face no intersection
+    for (int corner = 0; corner < 4; ++corner) {
+      if (!rng.Bernoulli(0.5)) continue;
+      const double sx = corner & 1 ? 1.0 : -1.0, sy = corner & 2 ? 1.0 : -1.0;
+      const double x = (sx > 0 ? blk.max.x() : blk.min.x()) - 0.7 * sx,
+                   y = (sy > 0 ? blk.max.y() : blk.min.y()) - 0.7 * sy;
+      // Face traffic approaching along x (yaw 0 or pi) or along y (yaw +-pi/2) on this corner's side.
+      const double yaw = rng.Bernoulli(0.5) ? (sx > 0 ? 0.0 : M_PI) : (sy > 0 ? M_PI / 2 : -M_PI / 2);
+      AddStatic(scene, "sign_" + std::to_string(signs++), mesh_sign[rng.UniformInt(0, kSignKinds - 1)],
+                PlaceYaw(x, y, yaw, kCurbHeight));
+    }
+  }
+}
+
+// Along every street segment side: lights every ~28 m, trees between them, parked cars in the lane.
+void FurnishStreets(Scene& scene, const CityLayout& L, int mesh_light, const int (&mesh_tree)[3], CarFactory& cars,
+                    SceneRng& rng) {
+  const CityStyle& st = L.style;
+  const StreetGrid& g = L.grid;
+  const double hw = 0.5 * g.road_width_m;
+  int lights = 0, trees = 0;
+  const int nx = static_cast<int>(g.xs.size()), ny = static_cast<int>(g.ys.size());
+  auto furnish = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& dir, double length,
+                     const Eigen::Vector2d& to_road) {
+    // a: start of the curb line; dir: along the street; to_road: unit normal from sidewalk to road.
+    const double yaw_to_road = std::atan2(to_road.y(), to_road.x());
+    for (double s = 6.0; s < length - 6.0; s += 28.0) {
+      const Eigen::Vector2d p = a + s * dir - 0.45 * to_road;
+      AddStatic(scene, "light_" + std::to_string(lights++), mesh_light,
+                PlaceYaw(p.x(), p.y(), yaw_to_road, kCurbHeight));
+      if (st.trees && s + 14.0 < length - 6.0 && rng.Bernoulli(0.8)) {
+        const Eigen::Vector2d q = a + (s + 14.0) * dir - 1.0 * to_road;
+        AddStatic(scene, "tree_" + std::to_string(trees++), mesh_tree[rng.UniformInt(0, 2)],
+                  PlaceYaw(q.x(), q.y(), rng.Uniform(0, 2 * M_PI), kCurbHeight));
+      }
+    }
+    if (st.parked_cars && st.parking_lane_m > 0) {
+      for (double s = 9.0; s < length - 9.0; s += 6.5) {
+        if (!rng.Bernoulli(0.45)) continue;
+        const Eigen::Vector2d p = a + s * dir + (0.5 * st.parking_lane_m + 0.15) * to_road;
+        const int mesh = cars.Get(rng.UniformInt(0, kNumCarShapes - 1), rng.UniformInt(0, kNumCarColors - 1));
+        AddStatic(scene, "parked_car", mesh,
+                  PlaceYaw(p.x(), p.y(), std::atan2(dir.y(), dir.x()) + rng.Normal(0, 0.02)));
+      }
+    }
+  };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i) {
+      const double x0 = g.xs[i] + hw, len = g.xs[i + 1] - hw - x0;
+      furnish({x0, g.ys[j] - hw}, {1, 0}, len, {0, 1});
+      furnish({x0 + len, g.ys[j] + hw}, {-1, 0}, len, {0, -1});
+    }
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j + 1 < ny; ++j) {
+      const double y0 = g.ys[j] + hw, len = g.ys[j + 1] - hw - y0;
+      furnish({g.xs[i] + hw, y0}, {0, 1}, len, {-1, 0});
+      furnish({g.xs[i] - hw, y0 + len}, {0, -1}, len, {1, 0});
+    }
+}
+
+// Moving vehicles (ids 1..N for the masks).
+void AddTraffic(Scene& scene, const CityLayout& L, uint64_t traffic_seed, double frame_rate, CarFactory& cars) {
+  const int frames = static_cast<int>(L.trajectory.size());
+  const std::vector<VehicleTrack> tracks = PlanTraffic(L, traffic_seed, frames, frame_rate);
+  uint16_t id = 1;
+  for (const VehicleTrack& v : tracks) {
+    Object o;
+    o.name = "vehicle_" + std::to_string(id) + "_" + v.kind;
+    o.mesh = cars.Get(v.shape, v.color);
+    o.id = id++;
+    o.world_from_object_per_frame = v.world_from_object;
+    scene.objects.push_back(std::move(o));
+  }
+}
+
 }  // namespace
 
 Scene GenerateScene(const std::string& preset_name, uint64_t seed, bool quick) {
@@ -690,255 +980,24 @@ Scene GenerateScene(const std::string& preset_name, uint64_t seed, bool quick) {
   scene.rig_trajectory = L.trajectory;
   scene.lighting = MakeLighting(preset.lighting, SubSeed(seed, preset.lighting.c_str()), st.high_sun_along_streets);
 
-  // Textures, generated in parallel (each from its own seed, so the result does not depend on threads).
-  const int num_facades = quick ? std::max(4, st.facade_textures / 3) : st.facade_textures;
-  const int num_storefronts = quick ? std::max(3, st.storefront_textures / 2) : st.storefront_textures;
-  std::vector<std::function<Texture()>> jobs;
-  for (int i = 0; i < num_facades; ++i) jobs.push_back([=] { return MakeFacadeTexture(texture_seed, i); });
-  for (int i = 0; i < num_storefronts; ++i) jobs.push_back([=] { return MakeStorefrontTexture(texture_seed, i); });
-  const int t_road = static_cast<int>(jobs.size());
-  for (int i = 0; i < 2; ++i) jobs.push_back([=] { return MakeRoadTexture(texture_seed, i, st.road_width_m, st.parking_lane_m); });
-  const int t_intersection = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeIntersectionTexture(texture_seed, st.road_width_m); });
-  const int t_sidewalk = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeSidewalkTexture(texture_seed); });
-  const int t_concrete = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeConcreteTexture(texture_seed); });
-  const int t_ground = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeGroundTexture(texture_seed); });
-  CarTextures car_tex;
-  car_tex.side = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeCarSideTexture(texture_seed); });
-  car_tex.end = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeCarEndTexture(texture_seed); });
-  car_tex.glass = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeCarGlassTexture(texture_seed); });
-  const int t_bark = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeBarkTexture(texture_seed); });
-  const int t_foliage = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeFoliageTexture(texture_seed); });
-  const int t_sign = static_cast<int>(jobs.size());
-  for (int k = 0; k < kSignKinds; ++k) jobs.push_back([=] { return MakeSignTexture(texture_seed, k); });
-  const int t_awning = static_cast<int>(jobs.size()), num_awnings = quick ? 3 : 6;
-  for (int k = 0; k < num_awnings; ++k) jobs.push_back([=] { return MakeAwningTexture(texture_seed, k); });
-  scene.textures.resize(jobs.size());
-  tbb::parallel_for(size_t{0}, jobs.size(), [&](size_t i) { scene.textures[i] = jobs[i](); });
-
-  // Shared materials.
-  const int m_road[2] = {AddMaterial(scene, "road_0", {1, 1, 1}, t_road), AddMaterial(scene, "road_1", {1, 1, 1}, t_road + 1)};
-  const int m_intersection = AddMaterial(scene, "intersection", {1, 1, 1}, t_intersection);
-  const int m_sidewalk = AddMaterial(scene, "sidewalk", {1, 1, 1}, t_sidewalk);
-  const int m_curb = AddMaterial(scene, "curb", {0.95f, 0.95f, 0.95f}, t_concrete);
-  const int m_roof = AddMaterial(scene, "roof", {0.8f, 0.78f, 0.75f}, t_concrete);
-  const int m_ground = AddMaterial(scene, "ground", {1, 1, 1}, t_ground);
-  const int m_metal = AddMaterial(scene, "pole_metal", {0.25f, 0.27f, 0.28f}, -1);
-  const int m_lamp = AddMaterial(scene, "lamp", {0.9f, 0.9f, 0.8f}, -1);
-  const int m_bark = AddMaterial(scene, "bark", {1, 1, 1}, t_bark);
-  const int m_foliage = AddMaterial(scene, "foliage", {1, 1, 1}, t_foliage);
-
-  const StreetGrid& g = L.grid;
-  const double W = g.road_width_m, hw = 0.5 * W;
-
-  // Ground beyond the city.
-  {
-    MeshBuilder b("ground");
-    const Eigen::Vector2d lo(g.MinX() - 1500, g.MinY() - 1500), hi(g.MaxX() + 1500, g.MaxY() + 1500);
-    b.Floor(lo, hi, -0.02, kGroundTileMetres, m_ground);
-    AddStatic(scene, "ground", AddMesh(scene, b.Finish()), Rigid3::Identity());
-  }
-  // Roads: segments between intersections (u along the street, v across from the left curb) and
-  // intersection squares.
-  {
-    MeshBuilder b("roads");
-    const int nx = static_cast<int>(g.xs.size()), ny = static_cast<int>(g.ys.size());
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i + 1 < nx; ++i) {  // along +x at y = ys[j]
-        const double x0 = g.xs[i] + hw, x1 = g.xs[i + 1] - hw, y = g.ys[j];
-        const float u0 = static_cast<float>(rng.Uniform(0, 1)), u1 = u0 + static_cast<float>((x1 - x0) / W);
-        b.Quad(MeshBuilder::P(x0, y - hw, 0), MeshBuilder::P(x1, y - hw, 0), MeshBuilder::P(x1, y + hw, 0),
-               MeshBuilder::P(x0, y + hw, 0), {u0, 1}, {u1, 1}, {u1, 0}, {u0, 0}, m_road[rng.UniformInt(0, 1)]);
-      }
-    for (int i = 0; i < nx; ++i)
-      for (int j = 0; j + 1 < ny; ++j) {  // along +y at x = xs[i]; left curb is at -x
-        const double y0 = g.ys[j] + hw, y1 = g.ys[j + 1] - hw, x = g.xs[i];
-        const float u0 = static_cast<float>(rng.Uniform(0, 1)), u1 = u0 + static_cast<float>((y1 - y0) / W);
-        b.Quad(MeshBuilder::P(x + hw, y0, 0), MeshBuilder::P(x + hw, y1, 0), MeshBuilder::P(x - hw, y1, 0),
-               MeshBuilder::P(x - hw, y0, 0), {u0, 1}, {u1, 1}, {u1, 0}, {u0, 0}, m_road[rng.UniformInt(0, 1)]);
-      }
-    for (int i = 0; i < nx; ++i)
-      for (int j = 0; j < ny; ++j) {
-        const double x = g.xs[i], y = g.ys[j];
-        b.Quad(MeshBuilder::P(x - hw, y - hw, 0), MeshBuilder::P(x + hw, y - hw, 0), MeshBuilder::P(x + hw, y + hw, 0),
-               MeshBuilder::P(x - hw, y + hw, 0), {0, 1}, {1, 1}, {1, 0}, {0, 0}, m_intersection);
-      }
-    AddStatic(scene, "roads", AddMesh(scene, b.Finish()), Rigid3::Identity());
-  }
-  // Sidewalk slabs with curbs, one per block.
-  {
-    MeshBuilder b("sidewalks");
-    for (const Box2& blk : L.blocks) {
-      b.Floor(blk.min, blk.max, kCurbHeight, kSidewalkTileMetres, m_sidewalk);
-      const Eigen::Vector2d c[4] = {blk.min, {blk.max.x(), blk.min.y()}, blk.max, {blk.min.x(), blk.max.y()}};
-      // Corners counter-clockwise seen from above: walking them in order keeps the block on the
-      // left, so each curb face's outward normal is on the right of a->b (as Wall expects).
-      for (int k = 0; k < 4; ++k) {
-        const Eigen::Vector2d a = c[k], bb = c[(k + 1) % 4];
-        b.Wall(a, bb, 0.0, kCurbHeight, 0.0, kRoofTileMetres, 0.0, kRoofTileMetres, m_curb);
-      }
-    }
-    AddStatic(scene, "sidewalks", AddMesh(scene, b.Finish()), Rigid3::Identity());
-  }
-  // Buildings (AddBuilding): storefronts, facades, relief, balconies, awnings, rooflines.
-  {
-    ArchitectureMaterials am;
-    am.roof = m_roof;
-    am.metal = AddMaterial(scene, "rooftop_metal", {0.62f, 0.64f, 0.66f}, t_concrete);
-    const Vec3f trims[] = {{0.95f, 0.93f, 0.88f}, {0.7f, 0.7f, 0.72f}, {0.85f, 0.78f, 0.65f}, {0.45f, 0.43f, 0.42f}};
-    for (size_t i = 0; i < 4; ++i) am.trim.push_back(AddMaterial(scene, "trim_" + std::to_string(i), trims[i], t_concrete));
-    am.roof_tiles.push_back(AddMaterial(scene, "roof_tiles_0", {0.62f, 0.3f, 0.2f}, t_concrete));
-    am.roof_tiles.push_back(AddMaterial(scene, "roof_tiles_1", {0.3f, 0.32f, 0.36f}, t_concrete));
-    const Vec3f rails[] = {{0.12f, 0.12f, 0.13f}, {0.85f, 0.85f, 0.83f}, {0.3f, 0.42f, 0.42f}};
-    for (size_t i = 0; i < 3; ++i) am.railing.push_back(AddMaterial(scene, "railing_" + std::to_string(i), rails[i], -1));
-    for (int i = 0; i < num_awnings; ++i) am.awning.push_back(AddMaterial(scene, "awning_" + std::to_string(i), {1, 1, 1}, t_awning + i));
-    SceneRng arch(SubSeed(layout_seed, "architecture"));
-    MeshBuilder b("buildings");
-    for (size_t k = 0; k < L.buildings.size(); ++k) {
-      const BuildingPlan& p = L.buildings[k];
-      const std::string name = "building_" + std::to_string(k);
-      const int m_facade = AddMaterial(scene, name + "_facade", p.tint, p.facade);
-      const int m_shop = AddMaterial(scene, name + "_shop", p.tint, num_facades + p.storefront);
-      AddBuilding(b, p, GetFacadeLayout(texture_seed, p.facade), m_facade, m_shop, am, st, arch);
-    }
-    AddStatic(scene, "buildings", AddMesh(scene, b.Finish()), Rigid3::Identity());
-  }
+  const CityTextures textures = GenerateTextures(scene, st, texture_seed, quick);
+  const CityMaterials materials = AddSharedMaterials(scene, textures);
+  AddGround(scene, L.grid, materials.ground);
+  AddRoads(scene, L.grid, materials, rng);
+  AddSidewalks(scene, L.blocks, materials);
+  AddBuildings(scene, L, textures, materials, layout_seed, texture_seed);
 
   // Street furniture: shared meshes placed along the curbs.
-  int mesh_light, mesh_tree[3];
-  {
-    MeshBuilder b("street_light");  // arm along +x (towards the road)
-    b.Prism({0, 0, 0}, 0.09f, 0.0f, 6.5f, 8, m_metal, m_metal);
-    const int arm[5] = {m_metal, m_metal, m_metal, m_metal, m_metal};
-    b.Box({0, -0.05f, 6.3f}, {1.6f, 0.05f, 6.42f}, arm);
-    const int lamp[5] = {m_metal, m_metal, m_metal, m_metal, m_metal};
-    b.Box({1.3f, -0.18f, 6.15f}, {1.9f, 0.18f, 6.3f}, lamp);
-    b.Floor({1.35, -0.15}, {1.85, 0.15}, 6.149, 1.0, m_lamp);
-    mesh_light = AddMesh(scene, b.Finish());
-  }
-  for (int v = 0; v < 3; ++v) {
-    MeshBuilder b("tree_" + std::to_string(v));
-    const float crown = 1.7f + 0.4f * v, centre = 4.3f + 0.3f * v;
-    b.Prism({0, 0, 0}, 0.14f + 0.03f * v, 0.0f, centre, 6, m_bark, m_bark);
-    // Crown: octahedron subdivided twice, vertices jittered; spherical UVs.
-    std::vector<Vec3f> tris = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0, 1, 0}, {-1, 0, 0}, {0, 0, 1}, {-1, 0, 0}, {0, -1, 0},
-                               {0, 0, 1}, {0, -1, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, {1, 0, 0}, {0, 0, -1}, {-1, 0, 0},
-                               {0, 1, 0}, {0, 0, -1}, {0, -1, 0}, {-1, 0, 0}, {0, 0, -1}, {1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
-    for (int level = 0; level < 2; ++level) {
-      std::vector<Vec3f> next;
-      for (size_t t = 0; t < tris.size(); t += 3) {
-        const Vec3f a = tris[t], bb = tris[t + 1], c = tris[t + 2];
-        const Vec3f ab = (a + bb).normalized(), bc = (bb + c).normalized(), ca = (c + a).normalized();
-        next.insert(next.end(), {a, ab, ca, ab, bb, bc, ca, bc, c, ab, bc, ca});
-      }
-      tris = next;
-    }
-    auto jitter = [&](const Vec3f& d) {
-      // Deterministic per direction: hash the quantized direction so shared vertices move together.
-      const int64_t key = std::lround(d.x() * 1000) * 1000003 + std::lround(d.y() * 1000) * 1009 + std::lround(d.z() * 1000);
-      SceneRng r(SubSeed(layout_seed ^ static_cast<uint64_t>(key), "crown", static_cast<uint64_t>(v)));
-      const float scale = crown * static_cast<float>(r.Uniform(0.8, 1.15));
-      return Vec3f(d.x() * scale, d.y() * scale, d.z() * scale * 0.85f + centre + 0.6f);
-    };
-    auto uv = [](const Vec3f& d) {
-      return Vec2f(static_cast<float>(2.0 * (std::atan2(d.y(), d.x()) / (2 * M_PI) + 0.5)), static_cast<float>(2.0 * std::acos(std::clamp(d.z(), -1.0f, 1.0f)) / M_PI));
-    };
-    for (size_t t = 0; t < tris.size(); t += 3) {
-      b.Tri(jitter(tris[t]), jitter(tris[t + 1]), jitter(tris[t + 2]), uv(tris[t]), uv(tris[t + 1]), uv(tris[t + 2]), m_foliage);
-    }
-    mesh_tree[v] = AddMesh(scene, b.Finish());
-  }
-  // Road signs: pole and a 0.6 m plate whose face (sign texture) looks along the mesh's +x.
+  const int mesh_light = AddStreetLightMesh(scene, materials);
+  int mesh_tree[3];
+  for (int v = 0; v < 3; ++v) mesh_tree[v] = AddTreeMesh(scene, materials, layout_seed, v);
   int mesh_sign[kSignKinds];
-  for (int k = 0; k < kSignKinds; ++k) {
-    MeshBuilder b("sign_" + std::to_string(k));
-    const int m_face = AddMaterial(scene, "sign_" + std::to_string(k), {1, 1, 1}, t_sign + k);
-    b.Prism({-0.05f, 0, 0}, 0.04f, 0.0f, 2.9f, 6, m_metal, m_metal);
-    const int plate[5] = {m_metal, m_face, m_metal, m_metal, m_metal};
-    b.Box({0.0f, -0.3f, 2.3f}, {0.025f, 0.3f, 2.9f}, plate);
-    mesh_sign[k] = AddMesh(scene, b.Finish());
-  }
-  // One sign at about half of the block corners, 0.7 m from both curbs, facing traffic on one of
-  // the two streets.
-  {
-    int signs = 0;
-    for (const Box2& blk : L.blocks) {
-      const bool inner_x = blk.min.x() > g.MinX() && blk.max.x() < g.MaxX();
-      const bool inner_y = blk.min.y() > g.MinY() && blk.max.y() < g.MaxY();
-      if (!inner_x && !inner_y) continue;  // outer corner blocks face no intersection
-      for (int corner = 0; corner < 4; ++corner) {
-        if (!rng.Bernoulli(0.5)) continue;
-        const double sx = corner & 1 ? 1.0 : -1.0, sy = corner & 2 ? 1.0 : -1.0;
-        const double x = (sx > 0 ? blk.max.x() : blk.min.x()) - 0.7 * sx, y = (sy > 0 ? blk.max.y() : blk.min.y()) - 0.7 * sy;
-        // Face traffic approaching along x (yaw 0 or pi) or along y (yaw +-pi/2) on this corner's side.
-        const double yaw = rng.Bernoulli(0.5) ? (sx > 0 ? 0.0 : M_PI) : (sy > 0 ? M_PI / 2 : -M_PI / 2);
-        AddStatic(scene, "sign_" + std::to_string(signs++), mesh_sign[rng.UniformInt(0, kSignKinds - 1)],
-                  PlaceYaw(x, y, yaw, kCurbHeight));
-      }
-    }
-  }
-  CarFactory cars(scene, car_tex);
-  {
-    int lights = 0, trees = 0;
-    // Along every street segment side: lights every ~28 m, trees between them, parked cars in the lane.
-    const int nx = static_cast<int>(g.xs.size()), ny = static_cast<int>(g.ys.size());
-    auto furnish = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& dir, double length, const Eigen::Vector2d& to_road) {
-      // a: start of the curb line; dir: along the street; to_road: unit normal from sidewalk to road.
-      const double yaw_to_road = std::atan2(to_road.y(), to_road.x());
-      for (double s = 6.0; s < length - 6.0; s += 28.0) {
-        const Eigen::Vector2d p = a + s * dir - 0.45 * to_road;
-        AddStatic(scene, "light_" + std::to_string(lights++), mesh_light, PlaceYaw(p.x(), p.y(), yaw_to_road, kCurbHeight));
-        if (st.trees && s + 14.0 < length - 6.0 && rng.Bernoulli(0.8)) {
-          const Eigen::Vector2d q = a + (s + 14.0) * dir - 1.0 * to_road;
-          AddStatic(scene, "tree_" + std::to_string(trees++), mesh_tree[rng.UniformInt(0, 2)],
-                    PlaceYaw(q.x(), q.y(), rng.Uniform(0, 2 * M_PI), kCurbHeight));
-        }
-      }
-      if (st.parked_cars && st.parking_lane_m > 0) {
-        for (double s = 9.0; s < length - 9.0; s += 6.5) {
-          if (!rng.Bernoulli(0.45)) continue;
-          const Eigen::Vector2d p = a + s * dir + (0.5 * st.parking_lane_m + 0.15) * to_road;
-          const int mesh = cars.Get(rng.UniformInt(0, kNumCarShapes - 1), rng.UniformInt(0, kNumCarColors - 1));
-          AddStatic(scene, "parked_car", mesh, PlaceYaw(p.x(), p.y(), std::atan2(dir.y(), dir.x()) + rng.Normal(0, 0.02)));
-        }
-      }
-    };
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i + 1 < nx; ++i) {
-        const double x0 = g.xs[i] + hw, len = g.xs[i + 1] - hw - x0;
-        furnish({x0, g.ys[j] - hw}, {1, 0}, len, {0, 1});
-        furnish({x0 + len, g.ys[j] + hw}, {-1, 0}, len, {0, -1});
-      }
-    for (int i = 0; i < nx; ++i)
-      for (int j = 0; j + 1 < ny; ++j) {
-        const double y0 = g.ys[j] + hw, len = g.ys[j + 1] - hw - y0;
-        furnish({g.xs[i] + hw, y0}, {0, 1}, len, {-1, 0});
-        furnish({g.xs[i] - hw, y0 + len}, {0, -1}, len, {1, 0});
-      }
-  }
+  for (int k = 0; k < kSignKinds; ++k) mesh_sign[k] = AddSignMesh(scene, materials, textures, k);
+  PlaceSigns(scene, L, mesh_sign, rng);
+  CarFactory cars(scene, textures.car);
+  FurnishStreets(scene, L, mesh_light, mesh_tree, cars, rng);
 
-  // Moving vehicles (ids 1..N for the masks).
-  if (preset.traffic) {
-    const int frames = static_cast<int>(L.trajectory.size());
-    const std::vector<VehicleTrack> tracks = PlanTraffic(L, layout_seed ^ seed, frames, preset.frame_rate);
-    uint16_t id = 1;
-    for (const VehicleTrack& v : tracks) {
-      Object o;
-      o.name = "vehicle_" + std::to_string(id) + "_" + v.kind;
-      o.mesh = cars.Get(v.shape, v.color);
-      o.id = id++;
-      o.world_from_object_per_frame = v.world_from_object;
-      scene.objects.push_back(std::move(o));
-    }
-  }
+  if (preset.traffic) AddTraffic(scene, L, layout_seed ^ seed, preset.frame_rate, cars);
   return scene;
 }
 
