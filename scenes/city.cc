@@ -440,24 +440,63 @@ struct ArchitectureMaterials {
   int metal = -1;
 };
 
-// One building: storefront ground floor, facade walls, roof, and real geometry that lines up with
-// the facade texture's windows (facade relief that recesses the windows, glass-wall fins,
-// balconies), awnings over the shops, a roofline (cornice, parapet or hipped roof) and rooftop
-// structures. `arch` draws every random choice, in a fixed order per building.
-void AddBuilding(MeshBuilder& b, const BuildingPlan& p, const FacadeLayout& fl, int m_facade, int m_shop,
-                 const ArchitectureMaterials& am, const CityStyle& st, SceneRng& arch) {
-  const double texel = kFacadeTileMetres / 1024.0;  // metres per facade texel (both axes)
-  // Window placement as MakeFacadeTexture paints it (integer pixel arithmetic reproduced).
-  const int bay_px = 1024 / fl.bays;
-  const int win_w_px = static_cast<int>(bay_px * fl.window_width_fraction);
-  const int win_h_px = static_cast<int>(256 * fl.window_height_fraction);
-  const int win_top_px = (256 - win_h_px) / 2 - 8;  // below the floor's top
-  const int floors = std::max(1, static_cast<int>(std::lround((p.height - 0.4 - kStorefrontHeightMetres) / kFloorHeightMetres)));
+// The street-facing wall of a building's base box, and where the facade texture paints its windows
+// (MakeFacadeTexture's integer pixel arithmetic reproduced) in wall coordinates d (metres from origin).
+struct StreetFacade {
+  Eigen::Vector2d origin, along;  // wall start and unit direction (outward normal on its right)
+  double length = 0.0;
+  double texel = 0.0;  // metres per facade texel (both axes)
+  int bay_px = 0, win_w_px = 0, win_h_px = 0;
+  int win_top_px = 0;  // below the floor's top
+  int floors = 0;
+  double top = 0.0;  // base box top (parapet included)
+  std::vector<double> bay_edges, window_centres;
+  std::function<Vec2f(double, double)> facade_uv;  // uv of the facade texture at (d, z)
+  double FloorTop(int k) const { return kStorefrontHeightMetres + (k + 1) * kFloorHeightMetres; }
+};
 
-  const double r_relief = arch.Uniform(), r_balcony = arch.Uniform(), r_roof = arch.Uniform(), r_awning = arch.Uniform(),
-               r_rooftop = arch.Uniform();
-  const bool hip_roof = !p.has_setback && p.height <= 17.0 && fl.style != 3 && r_roof < 0.45;
+StreetFacade MakeStreetFacade(const BuildingPlan& p, const FacadeLayout& fl) {
+  StreetFacade f;
+  f.texel = kFacadeTileMetres / 1024.0;
+  f.bay_px = 1024 / fl.bays;
+  f.win_w_px = static_cast<int>(f.bay_px * fl.window_width_fraction);
+  f.win_h_px = static_cast<int>(256 * fl.window_height_fraction);
+  f.win_top_px = (256 - f.win_h_px) / 2 - 8;
+  f.floors =
+      std::max(1, static_cast<int>(std::lround((p.height - 0.4 - kStorefrontHeightMetres) / kFloorHeightMetres)));
+  const Eigen::Vector2d corners[4] = {p.footprint.min,
+                                      {p.footprint.max.x(), p.footprint.min.y()},
+                                      p.footprint.max,
+                                      {p.footprint.min.x(), p.footprint.max.y()}};
+  int street = 0;
+  for (int e = 0; e < 4; ++e) {
+    const Eigen::Vector2d along = (corners[(e + 1) % 4] - corners[e]).normalized();
+    if (Eigen::Vector2d(along.y(), -along.x()).dot(p.facing) > 0.5) street = e;
+  }
+  f.origin = corners[street];
+  f.along = (corners[(street + 1) % 4] - f.origin).normalized();
+  f.length = (corners[(street + 1) % 4] - f.origin).norm();
+  const double u_offset = p.u_offset;
+  f.facade_uv = [u_offset](double d, double z) {
+    return Vec2f(static_cast<float>((u_offset + d) / kFacadeTileMetres),
+                 static_cast<float>(100.0 - (z - kStorefrontHeightMetres) / kFacadeTileMetres));
+  };
+  // Wall coordinate d of texture column x (pixels, any tile).
+  auto d_of_px = [&](double x) { return x * f.texel - p.u_offset; };
+  const int tile_first = static_cast<int>(std::floor(p.u_offset / kFacadeTileMetres)) - 1;
+  const int tile_last = static_cast<int>(std::ceil((p.u_offset + f.length) / kFacadeTileMetres)) + 1;
+  for (int t = tile_first; t <= tile_last; ++t)
+    for (int k = 0; k < fl.bays; ++k) {
+      const double x0 = 1024.0 * t + k * f.bay_px;
+      f.bay_edges.push_back(d_of_px(x0));
+      f.window_centres.push_back(d_of_px(x0 + (f.bay_px - f.win_w_px) / 2 + 0.5 * f.win_w_px));
+    }
+  f.top = p.height;
+  return f;
+}
 
+// Storefront ground floor, facade walls and flat roofs of the base box and of the setback.
+void AddBuildingWalls(MeshBuilder& b, const BuildingPlan& p, int m_facade, int m_shop, int m_roof, bool hip_roof) {
   auto walls = [&](const Box2& fp, double z0, double z1, bool shops, bool roof) {
     const Eigen::Vector2d c[4] = {fp.min, {fp.max.x(), fp.min.y()}, fp.max, {fp.min.x(), fp.max.y()}};
     for (int e = 0; e < 4; ++e) {
@@ -473,157 +512,156 @@ void AddBuilding(MeshBuilder& b, const BuildingPlan& p, const FacadeLayout& fl, 
       const double v0 = 100.0 - (zs - kStorefrontHeightMetres) / kFacadeTileMetres;
       b.Wall(a, bb, zs, z1, p.u_offset, kFacadeTileMetres, v0, kFacadeTileMetres, m_facade);
     }
-    if (roof) b.Floor(fp.min, fp.max, z1, kRoofTileMetres, am.roof);
+    if (roof) b.Floor(fp.min, fp.max, z1, kRoofTileMetres, m_roof);
   };
   walls(p.footprint, 0.0, p.height, true, !hip_roof);
   if (p.has_setback) walls(p.upper_footprint, p.height, p.upper_height, false, true);
+}
 
-  // The street-facing wall of the base box: origin, direction (outward normal on its right), length.
-  const Eigen::Vector2d corners[4] = {p.footprint.min, {p.footprint.max.x(), p.footprint.min.y()}, p.footprint.max,
-                                      {p.footprint.min.x(), p.footprint.max.y()}};
-  int street = 0;
-  for (int e = 0; e < 4; ++e) {
-    const Eigen::Vector2d along = (corners[(e + 1) % 4] - corners[e]).normalized();
-    if (Eigen::Vector2d(along.y(), -along.x()).dot(p.facing) > 0.5) street = e;
-  }
-  const Eigen::Vector2d origin = corners[street];
-  const Eigen::Vector2d along = (corners[(street + 1) % 4] - origin).normalized();
-  const double length = (corners[(street + 1) % 4] - origin).norm();
-  auto facade_uv = [&](double d, double z) {
-    return Vec2f(static_cast<float>((p.u_offset + d) / kFacadeTileMetres),
-                 static_cast<float>(100.0 - (z - kStorefrontHeightMetres) / kFacadeTileMetres));
-  };
-  // Wall coordinate d of texture column x (pixels, any tile).
-  auto d_of_px = [&](double x) { return x * texel - p.u_offset; };
-  const int tile_first = static_cast<int>(std::floor(p.u_offset / kFacadeTileMetres)) - 1;
-  const int tile_last = static_cast<int>(std::ceil((p.u_offset + length) / kFacadeTileMetres)) + 1;
-  std::vector<double> bay_edges, window_centres;
-  for (int t = tile_first; t <= tile_last; ++t)
-    for (int k = 0; k < fl.bays; ++k) {
-      const double x0 = 1024.0 * t + k * bay_px;
-      bay_edges.push_back(d_of_px(x0));
-      window_centres.push_back(d_of_px(x0 + (bay_px - win_w_px) / 2 + 0.5 * win_w_px));
-    }
-  const double top = p.height;  // base box top (parapet included)
-  auto floor_top = [&](int k) { return kStorefrontHeightMetres + (k + 1) * kFloorHeightMetres; };
-
-  // Facade relief: the wall between the windows steps forward, so the windows sit in recesses.
+// Facade relief: the wall between the windows steps forward, so the windows sit in recesses.
+void AddFacadeRelief(MeshBuilder& b, const StreetFacade& f, const FacadeLayout& fl, double r_relief, int m_facade,
+                     SceneRng& arch) {
+  const double texel = f.texel, length = f.length, top = f.top;
   if (fl.style == 3) {
     if (r_relief < 0.7) {  // glass curtain wall: thin vertical fins at the mullion lines
-      const double fin_w = std::min(0.1, 0.6 * (bay_px - win_w_px) * texel), fin_d = arch.Uniform(0.3, 0.5);
-      for (double d : bay_edges)
+      const double fin_w = std::min(0.1, 0.6 * (f.bay_px - f.win_w_px) * texel), fin_d = arch.Uniform(0.3, 0.5);
+      for (double d : f.bay_edges)
         if (d - fin_w > 0.2 && d + fin_w < length - 0.2)
-          b.WallBlock(origin, along, d - 0.5 * fin_w, d + 0.5 * fin_w, 0.0, fin_d, kStorefrontHeightMetres, top, facade_uv, m_facade);
+          b.WallBlock(f.origin, f.along, d - 0.5 * fin_w, d + 0.5 * fin_w, 0.0, fin_d, kStorefrontHeightMetres, top,
+                      f.facade_uv, m_facade);
     }
   } else if (r_relief < 0.6) {
     const double depth = arch.Uniform(0.12, 0.3);
     const int kind = arch.UniformInt(0, 2);  // 0 pilasters, 1 floor bands, 2 both
     if (kind != 1) {
-      const double w = std::min(0.45, 0.7 * (bay_px - win_w_px) * texel);
+      const double w = std::min(0.45, 0.7 * (f.bay_px - f.win_w_px) * texel);
       // Corner pilasters where no painted window column reaches the corner.
       auto clear_of_windows = [&](double d0, double d1) {
-        for (double dc : window_centres)
-          if (d1 > dc - 0.5 * win_w_px * texel && d0 < dc + 0.5 * win_w_px * texel) return false;
+        for (double dc : f.window_centres)
+          if (d1 > dc - 0.5 * f.win_w_px * texel && d0 < dc + 0.5 * f.win_w_px * texel) return false;
         return true;
       };
-      if (clear_of_windows(0.0, w)) b.WallBlock(origin, along, 0.0, w, 0.0, depth, kStorefrontHeightMetres, top, facade_uv, m_facade);
+      if (clear_of_windows(0.0, w))
+        b.WallBlock(f.origin, f.along, 0.0, w, 0.0, depth, kStorefrontHeightMetres, top, f.facade_uv, m_facade);
       if (clear_of_windows(length - w, length))
-        b.WallBlock(origin, along, length - w, length, 0.0, depth, kStorefrontHeightMetres, top, facade_uv, m_facade);
-      for (double d : bay_edges)
+        b.WallBlock(f.origin, f.along, length - w, length, 0.0, depth, kStorefrontHeightMetres, top, f.facade_uv,
+                    m_facade);
+      for (double d : f.bay_edges)
         if (d - w > 0.3 && d + w < length - 0.3)
-          b.WallBlock(origin, along, d - 0.5 * w, d + 0.5 * w, 0.0, depth, kStorefrontHeightMetres, top, facade_uv, m_facade);
+          b.WallBlock(f.origin, f.along, d - 0.5 * w, d + 0.5 * w, 0.0, depth, kStorefrontHeightMetres, top,
+                      f.facade_uv, m_facade);
     }
     if (kind != 0) {
       // From the window top of one floor to the window bottom of the next (the storefront top and
       // the roof close the first and last band).
-      for (int k = 0; k <= floors; ++k) {
-        const double z0 = k == 0 ? kStorefrontHeightMetres : floor_top(k - 1) - win_top_px * texel;
-        const double z1 = k == floors ? top : floor_top(k) - (win_top_px + win_h_px) * texel;
-        if (z1 - z0 > 0.05) b.WallBlock(origin, along, 0.0, length, 0.0, depth, z0, z1, facade_uv, m_facade);
+      for (int k = 0; k <= f.floors; ++k) {
+        const double z0 = k == 0 ? kStorefrontHeightMetres : f.FloorTop(k - 1) - f.win_top_px * texel;
+        const double z1 = k == f.floors ? top : f.FloorTop(k) - (f.win_top_px + f.win_h_px) * texel;
+        if (z1 - z0 > 0.05) b.WallBlock(f.origin, f.along, 0.0, length, 0.0, depth, z0, z1, f.facade_uv, m_facade);
       }
     }
   }
+}
 
-  // Balconies under the windows of the street side: slab, front and side railing panels.
-  if (fl.style != 3 && floors >= 2 && r_balcony < 0.3) {
-    const double depth = arch.Uniform(0.9, 1.3);
-    const int stride = arch.UniformInt(1, 2), phase = arch.UniformInt(0, 1), first_floor = arch.UniformInt(0, 1);
-    const int rail = am.railing[arch.UniformInt(0, static_cast<int>(am.railing.size()) - 1)];
-    const int slab = am.trim[arch.UniformInt(0, static_cast<int>(am.trim.size()) - 1)];
-    const double half = std::min(0.5 * win_w_px * texel + 0.3, 0.5 * bay_px * texel - 0.05);
-    auto plain_uv = [](double d, double z) { return Vec2f(static_cast<float>(d / kRoofTileMetres), static_cast<float>(-z / kRoofTileMetres)); };
-    int count = 0;
-    for (size_t i = 0; i < window_centres.size(); ++i) {
-      const double dc = window_centres[i];
-      if (static_cast<int>(i) % stride != phase % stride || dc - half < 0.3 || dc + half > length - 0.3) continue;
-      for (int k = first_floor; k < floors && count < 120; ++k, ++count) {
-        const double z = kStorefrontHeightMetres + k * kFloorHeightMetres;  // floor level
-        b.WallBlock(origin, along, dc - half, dc + half, 0.0, depth, z - 0.18, z, plain_uv, slab);
-        b.WallBlock(origin, along, dc - half, dc + half, depth - 0.05, depth, z, z + 1.0, plain_uv, rail);
-        b.WallBlock(origin, along, dc - half, dc - half + 0.05, 0.0, depth - 0.05, z, z + 1.0, plain_uv, rail);
-        b.WallBlock(origin, along, dc + half - 0.05, dc + half, 0.0, depth - 0.05, z, z + 1.0, plain_uv, rail);
-      }
+// Balconies under the windows of the street side: slab, front and side railing panels.
+void AddBalconies(MeshBuilder& b, const StreetFacade& f, const ArchitectureMaterials& am, SceneRng& arch) {
+  const double texel = f.texel, length = f.length;
+  const double depth = arch.Uniform(0.9, 1.3);
+  const int stride = arch.UniformInt(1, 2), phase = arch.UniformInt(0, 1), first_floor = arch.UniformInt(0, 1);
+  const int rail = am.railing[arch.UniformInt(0, static_cast<int>(am.railing.size()) - 1)];
+  const int slab = am.trim[arch.UniformInt(0, static_cast<int>(am.trim.size()) - 1)];
+  const double half = std::min(0.5 * f.win_w_px * texel + 0.3, 0.5 * f.bay_px * texel - 0.05);
+  auto plain_uv = [](double d, double z) {
+    return Vec2f(static_cast<float>(d / kRoofTileMetres), static_cast<float>(-z / kRoofTileMetres));
+  };
+  int count = 0;
+  for (size_t i = 0; i < f.window_centres.size(); ++i) {
+    const double dc = f.window_centres[i];
+    if (static_cast<int>(i) % stride != phase % stride || dc - half < 0.3 || dc + half > length - 0.3) continue;
+    for (int k = first_floor; k < f.floors && count < 120; ++k, ++count) {
+      const double z = kStorefrontHeightMetres + k * kFloorHeightMetres;  // floor level
+      b.WallBlock(f.origin, f.along, dc - half, dc + half, 0.0, depth, z - 0.18, z, plain_uv, slab);
+      b.WallBlock(f.origin, f.along, dc - half, dc + half, depth - 0.05, depth, z, z + 1.0, plain_uv, rail);
+      b.WallBlock(f.origin, f.along, dc - half, dc - half + 0.05, 0.0, depth - 0.05, z, z + 1.0, plain_uv, rail);
+      b.WallBlock(f.origin, f.along, dc + half - 0.05, dc + half, 0.0, depth - 0.05, z, z + 1.0, plain_uv, rail);
     }
   }
+}
 
-  // Awnings over the shop windows: a sloped cloth, a front valance and closed sides.
-  if (r_awning < 0.45 && length > 3.0) {
-    const double reach = std::min(1.3, st.sidewalk_width_m - 0.8);
-    const int n = arch.UniformInt(1, 3);
-    const double part = length / n;
-    for (int i = 0; i < n; ++i) {
-      const double w = arch.Uniform(std::min(2.0, part - 0.8), part - 0.8);
-      const double d0 = i * part + 0.4 + arch.Uniform(0.0, part - 0.8 - w), d1 = d0 + w;
-      const int m = am.awning[arch.UniformInt(0, static_cast<int>(am.awning.size()) - 1)];
-      if (w < 1.0) continue;
-      const double z_wall = 3.15, z_edge = 2.6, z_low = 2.35;
-      const Eigen::Vector2d normal(along.y(), -along.x());
-      auto at = [&](double d, double nn, double z) {
-        const Eigen::Vector2d xy = origin + d * along + nn * normal;
-        return MeshBuilder::P(xy.x(), xy.y(), z);
-      };
-      const float u0 = static_cast<float>(d0 / 2.56), u1 = static_cast<float>(d1 / 2.56);
-      const float v_edge = static_cast<float>(std::hypot(reach, z_wall - z_edge) / 0.64);
-      const float v_low = v_edge + static_cast<float>((z_edge - z_low) / 0.64);
-      b.Quad(at(d0, reach, z_edge), at(d1, reach, z_edge), at(d1, 0.0, z_wall), at(d0, 0.0, z_wall), {u0, v_edge}, {u1, v_edge},
-             {u1, 0}, {u0, 0}, m);
-      b.Quad(at(d0, reach, z_low), at(d1, reach, z_low), at(d1, reach, z_edge), at(d0, reach, z_edge), {u0, v_low}, {u1, v_low},
-             {u1, v_edge}, {u0, v_edge}, m);
-      b.Tri(at(d0, 0.0, z_wall), at(d0, reach, z_low), at(d0, reach, z_edge), {0, 0}, {0.2f, v_low}, {0.2f, v_edge}, m);
-      b.Tri(at(d1, 0.0, z_wall), at(d1, reach, z_edge), at(d1, reach, z_low), {0, 0}, {0.2f, v_edge}, {0.2f, v_low}, m);
-    }
+// Awnings over the shop windows: a sloped cloth, a front valance and closed sides.
+void AddAwnings(MeshBuilder& b, const StreetFacade& f, const ArchitectureMaterials& am, const CityStyle& st,
+                SceneRng& arch) {
+  const Eigen::Vector2d& origin = f.origin;
+  const Eigen::Vector2d& along = f.along;
+  const double length = f.length;
+  const double reach = std::min(1.3, st.sidewalk_width_m - 0.8);
+  const int n = arch.UniformInt(1, 3);
+  const double part = length / n;
+  for (int i = 0; i < n; ++i) {
+    const double w = arch.Uniform(std::min(2.0, part - 0.8), part - 0.8);
+    const double d0 = i * part + 0.4 + arch.Uniform(0.0, part - 0.8 - w), d1 = d0 + w;
+    const int m = am.awning[arch.UniformInt(0, static_cast<int>(am.awning.size()) - 1)];
+    if (w < 1.0) continue;
+    const double z_wall = 3.15, z_edge = 2.6, z_low = 2.35;
+    const Eigen::Vector2d normal(along.y(), -along.x());
+    auto at = [&](double d, double nn, double z) {
+      const Eigen::Vector2d xy = origin + d * along + nn * normal;
+      return MeshBuilder::P(xy.x(), xy.y(), z);
+    };
+    const float u0 = static_cast<float>(d0 / 2.56), u1 = static_cast<float>(d1 / 2.56);
+    const float v_edge = static_cast<float>(std::hypot(reach, z_wall - z_edge) / 0.64);
+    const float v_low = v_edge + static_cast<float>((z_edge - z_low) / 0.64);
+    b.Quad(at(d0, reach, z_edge), at(d1, reach, z_edge), at(d1, 0.0, z_wall), at(d0, 0.0, z_wall), {u0, v_edge},
+           {u1, v_edge}, {u1, 0}, {u0, 0}, m);
+    b.Quad(at(d0, reach, z_low), at(d1, reach, z_low), at(d1, reach, z_edge), at(d0, reach, z_edge), {u0, v_low},
+           {u1, v_low}, {u1, v_edge}, {u0, v_edge}, m);
+    b.Tri(at(d0, 0.0, z_wall), at(d0, reach, z_low), at(d0, reach, z_edge), {0, 0}, {0.2f, v_low}, {0.2f, v_edge}, m);
+    b.Tri(at(d1, 0.0, z_wall), at(d1, reach, z_edge), at(d1, reach, z_low), {0, 0}, {0.2f, v_edge}, {0.2f, v_low}, m);
   }
+}
 
-  // Roofline: a hipped roof on some low buildings, else a cornice or a parapet.
+// A hipped roof over `roof_fp` at height `roof_z`, with eaves and a soffit of material `trim`.
+void AddHipRoof(MeshBuilder& b, const Box2& roof_fp, double roof_z, int trim, const ArchitectureMaterials& am,
+                SceneRng& arch) {
+  const double eave = arch.Uniform(0.3, 0.6), pitch = arch.Uniform(22.0, 35.0) * M_PI / 180.0;
+  const int tiles = am.roof_tiles[arch.UniformInt(0, static_cast<int>(am.roof_tiles.size()) - 1)];
+  const Eigen::Vector2d lo = roof_fp.min.array() - eave, hi = roof_fp.max.array() + eave;
+  // Local frame: a along the ridge, c across it.
+  const bool ridge_x = hi.x() - lo.x() >= hi.y() - lo.y();
+  const double a0 = ridge_x ? lo.x() : lo.y(), a1 = ridge_x ? hi.x() : hi.y();
+  const double c0 = ridge_x ? lo.y() : lo.x(), c1 = ridge_x ? hi.y() : hi.x();
+  const double half = 0.5 * (c1 - c0), cm = 0.5 * (c0 + c1), rise = half * std::tan(pitch);
+  auto P = [&](double a, double c, double z) { return ridge_x ? MeshBuilder::P(a, c, z) : MeshBuilder::P(c, a, z); };
+  auto uv = [&](double a, double c) {
+    return Vec2f(static_cast<float>(a / kRoofTileMetres), static_cast<float>(c / kRoofTileMetres));
+  };
+  const double z = roof_z, zr = roof_z + rise;
+  // With ridge_x false the local frame is mirrored; the tracer shades both sides of a triangle.
+  b.Quad(P(a0, c0, z), P(a1, c0, z), P(a1 - half, cm, zr), P(a0 + half, cm, zr), uv(a0, c0), uv(a1, c0),
+         uv(a1 - half, cm), uv(a0 + half, cm), tiles);
+  b.Quad(P(a1, c1, z), P(a0, c1, z), P(a0 + half, cm, zr), P(a1 - half, cm, zr), uv(a1, c1), uv(a0, c1),
+         uv(a0 + half, cm), uv(a1 - half, cm), tiles);
+  b.Tri(P(a0, c1, z), P(a0, c0, z), P(a0 + half, cm, zr), uv(c1, a0), uv(c0, a0), uv(cm, a0 + half), tiles);
+  b.Tri(P(a1, c0, z), P(a1, c1, z), P(a1 - half, cm, zr), uv(c0, a1), uv(c1, a1), uv(cm, a1 - half), tiles);
+  b.Floor(lo, hi, z, kRoofTileMetres, trim);  // eave soffit (and ceiling under the roof)
+}
+
+// Roofline: a hipped roof on some low buildings, else a cornice or a parapet. Returns the trim
+// material it drew (the rooftop structures use it too).
+int AddRoofline(MeshBuilder& b, const BuildingPlan& p, bool hip_roof, double r_roof, const ArchitectureMaterials& am,
+                SceneRng& arch) {
   const int trim = am.trim[arch.UniformInt(0, static_cast<int>(am.trim.size()) - 1)];
   const Box2& roof_fp = p.has_setback ? p.upper_footprint : p.footprint;
   const double roof_z = p.has_setback ? p.upper_height : p.height;
   if (hip_roof) {
-    const double eave = arch.Uniform(0.3, 0.6), pitch = arch.Uniform(22.0, 35.0) * M_PI / 180.0;
-    const int tiles = am.roof_tiles[arch.UniformInt(0, static_cast<int>(am.roof_tiles.size()) - 1)];
-    const Eigen::Vector2d lo = roof_fp.min.array() - eave, hi = roof_fp.max.array() + eave;
-    // Local frame: a along the ridge, c across it.
-    const bool ridge_x = hi.x() - lo.x() >= hi.y() - lo.y();
-    const double a0 = ridge_x ? lo.x() : lo.y(), a1 = ridge_x ? hi.x() : hi.y();
-    const double c0 = ridge_x ? lo.y() : lo.x(), c1 = ridge_x ? hi.y() : hi.x();
-    const double half = 0.5 * (c1 - c0), cm = 0.5 * (c0 + c1), rise = half * std::tan(pitch);
-    auto P = [&](double a, double c, double z) { return ridge_x ? MeshBuilder::P(a, c, z) : MeshBuilder::P(c, a, z); };
-    auto uv = [&](double a, double c) { return Vec2f(static_cast<float>(a / kRoofTileMetres), static_cast<float>(c / kRoofTileMetres)); };
-    const double z = roof_z, zr = roof_z + rise;
-    // With ridge_x false the local frame is mirrored; the tracer shades both sides of a triangle.
-    b.Quad(P(a0, c0, z), P(a1, c0, z), P(a1 - half, cm, zr), P(a0 + half, cm, zr), uv(a0, c0), uv(a1, c0), uv(a1 - half, cm),
-           uv(a0 + half, cm), tiles);
-    b.Quad(P(a1, c1, z), P(a0, c1, z), P(a0 + half, cm, zr), P(a1 - half, cm, zr), uv(a1, c1), uv(a0, c1), uv(a0 + half, cm),
-           uv(a1 - half, cm), tiles);
-    b.Tri(P(a0, c1, z), P(a0, c0, z), P(a0 + half, cm, zr), uv(c1, a0), uv(c0, a0), uv(cm, a0 + half), tiles);
-    b.Tri(P(a1, c0, z), P(a1, c1, z), P(a1 - half, cm, zr), uv(c0, a1), uv(c1, a1), uv(cm, a1 - half), tiles);
-    b.Floor(lo, hi, z, kRoofTileMetres, trim);  // eave soffit (and ceiling under the roof)
+    AddHipRoof(b, roof_fp, roof_z, trim, am, arch);
   } else if (r_roof < 0.75) {
     const double over = arch.Uniform(0.25, 0.45), height = arch.Uniform(0.4, 0.7);
     const int faces[5] = {trim, trim, trim, trim, am.roof};
     auto cornice = [&](const Box2& fp, double z) {
-      b.Box(MeshBuilder::P(fp.min.x() - over, fp.min.y() - over, z - height), MeshBuilder::P(fp.max.x() + over, fp.max.y() + over, z + 0.05),
-            faces, static_cast<float>(kRoofTileMetres), true);
+      b.Box(MeshBuilder::P(fp.min.x() - over, fp.min.y() - over, z - height),
+            MeshBuilder::P(fp.max.x() + over, fp.max.y() + over, z + 0.05), faces, static_cast<float>(kRoofTileMetres),
+            true);
     };
     cornice(p.footprint, p.height);
     if (p.has_setback) cornice(p.upper_footprint, p.upper_height);
@@ -640,33 +678,59 @@ void AddBuilding(MeshBuilder& b, const BuildingPlan& p, const FacadeLayout& fl, 
     box(fp.min.x(), fp.min.y() + t, fp.min.x() + t, fp.max.y() - t);
     box(fp.max.x() - t, fp.min.y() + t, fp.max.x(), fp.max.y() - t);
   }
+  return trim;
+}
 
-  // Rooftop structures on flat roofs: stair house, air conditioners, sometimes a water tank.
+// Rooftop structures on a flat roof: stair house, air conditioners, sometimes a water tank.
+void AddRooftopStructures(MeshBuilder& b, const BuildingPlan& p, int trim, const ArchitectureMaterials& am,
+                          SceneRng& arch) {
+  const Box2& roof_fp = p.has_setback ? p.upper_footprint : p.footprint;
+  const double roof_z = p.has_setback ? p.upper_height : p.height;
   const Eigen::Vector2d room = roof_fp.max - roof_fp.min;
-  if (!hip_roof && r_rooftop < 0.55 && room.minCoeff() > 5.0) {
-    const int faces[5] = {trim, trim, trim, trim, am.roof};
-    const float z = static_cast<float>(roof_z);
-    auto spot = [&](double sx, double sy) {
-      return Eigen::Vector2d(arch.Uniform(roof_fp.min.x() + 1.0, roof_fp.max.x() - 1.0 - sx),
-                             arch.Uniform(roof_fp.min.y() + 1.0, roof_fp.max.y() - 1.0 - sy));
-    };
-    const double sx = std::min(room.x() - 2.5, arch.Uniform(2.2, 3.5)), sy = std::min(room.y() - 2.5, arch.Uniform(2.2, 3.5));
-    const Eigen::Vector2d s0 = spot(sx, sy);
-    b.Box(MeshBuilder::P(s0.x(), s0.y(), z), MeshBuilder::P(s0.x() + sx, s0.y() + sy, z + arch.Uniform(2.4, 3.0)), faces,
-          static_cast<float>(kRoofTileMetres));
-    const int units = arch.UniformInt(0, 3);
-    const int metal[5] = {am.metal, am.metal, am.metal, am.metal, am.metal};
-    for (int i = 0; i < units; ++i) {
-      const Eigen::Vector2d u0 = spot(1.2, 0.8);
-      b.Box(MeshBuilder::P(u0.x(), u0.y(), z), MeshBuilder::P(u0.x() + 1.2, u0.y() + 0.8, z + 0.9), metal);
-    }
-    if (arch.Bernoulli(0.3)) {
-      const double r = arch.Uniform(0.8, 1.2);
-      const Eigen::Vector2d t0 = spot(2 * r, 2 * r);
-      b.Prism(MeshBuilder::P(t0.x() + r, t0.y() + r, 0), static_cast<float>(r), z, z + static_cast<float>(arch.Uniform(2.0, 3.0)), 10,
-              am.metal, am.metal);
-    }
+  const int faces[5] = {trim, trim, trim, trim, am.roof};
+  const float z = static_cast<float>(roof_z);
+  auto spot = [&](double sx, double sy) {
+    return Eigen::Vector2d(arch.Uniform(roof_fp.min.x() + 1.0, roof_fp.max.x() - 1.0 - sx),
+                           arch.Uniform(roof_fp.min.y() + 1.0, roof_fp.max.y() - 1.0 - sy));
+  };
+  const double sx = std::min(room.x() - 2.5, arch.Uniform(2.2, 3.5)),
+               sy = std::min(room.y() - 2.5, arch.Uniform(2.2, 3.5));
+  const Eigen::Vector2d s0 = spot(sx, sy);
+  b.Box(MeshBuilder::P(s0.x(), s0.y(), z), MeshBuilder::P(s0.x() + sx, s0.y() + sy, z + arch.Uniform(2.4, 3.0)), faces,
+        static_cast<float>(kRoofTileMetres));
+  const int units = arch.UniformInt(0, 3);
+  const int metal[5] = {am.metal, am.metal, am.metal, am.metal, am.metal};
+  for (int i = 0; i < units; ++i) {
+    const Eigen::Vector2d u0 = spot(1.2, 0.8);
+    b.Box(MeshBuilder::P(u0.x(), u0.y(), z), MeshBuilder::P(u0.x() + 1.2, u0.y() + 0.8, z + 0.9), metal);
   }
+  if (arch.Bernoulli(0.3)) {
+    const double r = arch.Uniform(0.8, 1.2);
+    const Eigen::Vector2d t0 = spot(2 * r, 2 * r);
+    b.Prism(MeshBuilder::P(t0.x() + r, t0.y() + r, 0), static_cast<float>(r), z,
+            z + static_cast<float>(arch.Uniform(2.0, 3.0)), 10, am.metal, am.metal);
+  }
+}
+
+// One building: storefront ground floor, facade walls, roof, and real geometry that lines up with
+// the facade texture's windows (facade relief that recesses the windows, glass-wall fins,
+// balconies), awnings over the shops, a roofline (cornice, parapet or hipped roof) and rooftop
+// structures. `arch` draws every random choice, in a fixed order per building.
+void AddBuilding(MeshBuilder& b, const BuildingPlan& p, const FacadeLayout& fl, int m_facade, int m_shop,
+                 const ArchitectureMaterials& am, const CityStyle& st, SceneRng& arch) {
+  const StreetFacade facade = MakeStreetFacade(p, fl);
+  const double r_relief = arch.Uniform(), r_balcony = arch.Uniform(), r_roof = arch.Uniform(),
+               r_awning = arch.Uniform(), r_rooftop = arch.Uniform();
+  const bool hip_roof = !p.has_setback && p.height <= 17.0 && fl.style != 3 && r_roof < 0.45;
+
+  AddBuildingWalls(b, p, m_facade, m_shop, am.roof, hip_roof);
+  AddFacadeRelief(b, facade, fl, r_relief, m_facade, arch);
+  if (fl.style != 3 && facade.floors >= 2 && r_balcony < 0.3) AddBalconies(b, facade, am, arch);
+  if (r_awning < 0.45 && facade.length > 3.0) AddAwnings(b, facade, am, st, arch);
+  const int trim = AddRoofline(b, p, hip_roof, r_roof, am, arch);
+  const Box2& roof_fp = p.has_setback ? p.upper_footprint : p.footprint;
+  const Eigen::Vector2d room = roof_fp.max - roof_fp.min;
+  if (!hip_roof && r_rooftop < 0.55 && room.minCoeff() > 5.0) AddRooftopStructures(b, p, trim, am, arch);
 }
 
 // Texture indices of the generated textures (in scene.textures).
