@@ -80,8 +80,8 @@ void AddRenderCommands(CliGroups& groups) {
       if (!args->frames.empty()) ParseFrameRange(args->frames, &options.frame_begin, &options.frame_end);
       if (!args->shard.empty()) ParseShard(args->shard, &options.shard_index, &options.shard_count);
       const RenderSummary s = RenderDataset(options);
-      std::printf("rendered %d frames, skipped %d complete, %d in this shard, %.1f s\n", s.frames_rendered,
-                  s.frames_skipped, s.frames_total, s.seconds);
+      std::printf("rendered %d frames, skipped %d complete, %d in this shard, %.1f s\n%s\n", s.frames_rendered,
+                  s.frames_skipped, s.frames_total, s.seconds, s.rig.c_str());
     });
   }
 

@@ -368,10 +368,7 @@ RenderSummary RenderDataset(const RenderOptions& options) {
   const Trajectory groundtruth(scene.rig_trajectory.begin() + begin, scene.rig_trajectory.begin() + end);
   RenderSummary summary;
   summary.rig = DescribeRigChoice(rig_choice);
-  if (!options.quiet) {
-    std::printf("%s\n", summary.rig.c_str());
-    std::fflush(stdout);
-  }
+  if (!options.quiet) std::fprintf(stderr, "%s\n", summary.rig.c_str());  // before the long part
 
   // The build of the tracer validates the scene's indices (before any output).
   const int spp = options.spp > 0 ? options.spp : kDefaultSpp;

@@ -43,7 +43,8 @@ struct RenderSummary {
 // std::invalid_argument / std::runtime_error naming the file or option for bad input, before any
 // output is written. Resumable: frames whose files all exist are skipped (files appear only by
 // atomic rename). groundtruth.tum and dataset.json cover the whole frame range and are identical
-// from every shard. Images are identical for any thread count.
+// from every shard. Images are identical for any thread count. Unless quiet, prints the rig line
+// (DescribeRigChoice) to stderr before rendering.
 RenderSummary RenderDataset(const RenderOptions& options);
 
 // Samples per pixel when RenderOptions::spp is 0: the cheapest setting whose mean error against a
