@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # Configures and builds rovo (Release, warnings as errors) into build/. Incremental.
+# Usage: ci/build.sh [TARGET...]   (default: everything; e.g. `ci/build.sh rovo` for the executable only)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 launcher=()
 if command -v ccache >/dev/null 2>&1; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DROVO_WERROR=ON "${launcher[@]}" >/dev/null
-cmake --build build -j"$(nproc)"
+targets=()
+for target in "$@"; do targets+=(--target "$target"); done
+cmake --build build -j"$(nproc)" "${targets[@]}"

@@ -162,16 +162,112 @@ void PrintCyclesRatio(const std::string& path, double bench_default_cpu, int spp
               spp_default, cycles / bench_default_cpu);
 }
 
+// One row of the speed table.
+struct BenchRow {
+  std::string name;
+  int spp;
+  bool raw;
+  bool textures = true;
+  bool trilinear = true;
+  double seconds_per_frame = 0;
+  double cpu_seconds_per_frame = 0;
+};
+
+std::vector<BenchRow> BenchRows(int spp_default, bool breakdown) {
+  std::vector<BenchRow> rows = {{"raw cast (same camera + shadow rays)", 1, true}, {"full render", 1, false}};
+  if (spp_default != 1) {
+    rows.push_back({"raw cast (same camera + shadow rays)", spp_default, true});
+    rows.push_back({"full render", spp_default, false});
+  }
+  if (breakdown) {
+    rows.push_back({"full render, bilinear on the nearest mip level", 1, false, true, false});
+    rows.push_back({"full render, no textures", 1, false, false, true});
+  }
+  return rows;
+}
+
+// Times every row over `frames` frames. Rows interleaved frame by frame (one untimed warm-up frame
+// per row first), so that every row sees the same load on a shared machine and the ratios between
+// rows are robust to it.
+void TimeRows(const Scene& scene, const Rig& rig, const std::vector<CameraRays>& rays, Tracer& tracer,
+              tbb::task_arena& arena, int frames, std::vector<BenchRow>* rows) {
+  std::vector<CameraImage> images(rig.NumCameras());
+  auto settings_for = [](const BenchRow& row) {
+    ShadeSettings settings;
+    settings.spp = row.spp;
+    settings.raw_cast_only = row.raw;
+    settings.textures = row.textures;
+    settings.trilinear = row.trilinear;
+    return settings;
+  };
+  auto render_frame = [&](const ShadeSettings& settings, int f) {
+    arena.execute([&] {
+      tracer.SetFrame(f);
+      const Rigid3& world_from_rig = scene.rig_trajectory[f].world_from_rig;
+      for (int c = 0; c < rig.NumCameras(); ++c)
+        tracer.Render(rays[c], world_from_rig * rig.cameras[c].cam_from_rig.Inverse(), settings, &images[c]);
+    });
+  };
+  for (const BenchRow& row : *rows) render_frame(settings_for(row), 0);
+  for (int f = 0; f < frames; ++f) {
+    for (BenchRow& row : *rows) {
+      const auto t = std::chrono::steady_clock::now();
+      const double cpu0 = CpuSeconds();
+      render_frame(settings_for(row), f);
+      row.seconds_per_frame += Seconds(t) / frames;
+      row.cpu_seconds_per_frame += (CpuSeconds() - cpu0) / frames;
+    }
+  }
+}
+
+// Seconds per frame of a full `rovo render` of the frames into options.write_dir.
+double TimeDatasetWriting(const RenderBenchOptions& options, int frames, int spp) {
+  RenderOptions ro;
+  ro.preset = options.scene_dir.empty() ? options.preset : "";
+  ro.scene_dir = options.scene_dir;
+  ro.seed = options.seed;
+  ro.out_dir = options.write_dir;
+  ro.frame_end = frames;
+  ro.scale = options.scale;
+  ro.threads = options.threads;
+  ro.spp = spp;
+  ro.quiet = true;
+  const RenderSummary s = RenderDataset(ro);
+  return s.frames_rendered > 0 ? s.seconds / s.frames_rendered : -1.0;
+}
+
+// The speed table and the ratios against the targets.
+void PrintRowTable(const std::vector<BenchRow>& rows, int64_t valid_pixels, int spp_default) {
+  std::printf("\n| mode | spp | wall s/frame | CPU s/frame | camera Mrays/s (wall) | camera Mrays/CPU-s |\n"
+              "|---|---:|---:|---:|---:|---:|\n");
+  for (const BenchRow& row : rows) {
+    const double rays_per_frame = valid_pixels * static_cast<double>(row.spp);
+    std::printf("| %s | %d | %.3f | %.3f | %.1f | %.1f |\n", row.name.c_str(), row.spp, row.seconds_per_frame,
+                row.cpu_seconds_per_frame, rays_per_frame / row.seconds_per_frame / 1e6,
+                rays_per_frame / row.cpu_seconds_per_frame / 1e6);
+  }
+  std::printf("\nfull/raw at 1 spp: wall %.2f, CPU %.2f (target <= 1.5)\n",
+              rows[1].seconds_per_frame / rows[0].seconds_per_frame,
+              rows[1].cpu_seconds_per_frame / rows[0].cpu_seconds_per_frame);
+  const BenchRow& full_default = spp_default != 1 ? rows[3] : rows[1];
+  if (spp_default != 1)
+    std::printf("full/raw at %d spp: wall %.2f, CPU %.2f\n", spp_default,
+                rows[3].seconds_per_frame / rows[2].seconds_per_frame,
+                rows[3].cpu_seconds_per_frame / rows[2].cpu_seconds_per_frame);
+  std::printf("default quality (%d spp): %.3f s/frame wall, %.3f CPU s/frame (target <= 1 s wall on 2 idle cores)\n",
+              spp_default, full_default.seconds_per_frame, full_default.cpu_seconds_per_frame);
+}
+
 }  // namespace
 
 void RunRenderBenchmark(const RenderBenchOptions& options) {
   if (options.frames < 1) throw std::invalid_argument("--frames: must be >= 1");
   const double load_before = LoadAverage();
   const auto t_scene = std::chrono::steady_clock::now();
-  const Scene scene = SceneForOptions(options.scene_dir.empty() ? options.preset : "", false, options.seed,
-                                      options.scene_dir);
+  const Scene scene =
+      SceneForOptions(options.scene_dir.empty() ? options.preset : "", false, options.seed, options.scene_dir);
   const double scene_seconds = Seconds(t_scene);
-  const Rig rig = RigForOptions("", scene, options.scale);
+  const Rig rig = RigForOptions("", scene, options.scale, options.scene_dir);
   const int frames = std::min<int>(options.frames, static_cast<int>(scene.rig_trajectory.size()));
   const int spp_default = options.spp > 0 ? options.spp : kDefaultSpp;
 
@@ -190,69 +286,10 @@ void RunRenderBenchmark(const RenderBenchOptions& options) {
   int64_t valid_pixels = 0;
   for (const CameraRays& r : rays) valid_pixels += r.num_valid;
 
-  struct Row {
-    std::string name;
-    int spp;
-    bool raw;
-    bool textures = true;
-    bool trilinear = true;
-    double seconds_per_frame = 0;
-    double cpu_seconds_per_frame = 0;
-  };
-  std::vector<Row> rows = {{"raw cast (same camera + shadow rays)", 1, true}, {"full render", 1, false}};
-  if (spp_default != 1) {
-    rows.push_back({"raw cast (same camera + shadow rays)", spp_default, true});
-    rows.push_back({"full render", spp_default, false});
-  }
-  if (options.breakdown) {
-    rows.push_back({"full render, bilinear on the nearest mip level", 1, false, true, false});
-    rows.push_back({"full render, no textures", 1, false, false, true});
-  }
-  // Rows interleaved frame by frame (one untimed warm-up frame per row first), so that every row
-  // sees the same load on a shared machine and the ratios between rows are robust to it.
-  std::vector<CameraImage> images(rig.NumCameras());
-  auto settings_for = [](const Row& row) {
-    ShadeSettings settings;
-    settings.spp = row.spp;
-    settings.raw_cast_only = row.raw;
-    settings.textures = row.textures;
-    settings.trilinear = row.trilinear;
-    return settings;
-  };
-  auto render_frame = [&](const ShadeSettings& settings, int f) {
-    arena.execute([&] {
-      tracer->SetFrame(f);
-      const Rigid3& world_from_rig = scene.rig_trajectory[f].world_from_rig;
-      for (int c = 0; c < rig.NumCameras(); ++c)
-        tracer->Render(rays[c], world_from_rig * rig.cameras[c].cam_from_rig.Inverse(), settings, &images[c]);
-    });
-  };
-  for (const Row& row : rows) render_frame(settings_for(row), 0);
-  for (int f = 0; f < frames; ++f) {
-    for (Row& row : rows) {
-      const auto t = std::chrono::steady_clock::now();
-      const double cpu0 = CpuSeconds();
-      render_frame(settings_for(row), f);
-      row.seconds_per_frame += Seconds(t) / frames;
-      row.cpu_seconds_per_frame += (CpuSeconds() - cpu0) / frames;
-    }
-  }
-
-  double write_seconds_per_frame = -1.0;
-  if (!options.write_dir.empty()) {
-    RenderOptions ro;
-    ro.preset = options.scene_dir.empty() ? options.preset : "";
-    ro.scene_dir = options.scene_dir;
-    ro.seed = options.seed;
-    ro.out_dir = options.write_dir;
-    ro.frame_end = frames;
-    ro.scale = options.scale;
-    ro.threads = options.threads;
-    ro.spp = spp_default;
-    ro.quiet = true;
-    const RenderSummary s = RenderDataset(ro);
-    write_seconds_per_frame = s.frames_rendered > 0 ? s.seconds / s.frames_rendered : -1.0;
-  }
+  std::vector<BenchRow> rows = BenchRows(spp_default, options.breakdown);
+  TimeRows(scene, rig, rays, *tracer, arena, frames, &rows);
+  const double write_seconds_per_frame =
+      options.write_dir.empty() ? -1.0 : TimeDatasetWriting(options, frames, spp_default);
 
   const Camera& cam0 = rig.cameras[0].camera;
   std::printf("rovo bench render: %s, %d frames, rig %d x %dx%d, threads %d, load average %.1f before / %.1f after\n",
@@ -260,28 +297,13 @@ void RunRenderBenchmark(const RenderBenchOptions& options) {
               rig.NumCameras(), cam0.width, cam0.height,
               options.threads > 0 ? options.threads : tbb::this_task_arena::max_concurrency(), load_before,
               LoadAverage());
-  std::printf("scene: %zu static triangles, %zu objects; generate/load %.2f s; static BVH build %.3f s; "
-              "pixel and sample bearings (%d spp) %.2f s\n",
-              tracer->num_static_triangles(), scene.objects.size(), scene_seconds, tracer->static_build_seconds(),
-              spp_default, rays_seconds);
-  std::printf("\n| mode | spp | wall s/frame | CPU s/frame | camera Mrays/s (wall) | camera Mrays/CPU-s |\n"
-              "|---|---:|---:|---:|---:|---:|\n");
-  for (const Row& row : rows) {
-    const double rays_per_frame = valid_pixels * static_cast<double>(row.spp);
-    std::printf("| %s | %d | %.3f | %.3f | %.1f | %.1f |\n", row.name.c_str(), row.spp, row.seconds_per_frame,
-                row.cpu_seconds_per_frame, rays_per_frame / row.seconds_per_frame / 1e6,
-                rays_per_frame / row.cpu_seconds_per_frame / 1e6);
-  }
-  std::printf("\nfull/raw at 1 spp: wall %.2f, CPU %.2f (target <= 1.5)\n",
-              rows[1].seconds_per_frame / rows[0].seconds_per_frame,
-              rows[1].cpu_seconds_per_frame / rows[0].cpu_seconds_per_frame);
-  const Row& full_default = spp_default != 1 ? rows[3] : rows[1];
-  if (spp_default != 1)
-    std::printf("full/raw at %d spp: wall %.2f, CPU %.2f\n", spp_default,
-                rows[3].seconds_per_frame / rows[2].seconds_per_frame,
-                rows[3].cpu_seconds_per_frame / rows[2].cpu_seconds_per_frame);
-  std::printf("default quality (%d spp): %.3f s/frame wall, %.3f CPU s/frame (target <= 1 s wall on 2 idle cores)\n",
-              spp_default, full_default.seconds_per_frame, full_default.cpu_seconds_per_frame);
+  std::printf(
+      "scene: %zu static triangles, %zu objects; generate/load %.2f s; static BVH build %.3f s; "
+      "pixel and sample bearings (%d spp) %.2f s\n",
+      tracer->num_static_triangles(), scene.objects.size(), scene_seconds, tracer->static_build_seconds(), spp_default,
+      rays_seconds);
+  PrintRowTable(rows, valid_pixels, spp_default);
+  const BenchRow& full_default = spp_default != 1 ? rows[3] : rows[1];
   if (write_seconds_per_frame >= 0.0)
     std::printf("rovo render incl. PNG writing (%d spp): %.3f s/frame (includes scene generation and set-up)\n",
                 spp_default, write_seconds_per_frame);

@@ -57,7 +57,10 @@ void AddRenderCommands(CliGroups& groups) {
     auto* scene = cmd->add_option("--scene", args->options.scene_dir, "Scene folder (scenes/FORMAT.md)");
     preset->excludes(scene);
     cmd->add_flag("--quick", args->options.quick, "The preset's quick form: fewer frames, smaller images");
-    cmd->add_option("--rig", args->options.rig, "Rig preset (rovo4, omnimvs4, rovo4_real) or rig.json; default: the scene's");
+    cmd->add_option(
+        "--rig", args->options.rig,
+        "Rig preset (rovo4, omnimvs4, rovo4_real) or rig.json; default: the scene folder's rig.json, else the "
+        "scene's rig_preset, else rovo4 (the rig used is printed)");
     cmd->add_option("--out", args->options.out_dir, "Output dataset folder")->required();
     cmd->add_option("--frames", args->frames, "Trajectory frame range A:B (B exclusive; default: all)");
     cmd->add_option("--shard", args->shard, "Render only shard I of N (chunks of 8 frames), e.g. 0/4");
@@ -77,8 +80,8 @@ void AddRenderCommands(CliGroups& groups) {
       if (!args->frames.empty()) ParseFrameRange(args->frames, &options.frame_begin, &options.frame_end);
       if (!args->shard.empty()) ParseShard(args->shard, &options.shard_index, &options.shard_count);
       const RenderSummary s = RenderDataset(options);
-      std::printf("rendered %d frames, skipped %d complete, %d in this shard, %.1f s\n", s.frames_rendered,
-                  s.frames_skipped, s.frames_total, s.seconds);
+      std::printf("rendered %d frames, skipped %d complete, %d in this shard, %.1f s\n%s\n", s.frames_rendered,
+                  s.frames_skipped, s.frames_total, s.seconds, s.rig.c_str());
     });
   }
 

@@ -82,7 +82,7 @@ void RenderScenePreview(const PreviewOptions& options) {
   if (options.spp < 1) throw std::invalid_argument("--spp: must be >= 1");
   if (options.width < 0) throw std::invalid_argument("--width: must be >= 0");
   const Scene scene = SceneForOptions(options.preset, true, options.seed, options.scene_dir);
-  const Rig rig = RigForOptions(options.rig, scene, options.scale);
+  const Rig rig = RigForOptions(options.rig, scene, options.scale, options.scene_dir);
   const int num_traj = static_cast<int>(scene.rig_trajectory.size());
   if (num_traj == 0) throw std::runtime_error("scene: trajectory: the scene has no rig poses");
   std::vector<int> frames = options.frames;

@@ -12,6 +12,7 @@
 
 #include <chrono>
 #include <condition_variable>
+#include <cstdio>
 #include <deque>
 #include <exception>
 #include <filesystem>
@@ -168,20 +169,44 @@ Scene SceneForOptions(const std::string& preset, bool quick, uint64_t seed, cons
   return LoadScene(scene_dir);
 }
 
-Rig RigForOptions(const std::string& rig, const Scene& scene, double scale) {
+RigChoice ChooseRig(const std::string& rig, const Scene& scene, const std::string& scene_dir, double scale) {
   if (scale < 0.0 || scale > 4.0) throw std::invalid_argument("--scale " + std::to_string(scale) + ": must be in (0, 4]");
-  Rig result;
-  if (rig.empty()) {
-    result = MakeRigPreset(scene.rig_preset.empty() ? "rovo4" : scene.rig_preset);
-  } else if (EndsWith(rig, ".json")) {
+  const std::string scene_rig_json = scene_dir.empty() ? "" : (fs::path(scene_dir) / "rig.json").string();
+  RigChoice choice;
+  if (!rig.empty() && EndsWith(rig, ".json")) {
     if (!fs::exists(rig)) throw std::runtime_error(rig + ": rig file does not exist");
-    result = ReadRigJson(rig);
+    choice.rig = ReadRigJson(rig);
+    choice.source = rig + " (--rig)";
+  } else if (!rig.empty()) {
+    choice.rig = MakeRigPreset(rig);
+    choice.source = "preset " + rig + " (--rig)";
+  } else if (!scene_rig_json.empty() && fs::exists(scene_rig_json)) {
+    choice.rig = ReadRigJson(scene_rig_json);
+    choice.source = scene_rig_json + " (the scene's rig.json)";
+  } else if (!scene.rig_preset.empty()) {
+    choice.rig = MakeRigPreset(scene.rig_preset);
+    choice.source = "preset " + scene.rig_preset + " (the scene's rig_preset)";
   } else {
-    result = MakeRigPreset(rig);
+    choice.rig = MakeRigPreset("rovo4");
+    choice.source = "preset rovo4 (the default: the scene names no rig)";
   }
-  if (scale > 0.0 && scale != 1.0) result = result.Scaled(scale);
-  result.Check("rig");
-  return result;
+  if (scale > 0.0 && scale != 1.0) choice.rig = choice.rig.Scaled(scale);
+  choice.rig.Check("rig from " + choice.source);
+  return choice;
+}
+
+Rig RigForOptions(const std::string& rig, const Scene& scene, double scale, const std::string& scene_dir) {
+  return ChooseRig(rig, scene, scene_dir, scale).rig;
+}
+
+std::string DescribeRigChoice(const RigChoice& choice) {
+  std::string cameras;
+  for (const RigCamera& cam : choice.rig.cameras) {
+    const std::string one = CameraModelName(cam.camera.model) + " " + std::to_string(cam.camera.width) + "x" +
+                            std::to_string(cam.camera.height);
+    if (cameras.find(one) == std::string::npos) cameras += (cameras.empty() ? "" : ", ") + one;
+  }
+  return "rig: " + choice.source + ": " + std::to_string(choice.rig.NumCameras()) + " cameras, " + cameras;
 }
 
 bool FrameComplete(const std::string& out_dir, const Rig& rig, int frame, bool depth, bool masks) {
@@ -194,9 +219,10 @@ bool FrameComplete(const std::string& out_dir, const Rig& rig, int frame, bool d
   return true;
 }
 
-RenderSummary RenderDataset(const RenderOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  // ---- Validate everything before writing anything.
+namespace {
+
+// Option checks that need no scene; throws naming the option.
+void CheckRenderOptions(const RenderOptions& options) {
   if (options.out_dir.empty()) throw std::invalid_argument("--out: an output folder is required");
   if (options.shard_count < 1 || options.shard_index < 0 || options.shard_index >= options.shard_count)
     throw std::invalid_argument("--shard " + std::to_string(options.shard_index) + "/" +
@@ -205,28 +231,22 @@ RenderSummary RenderDataset(const RenderOptions& options) {
   if (options.threads < 0) throw std::invalid_argument("--threads: must be >= 0");
   if (options.noise_sigma < 0.0f || options.vignetting < 0.0f || options.vignetting > 1.0f)
     throw std::invalid_argument("--noise must be >= 0 and --vignetting in [0, 1]");
+}
 
-  const Scene scene = SceneForOptions(options.preset, options.quick, options.seed, options.scene_dir);
-  const std::string scene_name = options.preset.empty() ? options.scene_dir : "preset " + options.preset;
-  const int num_traj = static_cast<int>(scene.rig_trajectory.size());
+// The scene has a trajectory and every dynamic object has one pose per trajectory frame.
+void CheckSceneMotion(const Scene& scene, const std::string& scene_name) {
+  const size_t num_traj = scene.rig_trajectory.size();
   if (num_traj == 0) throw std::runtime_error(scene_name + ": trajectory: the scene has no rig poses");
   for (const Object& obj : scene.objects) {
-    if (obj.IsDynamic() && static_cast<int>(obj.world_from_object_per_frame.size()) != num_traj)
+    if (obj.IsDynamic() && obj.world_from_object_per_frame.size() != num_traj)
       throw std::runtime_error(scene_name + ": object '" + obj.name + "': " +
                                std::to_string(obj.world_from_object_per_frame.size()) +
                                " motion frames for a trajectory of " + std::to_string(num_traj));
   }
-  double scale = options.scale;
-  if (scale == 0.0) scale = options.quick && !options.preset.empty() ? FindScenePreset(options.preset).quick_scale : 1.0;
-  const Rig rig = RigForOptions(options.rig, scene, scale);
+}
 
-  const int begin = options.frame_begin;
-  const int end = options.frame_end < 0 ? num_traj : options.frame_end;
-  if (begin < 0 || begin >= end || end > num_traj)
-    throw std::out_of_range("--frames " + std::to_string(begin) + ":" + std::to_string(options.frame_end) +
-                            ": outside the trajectory of " + scene_name + " (frames 0:" + std::to_string(num_traj) + ")");
-  const int count = end - begin;
-
+// dataset.json of `count` frames rendered with `rig`.
+DatasetInfo MakeDatasetInfo(const RenderOptions& options, const Scene& scene, const Rig& rig, int count) {
   DatasetInfo info;
   info.generator = "rovo render";
   info.generator_version = ROVO_VERSION;
@@ -241,47 +261,47 @@ RenderSummary RenderDataset(const RenderOptions& options) {
   }
   info.has_depth = options.depth;
   info.has_masks = options.masks;
-  Trajectory groundtruth(scene.rig_trajectory.begin() + begin, scene.rig_trajectory.begin() + end);
+  return info;
+}
 
-  // The build of the tracer validates the scene's indices (before any output).
-  const int spp = options.spp > 0 ? options.spp : kDefaultSpp;
-  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
-  std::unique_ptr<Tracer> tracer;
-  arena.execute([&] { tracer = std::make_unique<Tracer>(scene); });
+void PrepareDir(const std::string& file_in_dir) {
+  const std::string dir = fs::path(file_in_dir).parent_path().string();
+  EnsureWritableDir(dir);
+  RemoveStaleTempFiles(dir);
+}
 
-  // ---- Output folder and the whole-range files (identical from every shard).
+// The output folder, its whole-range files (identical from every shard) and the per-camera folders.
+void PrepareOutput(const RenderOptions& options, const DatasetInfo& info, const Trajectory& groundtruth) {
   EnsureWritableDir(options.out_dir);
   CheckExistingDataset(options.out_dir, info);
   WriteTum(GroundTruthPath(options.out_dir), groundtruth);
   WriteDatasetInfo(options.out_dir, info);
-  for (const RigCamera& cam : rig.cameras) {
-    const std::string dir = fs::path(ImagePath(options.out_dir, cam.name, 0)).parent_path().string();
-    EnsureWritableDir(dir);
-    RemoveStaleTempFiles(dir);
-    if (options.depth) {
-      const std::string ddir = fs::path(DepthPath(options.out_dir, cam.name, 0)).parent_path().string();
-      EnsureWritableDir(ddir);
-      RemoveStaleTempFiles(ddir);
-    }
-    if (options.masks) {
-      const std::string mdir = fs::path(MaskPath(options.out_dir, cam.name, 0)).parent_path().string();
-      EnsureWritableDir(mdir);
-      RemoveStaleTempFiles(mdir);
-    }
+  for (const RigCamera& cam : info.rig.cameras) {
+    PrepareDir(ImagePath(options.out_dir, cam.name, 0));
+    if (options.depth) PrepareDir(DepthPath(options.out_dir, cam.name, 0));
+    if (options.masks) PrepareDir(MaskPath(options.out_dir, cam.name, 0));
   }
+}
 
-  RenderSummary summary;
+// Dataset frames of this shard that are not complete on disk; counts the shard's frames in `summary`.
+std::vector<int> FramesToRender(const RenderOptions& options, const Rig& rig, int count, RenderSummary* summary) {
   std::vector<int> todo;
   for (int f = 0; f < count; ++f) {
     if ((f / kShardChunkFrames) % options.shard_count != options.shard_index) continue;
-    ++summary.frames_total;
+    ++summary->frames_total;
     if (FrameComplete(options.out_dir, rig, f, options.depth, options.masks)) {
-      ++summary.frames_skipped;
+      ++summary->frames_skipped;
       continue;
     }
     todo.push_back(f);
   }
+  return todo;
+}
 
+// Renders the dataset frames `todo` (trajectory frames begin + f) and writes them beside the tracer.
+void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& rig, int begin,
+                  const std::vector<int>& todo, int spp, tbb::task_arena& arena, Tracer& tracer,
+                  RenderSummary* summary) {
   std::vector<CameraRays> rays;
   arena.execute([&] {
     std::vector<Camera> cameras;
@@ -306,19 +326,59 @@ RenderSummary RenderDataset(const RenderOptions& options) {
       job.dataset_frame = f;
       job.images.resize(rig.NumCameras());
       arena.execute([&] {
-        tracer->SetFrame(traj_frame);
+        tracer.SetFrame(traj_frame);
         for (int c = 0; c < rig.NumCameras(); ++c) {
           const Rigid3 world_from_cam = world_from_rig * rig.cameras[c].cam_from_rig.Inverse();
           settings.noise_seed = SplitMix(options.seed ^ SplitMix(static_cast<uint64_t>(traj_frame) * 16 + c));
-          tracer->Render(rays[c], world_from_cam, settings, &job.images[c]);
+          tracer.Render(rays[c], world_from_cam, settings, &job.images[c]);
         }
       });
       writer.Push(std::move(job));
-      ++summary.frames_rendered;
+      ++summary->frames_rendered;
     }
     writer.Close();
   }
   progress.Finish();
+}
+
+}  // namespace
+
+RenderSummary RenderDataset(const RenderOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  // ---- Validate everything before writing anything.
+  CheckRenderOptions(options);
+  const Scene scene = SceneForOptions(options.preset, options.quick, options.seed, options.scene_dir);
+  const std::string scene_name = options.preset.empty() ? options.scene_dir : "preset " + options.preset;
+  CheckSceneMotion(scene, scene_name);
+  const int num_traj = static_cast<int>(scene.rig_trajectory.size());
+  double scale = options.scale;
+  if (scale == 0.0)
+    scale = options.quick && !options.preset.empty() ? FindScenePreset(options.preset).quick_scale : 1.0;
+  const RigChoice rig_choice = ChooseRig(options.rig, scene, options.scene_dir, scale);
+  const Rig& rig = rig_choice.rig;
+
+  const int begin = options.frame_begin;
+  const int end = options.frame_end < 0 ? num_traj : options.frame_end;
+  if (begin < 0 || begin >= end || end > num_traj)
+    throw std::out_of_range("--frames " + std::to_string(begin) + ":" + std::to_string(options.frame_end) +
+                            ": outside the trajectory of " + scene_name + " (frames 0:" + std::to_string(num_traj) +
+                            ")");
+  const int count = end - begin;
+  const DatasetInfo info = MakeDatasetInfo(options, scene, rig, count);
+  const Trajectory groundtruth(scene.rig_trajectory.begin() + begin, scene.rig_trajectory.begin() + end);
+  RenderSummary summary;
+  summary.rig = DescribeRigChoice(rig_choice);
+  if (!options.quiet) std::fprintf(stderr, "%s\n", summary.rig.c_str());  // before the long part
+
+  // The build of the tracer validates the scene's indices (before any output).
+  const int spp = options.spp > 0 ? options.spp : kDefaultSpp;
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+  std::unique_ptr<Tracer> tracer;
+  arena.execute([&] { tracer = std::make_unique<Tracer>(scene); });
+
+  PrepareOutput(options, info, groundtruth);
+  const std::vector<int> todo = FramesToRender(options, rig, count, &summary);
+  RenderFrames(options, scene, rig, begin, todo, spp, arena, *tracer, &summary);
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
 }

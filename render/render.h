@@ -14,7 +14,7 @@ struct RenderOptions {
   std::string preset;          // scenes preset to generate and render, or ""
   bool quick = false;          // the preset's quick form (fewer frames, smaller images)
   std::string scene_dir;       // or a scene folder (scenes/FORMAT.md)
-  std::string rig;             // rig preset name or rig .json path; "" = the scene's rig preset
+  std::string rig;             // rig preset name or rig .json path; "" = the scene's rig (ChooseRig)
   std::string out_dir;         // dataset folder
   int frame_begin = 0;         // [frame_begin, frame_end) of the trajectory; -1 = to the end
   int frame_end = -1;
@@ -36,13 +36,15 @@ struct RenderSummary {
   int frames_rendered = 0;
   int frames_skipped = 0;      // already complete on disk (resume)
   double seconds = 0.0;
+  std::string rig;             // the rig used and where it came from (DescribeRigChoice)
 };
 
 // Renders the frames of `options` (see RenderOptions) into options.out_dir. Throws
 // std::invalid_argument / std::runtime_error naming the file or option for bad input, before any
 // output is written. Resumable: frames whose files all exist are skipped (files appear only by
 // atomic rename). groundtruth.tum and dataset.json cover the whole frame range and are identical
-// from every shard. Images are identical for any thread count.
+// from every shard. Images are identical for any thread count. Unless quiet, prints the rig line
+// (DescribeRigChoice) to stderr before rendering.
 RenderSummary RenderDataset(const RenderOptions& options);
 
 // Samples per pixel when RenderOptions::spp is 0: the cheapest setting whose mean error against a
@@ -57,9 +59,20 @@ inline constexpr int kNumPerturbedSets = 5;
 
 // The scene of a preset (generated) or a scene folder (loaded); exactly one must be non-empty.
 Scene SceneForOptions(const std::string& preset, bool quick, uint64_t seed, const std::string& scene_dir);
-// `rig` is a preset name, a rig.json/dataset.json path, or "" for the scene's preset ("rovo4" if
-// none); `scale` 0 means 1.
-Rig RigForOptions(const std::string& rig, const Scene& scene, double scale);
+// The rig of a render and where it came from.
+struct RigChoice {
+  Rig rig;
+  std::string source;  // e.g. "scene/rig.json (the scene's rig.json)", "preset rovo4 (--rig)"
+};
+// The first that applies: `rig` (a preset name, or a rig.json/dataset.json path); <scene_dir>/rig.json
+// (written by scenes/blender/export_scene.py); the scene's rig_preset; "rovo4". `scale` 0 means 1.
+// Throws naming the file or option.
+RigChoice ChooseRig(const std::string& rig, const Scene& scene, const std::string& scene_dir, double scale);
+// ChooseRig's rig.
+Rig RigForOptions(const std::string& rig, const Scene& scene, double scale, const std::string& scene_dir = "");
+// One line: the source, the camera count, model and image size, e.g.
+// "rig: preset rovo4 (the scene's rig_preset): 4 cameras, equidistant 1024x1024".
+std::string DescribeRigChoice(const RigChoice& choice);
 // True when every file of dataset frame `frame` exists under its final name.
 bool FrameComplete(const std::string& out_dir, const Rig& rig, int frame, bool depth, bool masks);
 

@@ -281,6 +281,12 @@ struct Tracer::Impl {
 
   explicit Impl(const Scene& s) : scene(s) {}
 
+  // Steps of the Tracer constructor.
+  void BuildShadeRecords();
+  void BuildStaticScene(size_t* num_static_triangles, double* build_seconds);
+  void BuildTopScene();
+  void SetUpLighting();
+
   ~Impl() {
     if (top) rtcReleaseScene(top);
     if (static_scene) rtcReleaseScene(static_scene);
@@ -318,9 +324,10 @@ struct Tracer::Impl {
   }
 };
 
-Tracer::Tracer(const Scene& scene) : impl_(std::make_unique<Impl>(scene)) {
-  Impl& d = *impl_;
-  // Validate indices first: bad input must fail with a message naming the culprit.
+namespace {
+
+// Index checks before anything is built: bad input fails with a message naming the culprit.
+void ValidateSceneIndices(const Scene& scene) {
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     const Mesh& mesh = scene.meshes[m];
     const std::string what = "mesh '" + mesh.name + "'";
@@ -347,18 +354,24 @@ Tracer::Tracer(const Scene& scene) : impl_(std::make_unique<Impl>(scene)) {
   for (const Object& obj : scene.objects)
     if (obj.mesh < 0 || obj.mesh >= static_cast<int>(scene.meshes.size()))
       throw std::invalid_argument("object '" + obj.name + "': mesh index " + std::to_string(obj.mesh) + " out of range");
+}
 
-  d.textures.reserve(scene.textures.size());
-  for (const Texture& tex : scene.textures) d.textures.emplace_back(tex);
+}  // namespace
+
+// Textures, per-triangle shading records (UV-to-object area ratio; rigid transforms keep areas),
+// the per-object and per-material shading tables.
+void Tracer::Impl::BuildShadeRecords() {
+  textures.reserve(scene.textures.size());
+  for (const Texture& tex : scene.textures) textures.emplace_back(tex);
 
   // Per-triangle shading records; UV-to-object area ratio (rigid transforms keep areas).
-  d.mesh_shade.resize(scene.meshes.size());
+  mesh_shade.resize(scene.meshes.size());
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     const Mesh& mesh = scene.meshes[m];
-    std::vector<Impl::TriangleShade>& shade = d.mesh_shade[m];
+    std::vector<TriangleShade>& shade = mesh_shade[m];
     shade.resize(mesh.triangles.size());
     for (size_t i = 0; i < mesh.triangles.size(); ++i) {
-      Impl::TriangleShade& ts = shade[i];
+      TriangleShade& ts = shade[i];
       ts.material = mesh.triangle_materials.empty() ? mesh.material : mesh.triangle_materials[i];
       std::fill(std::begin(ts.uv), std::end(ts.uv), 0.0f);
       ts.texels_per_metre = -1.0f;
@@ -376,109 +389,126 @@ Tracer::Tracer(const Scene& scene) : impl_(std::make_unique<Impl>(scene)) {
       const Eigen::Vector2f e1 = mesh.uvs[tri[1]] - mesh.uvs[tri[0]];
       const Eigen::Vector2f e2 = mesh.uvs[tri[2]] - mesh.uvs[tri[0]];
       const float uv_area = std::abs(e1.x() * e2.y() - e1.y() * e2.x());
-      ts.texels_per_metre = area > 0.0f ? std::sqrt(uv_area / area) * d.textures[texture].TexelsPerUv() : 0.0f;
+      ts.texels_per_metre = area > 0.0f ? std::sqrt(uv_area / area) * textures[texture].TexelsPerUv() : 0.0f;
     }
   }
-  d.object_mesh.resize(scene.objects.size());
-  d.object_shade.resize(scene.objects.size());
+  object_mesh.resize(scene.objects.size());
+  object_shade.resize(scene.objects.size());
   for (size_t o = 0; o < scene.objects.size(); ++o) {
-    d.object_mesh[o] = scene.objects[o].mesh;
-    d.object_shade[o] = d.mesh_shade[scene.objects[o].mesh].data();
+    object_mesh[o] = scene.objects[o].mesh;
+    object_shade[o] = mesh_shade[scene.objects[o].mesh].data();
   }
-  d.shade_materials.resize(scene.materials.size());
+  shade_materials.resize(scene.materials.size());
   for (size_t m = 0; m < scene.materials.size(); ++m) {
     const Material& mat = scene.materials[m];
-    Impl::ShadeMaterial& sm = d.shade_materials[m];
+    ShadeMaterial& sm = shade_materials[m];
     for (int k = 0; k < 3; ++k) sm.base_color[k] = mat.base_color[k];
     sm.base_color[3] = 0.0f;
-    sm.texture = mat.texture >= 0 ? &d.textures[mat.texture] : nullptr;
+    sm.texture = mat.texture >= 0 ? &textures[mat.texture] : nullptr;
   }
+}
 
-  d.device = rtcNewDevice(nullptr);
-  if (!d.device) throw std::runtime_error("cannot create the Embree device");
-
+// The static BVH: every static object's triangles in world coordinates; a BVH per mesh of a
+// dynamic object.
+void Tracer::Impl::BuildStaticScene(size_t* num_static_triangles, double* build_seconds) {
   const auto start = std::chrono::steady_clock::now();
-  d.static_scene = rtcNewScene(d.device);
+  static_scene = rtcNewScene(device);
   // Robust mode keeps the triangle test watertight along edges shared by separate meshes (a ray
   // exactly along a room corner must not slip through).
-  rtcSetSceneFlags(d.static_scene, RTC_SCENE_FLAG_ROBUST);
-  rtcSetSceneBuildQuality(d.static_scene, RTC_BUILD_QUALITY_HIGH);
-  d.object_rotation.assign(scene.objects.size(), Eigen::Matrix3f::Identity());
-  d.mesh_scenes.assign(scene.meshes.size(), nullptr);
+  rtcSetSceneFlags(static_scene, RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(static_scene, RTC_BUILD_QUALITY_HIGH);
+  object_rotation.assign(scene.objects.size(), Eigen::Matrix3f::Identity());
+  mesh_scenes.assign(scene.meshes.size(), nullptr);
   for (size_t o = 0; o < scene.objects.size(); ++o) {
     const Object& obj = scene.objects[o];
     const Mesh& mesh = scene.meshes[obj.mesh];
     if (mesh.triangles.empty()) continue;
     if (obj.IsDynamic()) {
-      if (!d.mesh_scenes[obj.mesh]) {
-        RTCScene ms = rtcNewScene(d.device);
+      if (!mesh_scenes[obj.mesh]) {
+        RTCScene ms = rtcNewScene(device);
         rtcSetSceneFlags(ms, RTC_SCENE_FLAG_ROBUST);
         rtcSetSceneBuildQuality(ms, RTC_BUILD_QUALITY_HIGH);
-        RTCGeometry g = d.MakeTriangles(mesh, nullptr, RTC_BUILD_QUALITY_HIGH);
+        RTCGeometry g = MakeTriangles(mesh, nullptr, RTC_BUILD_QUALITY_HIGH);
         rtcAttachGeometry(ms, g);
         rtcReleaseGeometry(g);
         rtcCommitScene(ms);
-        d.mesh_scenes[obj.mesh] = ms;
+        mesh_scenes[obj.mesh] = ms;
       }
-      d.dynamic_objects.push_back(static_cast<int>(o));
+      dynamic_objects.push_back(static_cast<int>(o));
       continue;
     }
-    RTCGeometry g = d.MakeTriangles(mesh, &obj.world_from_object, RTC_BUILD_QUALITY_HIGH);
-    const unsigned id = rtcAttachGeometry(d.static_scene, g);
+    RTCGeometry g = MakeTriangles(mesh, &obj.world_from_object, RTC_BUILD_QUALITY_HIGH);
+    const unsigned id = rtcAttachGeometry(static_scene, g);
     rtcReleaseGeometry(g);
-    if (d.static_geom_object.size() <= id) d.static_geom_object.resize(id + 1, -1);
-    d.static_geom_object[id] = static_cast<int>(o);
-    num_static_triangles_ += mesh.triangles.size();
+    if (static_geom_object.size() <= id) static_geom_object.resize(id + 1, -1);
+    static_geom_object[id] = static_cast<int>(o);
+    *num_static_triangles += mesh.triangles.size();
   }
-  rtcCommitScene(d.static_scene);
-  d.static_geom_shade.assign(d.static_geom_object.size(), nullptr);
-  for (size_t id = 0; id < d.static_geom_object.size(); ++id)
-    if (d.static_geom_object[id] >= 0) d.static_geom_shade[id] = d.object_shade[d.static_geom_object[id]];
-  static_build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  d.CheckDevice("building the static scene");
+  rtcCommitScene(static_scene);
+  static_geom_shade.assign(static_geom_object.size(), nullptr);
+  for (size_t id = 0; id < static_geom_object.size(); ++id)
+    if (static_geom_object[id] >= 0) static_geom_shade[id] = object_shade[static_geom_object[id]];
+  *build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  CheckDevice("building the static scene");
+}
 
-  d.top = rtcNewScene(d.device);
-  rtcSetSceneFlags(d.top, static_cast<RTCSceneFlags>(RTC_SCENE_FLAG_DYNAMIC | RTC_SCENE_FLAG_ROBUST));
-  rtcSetSceneBuildQuality(d.top, RTC_BUILD_QUALITY_LOW);
+// The top-level scene: the static BVH as one instance plus an instance per dynamic object.
+void Tracer::Impl::BuildTopScene() {
+  top = rtcNewScene(device);
+  rtcSetSceneFlags(top, static_cast<RTCSceneFlags>(RTC_SCENE_FLAG_DYNAMIC | RTC_SCENE_FLAG_ROBUST));
+  rtcSetSceneBuildQuality(top, RTC_BUILD_QUALITY_LOW);
   {
-    RTCGeometry inst = rtcNewGeometry(d.device, RTC_GEOMETRY_TYPE_INSTANCE);
-    rtcSetGeometryInstancedScene(inst, d.static_scene);
+    RTCGeometry inst = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(inst, static_scene);
     const float identity[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
     rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, identity);
     rtcCommitGeometry(inst);
-    d.static_instance_id = rtcAttachGeometry(d.top, inst);
+    static_instance_id = rtcAttachGeometry(top, inst);
     rtcReleaseGeometry(inst);
-    d.top_instance_object.resize(d.static_instance_id + 1, -1);
+    top_instance_object.resize(static_instance_id + 1, -1);
   }
-  for (int o : d.dynamic_objects) {
-    RTCGeometry inst = rtcNewGeometry(d.device, RTC_GEOMETRY_TYPE_INSTANCE);
-    rtcSetGeometryInstancedScene(inst, d.mesh_scenes[scene.objects[o].mesh]);
-    const unsigned id = rtcAttachGeometry(d.top, inst);
-    if (d.top_instance_object.size() <= id) d.top_instance_object.resize(id + 1, -1);
-    d.top_instance_object[id] = o;
-    d.dynamic_instances.push_back(inst);  // the top scene holds a reference; kept for updates
+  for (int o : dynamic_objects) {
+    RTCGeometry inst = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(inst, mesh_scenes[scene.objects[o].mesh]);
+    const unsigned id = rtcAttachGeometry(top, inst);
+    if (top_instance_object.size() <= id) top_instance_object.resize(id + 1, -1);
+    top_instance_object[id] = o;
+    dynamic_instances.push_back(inst);  // the top scene holds a reference; kept for updates
     rtcReleaseGeometry(inst);
   }
+}
 
-  // Lighting constants.
+// Lighting constants: sun frame and disc samples, sky mean, ground irradiance.
+void Tracer::Impl::SetUpLighting() {
   const Lighting& light = scene.lighting;
   const Eigen::Vector3d s = light.direction_to_sun.norm() > 0 ? light.direction_to_sun.normalized()
                                                               : Eigen::Vector3d::UnitZ();
-  d.sun_dir = s.cast<float>();
-  const Eigen::Vector3f helper = std::abs(d.sun_dir.z()) < 0.9f ? Eigen::Vector3f::UnitZ() : Eigen::Vector3f::UnitX();
-  d.sun_e1 = d.sun_dir.cross(helper).normalized();
-  d.sun_e2 = d.sun_dir.cross(d.sun_e1);
-  d.sun_disc_radius = static_cast<float>(std::tan(0.5 * light.sun_angular_diameter_deg * M_PI / 180.0));
-  d.sky_mean = 0.5f * (light.sky_zenith + light.sky_horizon);
-  d.ground_irradiance =
-      light.ground_albedo.cwiseProduct(light.sun_radiance * std::max(0.0f, d.sun_dir.z()) * kInvPi + d.sky_mean);
+  sun_dir = s.cast<float>();
+  const Eigen::Vector3f helper = std::abs(sun_dir.z()) < 0.9f ? Eigen::Vector3f::UnitZ() : Eigen::Vector3f::UnitX();
+  sun_e1 = sun_dir.cross(helper).normalized();
+  sun_e2 = sun_dir.cross(sun_e1);
+  sun_disc_radius = static_cast<float>(std::tan(0.5 * light.sun_angular_diameter_deg * M_PI / 180.0));
+  sky_mean = 0.5f * (light.sky_zenith + light.sky_horizon);
+  ground_irradiance =
+      light.ground_albedo.cwiseProduct(light.sun_radiance * std::max(0.0f, sun_dir.z()) * kInvPi + sky_mean);
   // Sun-disc directions: point i of the (0,2)-sequence (radinv2(i), sobol2(i)) mapped to the disc
   // of radius tan(diameter / 2) around sun_dir (uniform in area).
   for (int i = 0; i < kSunSamples; ++i) {
-    const float radius = d.sun_disc_radius * std::sqrt(RadicalInverse2(static_cast<uint32_t>(i)));
+    const float radius = sun_disc_radius * std::sqrt(RadicalInverse2(static_cast<uint32_t>(i)));
     const float phi = 6.2831853f * Sobol2(static_cast<uint32_t>(i));
-    d.sun_samples[i] = (d.sun_dir + radius * (std::cos(phi) * d.sun_e1 + std::sin(phi) * d.sun_e2)).normalized();
+    sun_samples[i] = (sun_dir + radius * (std::cos(phi) * sun_e1 + std::sin(phi) * sun_e2)).normalized();
   }
+}
+
+Tracer::Tracer(const Scene& scene) : impl_(std::make_unique<Impl>(scene)) {
+  Impl& d = *impl_;
+  ValidateSceneIndices(scene);
+  d.BuildShadeRecords();
+  d.device = rtcNewDevice(nullptr);
+  if (!d.device) throw std::runtime_error("cannot create the Embree device");
+  d.BuildStaticScene(&num_static_triangles_, &static_build_seconds_);
+  d.BuildTopScene();
+  d.SetUpLighting();
   // The instance level only exists for moving objects: without them, trace the static BVH itself.
   d.trace_scene = d.dynamic_objects.empty() ? d.static_scene : d.top;
 
@@ -550,12 +580,338 @@ void InitRay(RTCRayHit* rh, const Eigen::Vector3f& origin, const Eigen::Vector3f
 
 __m128 Load3(const Eigen::Vector3f& v) { return _mm_setr_ps(v.x(), v.y(), v.z(), 0.0f); }
 
+// What every tile of one Render call reads: the inputs and the per-call constants.
+struct RenderJob {
+  RenderJob(const Tracer::Impl& d_in, const CameraRays& rays_in, const ShadeSettings& settings_in,
+            CameraImage* image_in)
+      : d(d_in),
+        rays(rays_in),
+        settings(settings_in),
+        image(image_in),
+        width(rays_in.width),
+        height(rays_in.height),
+        raw(settings_in.raw_cast_only) {}
+  const Tracer::Impl& d;
+  const CameraRays& rays;
+  const ShadeSettings& settings;
+  CameraImage* image;
+  int width, height;
+  bool raw;
+  Eigen::Matrix3f world_from_cam_rot = Eigen::Matrix3f::Identity();
+  Eigen::Vector3f origin = Eigen::Vector3f::Zero();
+  int spp = 1;
+  float inv_sqrt_spp = 1.0f;
+  float theta_max = 0.0f;
+  bool precomputed_samples = false, soft_sun = false, textures = false;
+  // A pixel's sun samples: the block of `spp` consecutive points of the (0,2)-sequence starting at
+  // a hashed multiple of spp (an elementary-interval-stratified set for power-of-two spp <= 64).
+  uint32_t spp_u = 1;
+  __m128 sky_horizon{}, sky_delta{}, sky_ground{}, ambient_ground{}, ambient_delta{}, sun_radiance{};
+  // exposure / (samples of a pixel): a pixel has at most spp samples.
+  std::vector<float> exposure_over_count;
+  std::array<Eigen::Vector2f, 64> offsets{};
+  int tiles_x = 0, tiles_y = 0;
+};
+
+// One tile's pixel rectangle.
+struct TileRect {
+  int tx0, ty0, tw, th;
+  size_t Pixel(const RenderJob& job, int local) const {
+    return static_cast<size_t>(ty0 + local / kTile) * job.width + tx0 + local % kTile;
+  }
+};
+
+// The camera rays of sample s (-1 or spp == 1: pixel centres) of the tile's valid pixels into
+// tb.rayhit / tb.pixel; returns their count.
+int MakeSampleRays(const RenderJob& job, const TileRect& t, int s, bool is_centre, TileBuffers& tb) {
+  const CameraRays& rays = job.rays;
+  const int spp = job.spp;
+  int n = 0;
+  for (int ly = 0; ly < t.th; ++ly) {
+    const size_t row = static_cast<size_t>(t.ty0 + ly) * job.width + t.tx0;
+    for (int lx = 0; lx < t.tw; ++lx) {
+      const size_t pi = row + lx;
+      if (!rays.valid[pi]) continue;
+      Eigen::Vector3f bearing;
+      if (is_centre) {
+        bearing = rays.bearing[pi];
+      } else if (job.precomputed_samples) {
+        bearing = rays.sample_bearing[s][pi];
+        if (bearing.x() == 0.0f && bearing.y() == 0.0f && bearing.z() == 0.0f) continue;
+      } else {
+        Eigen::Vector2f offset;
+        if (job.settings.rotate_pattern) {
+          const uint64_t h = Mix64(pi * 0x632be59bd9b4e019ull + 1);
+          offset.x() = Wrap01((s + 0.5f) / spp + UnitFloat(h)) - 0.5f;
+          offset.y() = Wrap01(RadicalInverse2(static_cast<uint32_t>(s)) + UnitFloat(Mix64(h))) - 0.5f;
+        } else {
+          offset = s < 64 ? job.offsets[s] : CameraRays::SampleOffset(s, spp);
+        }
+        if (!rays.SampleBearing(t.tx0 + lx + offset.x(), t.ty0 + ly + offset.y(), &bearing)) continue;
+      }
+      InitRay(&tb.rayhit[n], job.origin, job.world_from_cam_rot * bearing);
+      tb.pixel[n] = ly * kTile + lx;
+      ++n;
+    }
+  }
+  return n;
+}
+
+// Depth and object id of the pixel-centre hits.
+void WriteDepthAndMask(const RenderJob& job, const TileRect& t, int n, const TileBuffers& tb) {
+  const Tracer::Impl& d = job.d;
+  for (int r = 0; r < n; ++r) {
+    const RTCRayHit& rh = tb.rayhit[r];
+    const size_t pi = t.Pixel(job, tb.pixel[r]);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+    if (job.settings.want_depth) job.image->depth[pi] = rh.ray.tfar;
+    if (job.settings.want_mask) {
+      const unsigned inst = rh.hit.instID[0];
+      const int obj = inst != RTC_INVALID_GEOMETRY_ID && d.top_instance_object[inst] >= 0
+                          ? d.top_instance_object[inst]
+                          : d.static_geom_object[rh.hit.geomID];
+      job.image->mask[pi] = d.scene.objects[obj].id;
+    }
+  }
+}
+
+// Shading pass 1: misses take the sky; hits get their facing unit normal, base colour and texture
+// coordinates and level of detail (compacted lists). Sets the hit and textured-hit counts.
+void GatherHits(const RenderJob& job, const TileRect& t, int n, TileBuffers& tb, int* num_hits_out,
+                int* num_textured_out) {
+  const Tracer::Impl& d = job.d;
+  const bool raw = job.raw;
+  int num_hits = 0, num_textured = 0;
+  for (int r = 0; r < n; ++r) {
+    const RTCRayHit& rh = tb.rayhit[r];
+    const int local = tb.pixel[r];
+    const Eigen::Vector3f dir(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+      if (!raw) {
+        // Sky: mix(horizon, zenith, sqrt(d.z)) above the horizon, ground_albedo * horizon below.
+        const __m128 sky = dir.z() >= 0.0f
+                               ? _mm_add_ps(job.sky_horizon, _mm_mul_ps(_mm_set1_ps(std::sqrt(dir.z())), job.sky_delta))
+                               : job.sky_ground;
+        tb.sum[local] = _mm_add_ps(tb.sum[local], sky);
+        ++tb.count[local];
+      }
+      continue;
+    }
+    const int h = num_hits++;
+    tb.hit_ray[h] = r;
+    const unsigned inst = rh.hit.instID[0];
+    Eigen::Vector3f normal(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+    const Tracer::Impl::TriangleShade* shade;
+    if (inst == RTC_INVALID_GEOMETRY_ID) {
+      shade = d.static_geom_shade[rh.hit.geomID];
+    } else {
+      const int obj =
+          d.top_instance_object[inst] >= 0 ? d.top_instance_object[inst] : d.static_geom_object[rh.hit.geomID];
+      normal = d.object_rotation[obj] * normal;
+      shade = d.object_shade[obj];
+    }
+    const float nlen2 = normal.squaredNorm();
+    normal = nlen2 > 0.0f ? Eigen::Vector3f(normal / std::sqrt(nlen2)) : Eigen::Vector3f(-dir);
+    const float facing = normal.dot(dir);  // after the flip n.d = -|facing| exactly
+    if (facing > 0.0f) normal = -normal;
+    tb.normal[h] = normal;
+    if (raw) continue;
+    const Tracer::Impl::TriangleShade& ts = shade[rh.hit.primID];
+    const Tracer::Impl::ShadeMaterial& mat = d.shade_materials[ts.material];
+    tb.albedo[h] = _mm_load_ps(mat.base_color);
+    if (!job.textures || ts.texels_per_metre < 0.0f) continue;
+    const float bu = rh.hit.u, bv = rh.hit.v, bw = 1.0f - bu - bv;
+    const int k = num_textured++;
+    tb.textured_hit[k] = h;
+    tb.texture[k] = mat.texture;
+    tb.tex_u[k] = bw * ts.uv[0] + bu * ts.uv[2] + bv * ts.uv[4];
+    tb.tex_v[k] = bw * ts.uv[1] + bu * ts.uv[3] + bv * ts.uv[5];
+    // Ray-cone footprint in metres, then in texels of level 0.
+    const size_t pi = t.Pixel(job, local);
+    const float cos_view = std::max(facing > 0.0f ? facing : -facing, 0.1f);  // -normal.dot(dir)
+    const float texels = rh.ray.tfar * job.rays.pixel_angle[pi] / cos_view * job.inv_sqrt_spp * ts.texels_per_metre;
+    tb.tex_lod[k] = texels;  // turned into the level of detail below, four at a time
+  }
+  *num_hits_out = num_hits;
+  *num_textured_out = num_textured;
+}
+
+// Shading pass 2: the texture lookups (a tight loop keeps several independent texel loads in flight).
+void ApplyTextures(const RenderJob& job, int num_textured, TileBuffers& tb) {
+  // lod = FastLog2(texels) + bias where texels > 0, else 0.
+  for (int k = num_textured; k % 4 != 0; ++k) tb.tex_lod[k] = 0.0f;
+  const __m128 bias = _mm_set1_ps(job.settings.lod_bias);
+  for (int k = 0; k < num_textured; k += 4) {
+    const __m128 texels = _mm_load_ps(tb.tex_lod + k);
+    _mm_store_ps(tb.tex_lod + k,
+                 _mm_and_ps(_mm_cmpgt_ps(texels, _mm_setzero_ps()), _mm_add_ps(FastLog2x4(texels), bias)));
+  }
+  MipTexture::SampleBatch(tb.texture, tb.tex_u, tb.tex_v, tb.tex_lod, num_textured, tb.texel, job.settings.trilinear);
+  for (int k = 0; k < num_textured; ++k) {
+    const int h = tb.textured_hit[k];
+    tb.albedo[h] = _mm_mul_ps(tb.albedo[h], tb.texel[k]);
+  }
+}
+
+// Shading pass 3: ambient light, and the shadow rays of the lit hits (sun sample of sample s) into
+// tb.shadow with their direct light; returns the shadow ray count. Without shadows the direct
+// light is added at once.
+int AmbientAndShadowRays(const RenderJob& job, const TileRect& t, int s, int num_hits, TileBuffers& tb) {
+  const Tracer::Impl& d = job.d;
+  const bool raw = job.raw;
+  int num_shadow = 0;
+  for (int h = 0; h < num_hits; ++h) {
+    const RTCRayHit& rh = tb.rayhit[tb.hit_ray[h]];
+    const int local = tb.pixel[tb.hit_ray[h]];
+    const Eigen::Vector3f& normal = tb.normal[h];
+    __m128 albedo = _mm_setzero_ps();
+    if (!raw) {
+      albedo = tb.albedo[h];
+      // Ambient: hemisphere mix of sky and ground by the normal's elevation.
+      const float up = 0.5f * (1.0f + normal.z());
+      tb.sum[local] = _mm_add_ps(
+          tb.sum[local],
+          _mm_mul_ps(albedo, _mm_add_ps(job.ambient_ground, _mm_mul_ps(_mm_set1_ps(up), job.ambient_delta))));
+      ++tb.count[local];
+    }
+    const Eigen::Vector3f* to_sun = &d.sun_dir;
+    if (job.soft_sun) {
+      const size_t pi = t.Pixel(job, local);
+      to_sun = &d.sun_samples[(static_cast<uint32_t>(Mix64(pi * 0x9e3779b97f4a7c15ull + 7)) * job.spp_u +
+                               static_cast<uint32_t>(s)) &
+                              (kSunSamples - 1)];
+    }
+    const float cos_sun = normal.dot(*to_sun);
+    if (cos_sun <= 0.0f) continue;
+    const __m128 direct =
+        raw ? albedo : _mm_mul_ps(_mm_mul_ps(albedo, job.sun_radiance), _mm_set1_ps(cos_sun * kInvPi));
+    if (!job.settings.shadows) {
+      if (!raw) tb.sum[local] = _mm_add_ps(tb.sum[local], direct);
+      continue;
+    }
+    const Eigen::Vector3f dir(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
+    const float tfar = rh.ray.tfar;
+    const float offset = 1e-4f * (1.0f + tfar);
+    const Eigen::Vector3f shadow_origin = job.origin + tfar * dir + offset * normal;
+    RTCRay& sr = tb.shadow[num_shadow];
+    sr.org_x = shadow_origin.x();
+    sr.org_y = shadow_origin.y();
+    sr.org_z = shadow_origin.z();
+    sr.dir_x = to_sun->x();
+    sr.dir_y = to_sun->y();
+    sr.dir_z = to_sun->z();
+    sr.tnear = offset;
+    sr.tfar = std::numeric_limits<float>::infinity();
+    sr.mask = 0xffffffffu;
+    sr.time = 0.0f;
+    sr.id = 0;
+    sr.flags = 0;
+    tb.shadow_pixel[num_shadow] = local;
+    tb.direct[num_shadow] = direct;
+    ++num_shadow;
+  }
+  return num_shadow;
+}
+
+// Resolve: box filter, exposure, optional vignetting and noise, sRGB. The encoding clamps to
+// [0, 1] (NaN -> 0) and reads the 64k table at round(65535 x).
+void ResolveTile(const RenderJob& job, const TileRect& t, const TileBuffers& tb) {
+  const ShadeSettings& settings = job.settings;
+  const auto& srgb = SrgbTable();
+  const __m128 one = _mm_set1_ps(1.0f), scale = _mm_set1_ps(65535.0f), half = _mm_set1_ps(0.5f);
+  for (int ly = 0; ly < t.th; ++ly) {
+    uint8_t* out = job.image->rgb.data() + (static_cast<size_t>(t.ty0 + ly) * job.width + t.tx0) * 3;
+    for (int lx = 0; lx < t.tw; ++lx, out += 3) {
+      const int local = ly * kTile + lx;
+      if (tb.count[local] == 0) {
+        out[0] = out[1] = out[2] = 0;
+        continue;
+      }
+      const size_t pi = static_cast<size_t>(t.ty0 + ly) * job.width + t.tx0 + lx;
+      float gain = job.exposure_over_count[tb.count[local]];
+      if (settings.vignetting > 0.0f) {
+        const Eigen::Vector3f& b = job.rays.bearing[pi];
+        const float theta = std::atan2(std::hypot(b.x(), b.y()), b.z());
+        const float rel = theta / job.theta_max;
+        gain *= std::max(0.0f, 1.0f - settings.vignetting * rel * rel);
+      }
+      const __m128 c = _mm_min_ps(_mm_max_ps(_mm_mul_ps(tb.sum[local], _mm_set1_ps(gain)), _mm_setzero_ps()), one);
+      const __m128i i4 = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(c, scale), half));
+      const int index[3] = {_mm_cvtsi128_si32(i4), _mm_cvtsi128_si32(_mm_shuffle_epi32(i4, 1)),
+                            _mm_cvtsi128_si32(_mm_shuffle_epi32(i4, 2))};
+      for (int k = 0; k < 3; ++k) {
+        uint8_t value = srgb[index[k]];
+        if (settings.noise_sigma > 0.0f) {
+          // Box-Muller from two hashed uniforms: deterministic per (seed, pixel, channel).
+          const uint64_t h = Mix64(settings.noise_seed ^ Mix64(pi * 3 + k));
+          const float u1 = std::max(UnitFloat(h), 1e-7f);
+          const float u2 = UnitFloat(Mix64(h));
+          const float g = std::sqrt(-2.0f * std::log(u1)) * std::cos(6.2831853f * u2);
+          value = static_cast<uint8_t>(std::clamp(std::lround(value + settings.noise_sigma * g), 0L, 255L));
+        }
+        out[k] = value;
+      }
+    }
+  }
+}
+
+// One tile: a pixel-centre pass for depth and masks (shared with the only sample when spp == 1),
+// then per sample the camera rays, the three shading passes and the shadow rays; then the resolve.
+// The raw cast computes the same shadow rays (it needs the normal and the sun sample) but no
+// albedo, texture, sky or ambient term.
+void RenderTile(const RenderJob& job, int tile, TileBuffers& tb) {
+  const Tracer::Impl& d = job.d;
+  const ShadeSettings& settings = job.settings;
+  const int spp = job.spp;
+  const bool raw = job.raw;
+  TileRect t;
+  t.tx0 = (tile % job.tiles_x) * kTile;
+  t.ty0 = (tile / job.tiles_x) * kTile;
+  t.tw = std::min(kTile, job.width - t.tx0);
+  t.th = std::min(kTile, job.height - t.ty0);
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  // Shadow rays towards a wide sun disc are not coherent; Embree 3.13's coherent stream path
+  // never returned for such rays (a 30-degree overcast sun hung the render), so they go
+  // through the incoherent path.
+  RTCIntersectContext shadow_context;
+  rtcInitIntersectContext(&shadow_context);
+  shadow_context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  for (int i = 0; i < kTilePixels; ++i) {
+    tb.sum[i] = _mm_setzero_ps();
+    tb.count[i] = 0;
+  }
+
+  const bool centre_pass = settings.want_depth || settings.want_mask;
+  for (int s = (centre_pass && spp > 1) ? -1 : 0; s < spp; ++s) {
+    const bool is_centre = s < 0 || spp == 1;
+    const int n = MakeSampleRays(job, t, s, is_centre, tb);
+    if (n == 0) continue;
+    rtcIntersect1M(d.trace_scene, &context, tb.rayhit, static_cast<unsigned>(n), sizeof(RTCRayHit));
+    if (is_centre && !raw && centre_pass) WriteDepthAndMask(job, t, n, tb);
+    if (s < 0) continue;  // the extra centre pass only feeds depth and masks
+
+    int num_hits = 0, num_textured = 0;
+    GatherHits(job, t, n, tb, &num_hits, &num_textured);
+    if (num_textured > 0) ApplyTextures(job, num_textured, tb);
+    const int num_shadow = AmbientAndShadowRays(job, t, s, num_hits, tb);
+    if (num_shadow == 0) continue;
+    rtcOccluded1M(d.trace_scene, &shadow_context, tb.shadow, static_cast<unsigned>(num_shadow), sizeof(RTCRay));
+    if (raw) continue;
+    for (int k = 0; k < num_shadow; ++k) {
+      // Embree sets tfar to -inf for occluded rays.
+      if (tb.shadow[k].tfar >= 0.0f) tb.sum[tb.shadow_pixel[k]] = _mm_add_ps(tb.sum[tb.shadow_pixel[k]], tb.direct[k]);
+    }
+  }
+  if (!raw) ResolveTile(job, t, tb);
+}
+
 }  // namespace
 
 void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const ShadeSettings& settings,
                     CameraImage* image) const {
   const Impl& d = *impl_;
-  const Scene& scene = d.scene;
   const int width = rays.width, height = rays.height;
   const size_t num_pixels = static_cast<size_t>(width) * height;
   const bool raw = settings.raw_cast_only;
@@ -569,283 +925,36 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
     if (settings.want_mask) image->mask.assign(num_pixels, 0);
     else image->mask.clear();
   }
-  const Eigen::Matrix3f world_from_cam_rot = world_from_cam.RotationMatrix().cast<float>();
-  const Eigen::Vector3f origin = ToF(world_from_cam.translation);
   const int spp = std::max(1, settings.spp);
-  const float inv_sqrt_spp = 1.0f / std::sqrt(static_cast<float>(spp));
-  const Lighting& light = scene.lighting;
-  const auto& srgb = SrgbTable();
-  const float theta_max = static_cast<float>(0.5 * rays.camera.max_fov_deg * M_PI / 180.0);
-  const bool precomputed_samples = !settings.rotate_pattern && rays.sample_spp == spp;
-  const bool soft_sun = settings.soft_shadows && d.sun_disc_radius > 0.0f && spp > 1;
-  const bool textures = settings.textures;
-  // A pixel's sun samples: the block of `spp` consecutive points of the (0,2)-sequence starting at
-  // a hashed multiple of spp (an elementary-interval-stratified set for power-of-two spp <= 64).
-  const uint32_t spp_u = static_cast<uint32_t>(spp);
-  const __m128 sky_horizon = Load3(light.sky_horizon);
-  const __m128 sky_delta = Load3(light.sky_zenith - light.sky_horizon);
-  const __m128 sky_ground = Load3(light.ground_albedo.cwiseProduct(light.sky_horizon));
-  const __m128 ambient_ground = Load3(light.ambient * d.ground_irradiance);
-  const __m128 ambient_delta = Load3(light.ambient * (d.sky_mean - d.ground_irradiance));
-  const __m128 sun_radiance = Load3(light.sun_radiance);
-  // exposure / (samples of a pixel): a pixel has at most spp samples.
-  std::vector<float> exposure_over_count(spp + 1, 0.0f);
-  for (int c = 1; c <= spp; ++c) exposure_over_count[c] = light.exposure / static_cast<float>(c);
-  std::array<Eigen::Vector2f, 64> offsets{};
-  for (int s = 0; s < std::min(spp, 64); ++s) offsets[s] = CameraRays::SampleOffset(s, spp);
+  const Lighting& light = d.scene.lighting;
+  RenderJob job(d, rays, settings, image);
+  job.world_from_cam_rot = world_from_cam.RotationMatrix().cast<float>();
+  job.origin = ToF(world_from_cam.translation);
+  job.spp = spp;
+  job.inv_sqrt_spp = 1.0f / std::sqrt(static_cast<float>(spp));
+  job.theta_max = static_cast<float>(0.5 * rays.camera.max_fov_deg * M_PI / 180.0);
+  job.precomputed_samples = !settings.rotate_pattern && rays.sample_spp == spp;
+  job.soft_sun = settings.soft_shadows && d.sun_disc_radius > 0.0f && spp > 1;
+  job.textures = settings.textures;
+  job.spp_u = static_cast<uint32_t>(spp);
+  job.sky_horizon = Load3(light.sky_horizon);
+  job.sky_delta = Load3(light.sky_zenith - light.sky_horizon);
+  job.sky_ground = Load3(light.ground_albedo.cwiseProduct(light.sky_horizon));
+  job.ambient_ground = Load3(light.ambient * d.ground_irradiance);
+  job.ambient_delta = Load3(light.ambient * (d.sky_mean - d.ground_irradiance));
+  job.sun_radiance = Load3(light.sun_radiance);
+  job.exposure_over_count.assign(spp + 1, 0.0f);
+  for (int c = 1; c <= spp; ++c) job.exposure_over_count[c] = light.exposure / static_cast<float>(c);
+  for (int s = 0; s < std::min(spp, 64); ++s) job.offsets[s] = CameraRays::SampleOffset(s, spp);
+  job.tiles_x = (width + kTile - 1) / kTile;
+  job.tiles_y = (height + kTile - 1) / kTile;
 
-  const int tiles_x = (width + kTile - 1) / kTile;
-  const int tiles_y = (height + kTile - 1) / kTile;
-
-  auto render_tile = [&](int tile, TileBuffers& tb) {
-    const int tx0 = (tile % tiles_x) * kTile;
-    const int ty0 = (tile / tiles_x) * kTile;
-    const int tw = std::min(kTile, width - tx0);
-    const int th = std::min(kTile, height - ty0);
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    // Shadow rays towards a wide sun disc are not coherent; Embree 3.13's coherent stream path
-    // never returned for such rays (a 30-degree overcast sun hung the render), so they go
-    // through the incoherent path.
-    RTCIntersectContext shadow_context;
-    rtcInitIntersectContext(&shadow_context);
-    shadow_context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-    for (int i = 0; i < kTilePixels; ++i) {
-      tb.sum[i] = _mm_setzero_ps();
-      tb.count[i] = 0;
-    }
-
-    // Pixel-centre pass for depth and masks (shared with the only sample when spp == 1).
-    const bool centre_pass = settings.want_depth || settings.want_mask;
-    for (int s = (centre_pass && spp > 1) ? -1 : 0; s < spp; ++s) {
-      const bool is_centre = s < 0 || spp == 1;
-      int n = 0;
-      for (int ly = 0; ly < th; ++ly) {
-        const size_t row = static_cast<size_t>(ty0 + ly) * width + tx0;
-        for (int lx = 0; lx < tw; ++lx) {
-          const size_t pi = row + lx;
-          if (!rays.valid[pi]) continue;
-          Eigen::Vector3f bearing;
-          if (is_centre) {
-            bearing = rays.bearing[pi];
-          } else if (precomputed_samples) {
-            bearing = rays.sample_bearing[s][pi];
-            if (bearing.x() == 0.0f && bearing.y() == 0.0f && bearing.z() == 0.0f) continue;
-          } else {
-            Eigen::Vector2f offset;
-            if (settings.rotate_pattern) {
-              const uint64_t h = Mix64(pi * 0x632be59bd9b4e019ull + 1);
-              offset.x() = Wrap01((s + 0.5f) / spp + UnitFloat(h)) - 0.5f;
-              offset.y() = Wrap01(RadicalInverse2(static_cast<uint32_t>(s)) + UnitFloat(Mix64(h))) - 0.5f;
-            } else {
-              offset = s < 64 ? offsets[s] : CameraRays::SampleOffset(s, spp);
-            }
-            if (!rays.SampleBearing(tx0 + lx + offset.x(), ty0 + ly + offset.y(), &bearing)) continue;
-          }
-          InitRay(&tb.rayhit[n], origin, world_from_cam_rot * bearing);
-          tb.pixel[n] = ly * kTile + lx;
-          ++n;
-        }
-      }
-      if (n == 0) continue;
-      rtcIntersect1M(d.trace_scene, &context, tb.rayhit, static_cast<unsigned>(n), sizeof(RTCRayHit));
-
-      if (is_centre && !raw && centre_pass) {
-        for (int r = 0; r < n; ++r) {
-          const RTCRayHit& rh = tb.rayhit[r];
-          const size_t pi = static_cast<size_t>(ty0 + tb.pixel[r] / kTile) * width + tx0 + tb.pixel[r] % kTile;
-          if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
-          if (settings.want_depth) image->depth[pi] = rh.ray.tfar;
-          if (settings.want_mask) {
-            const unsigned inst = rh.hit.instID[0];
-            const int obj = inst != RTC_INVALID_GEOMETRY_ID && d.top_instance_object[inst] >= 0
-                                ? d.top_instance_object[inst]
-                                : d.static_geom_object[rh.hit.geomID];
-            image->mask[pi] = scene.objects[obj].id;
-          }
-        }
-      }
-      if (s < 0) continue;  // the extra centre pass only feeds depth and masks
-
-      // Three passes over the tile's rays. Pass 1: misses take the sky; hits get their facing unit
-      // normal, base colour and texture coordinates and level of detail (compacted lists). Pass 2:
-      // the texture lookups (a tight loop keeps several independent texel loads in flight). Pass 3:
-      // ambient light and the shadow rays. The raw cast computes the same shadow rays (it needs
-      // the normal and the sun sample) but no albedo, texture, sky or ambient term.
-      int num_hits = 0, num_textured = 0;
-      for (int r = 0; r < n; ++r) {
-        const RTCRayHit& rh = tb.rayhit[r];
-        const int local = tb.pixel[r];
-        const Eigen::Vector3f dir(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
-        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
-          if (!raw) {
-            // Sky: mix(horizon, zenith, sqrt(d.z)) above the horizon, ground_albedo * horizon below.
-            const __m128 sky = dir.z() >= 0.0f
-                                   ? _mm_add_ps(sky_horizon, _mm_mul_ps(_mm_set1_ps(std::sqrt(dir.z())), sky_delta))
-                                   : sky_ground;
-            tb.sum[local] = _mm_add_ps(tb.sum[local], sky);
-            ++tb.count[local];
-          }
-          continue;
-        }
-        const int h = num_hits++;
-        tb.hit_ray[h] = r;
-        const unsigned inst = rh.hit.instID[0];
-        Eigen::Vector3f normal(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
-        const Impl::TriangleShade* shade;
-        if (inst == RTC_INVALID_GEOMETRY_ID) {
-          shade = d.static_geom_shade[rh.hit.geomID];
-        } else {
-          const int obj = d.top_instance_object[inst] >= 0 ? d.top_instance_object[inst]
-                                                           : d.static_geom_object[rh.hit.geomID];
-          normal = d.object_rotation[obj] * normal;
-          shade = d.object_shade[obj];
-        }
-        const float nlen2 = normal.squaredNorm();
-        normal = nlen2 > 0.0f ? Eigen::Vector3f(normal / std::sqrt(nlen2)) : Eigen::Vector3f(-dir);
-        const float facing = normal.dot(dir);  // after the flip n.d = -|facing| exactly
-        if (facing > 0.0f) normal = -normal;
-        tb.normal[h] = normal;
-        if (raw) continue;
-        const Impl::TriangleShade& ts = shade[rh.hit.primID];
-        const Impl::ShadeMaterial& mat = d.shade_materials[ts.material];
-        tb.albedo[h] = _mm_load_ps(mat.base_color);
-        if (!textures || ts.texels_per_metre < 0.0f) continue;
-        const float bu = rh.hit.u, bv = rh.hit.v, bw = 1.0f - bu - bv;
-        const int k = num_textured++;
-        tb.textured_hit[k] = h;
-        tb.texture[k] = mat.texture;
-        tb.tex_u[k] = bw * ts.uv[0] + bu * ts.uv[2] + bv * ts.uv[4];
-        tb.tex_v[k] = bw * ts.uv[1] + bu * ts.uv[3] + bv * ts.uv[5];
-        // Ray-cone footprint in metres, then in texels of level 0.
-        const size_t pi = static_cast<size_t>(ty0 + local / kTile) * width + tx0 + local % kTile;
-        const float cos_view = std::max(facing > 0.0f ? facing : -facing, 0.1f);  // -normal.dot(dir)
-        const float texels = rh.ray.tfar * rays.pixel_angle[pi] / cos_view * inv_sqrt_spp * ts.texels_per_metre;
-        tb.tex_lod[k] = texels;  // turned into the level of detail below, four at a time
-      }
-
-      if (num_textured > 0) {
-        // lod = FastLog2(texels) + bias where texels > 0, else 0.
-        for (int k = num_textured; k % 4 != 0; ++k) tb.tex_lod[k] = 0.0f;
-        const __m128 bias = _mm_set1_ps(settings.lod_bias);
-        for (int k = 0; k < num_textured; k += 4) {
-          const __m128 texels = _mm_load_ps(tb.tex_lod + k);
-          _mm_store_ps(tb.tex_lod + k, _mm_and_ps(_mm_cmpgt_ps(texels, _mm_setzero_ps()),
-                                                  _mm_add_ps(FastLog2x4(texels), bias)));
-        }
-        MipTexture::SampleBatch(tb.texture, tb.tex_u, tb.tex_v, tb.tex_lod, num_textured, tb.texel, settings.trilinear);
-        for (int k = 0; k < num_textured; ++k) {
-          const int h = tb.textured_hit[k];
-          tb.albedo[h] = _mm_mul_ps(tb.albedo[h], tb.texel[k]);
-        }
-      }
-
-      int num_shadow = 0;
-      for (int h = 0; h < num_hits; ++h) {
-        const RTCRayHit& rh = tb.rayhit[tb.hit_ray[h]];
-        const int local = tb.pixel[tb.hit_ray[h]];
-        const Eigen::Vector3f& normal = tb.normal[h];
-        __m128 albedo = _mm_setzero_ps();
-        if (!raw) {
-          albedo = tb.albedo[h];
-          // Ambient: hemisphere mix of sky and ground by the normal's elevation.
-          const float up = 0.5f * (1.0f + normal.z());
-          tb.sum[local] = _mm_add_ps(
-              tb.sum[local], _mm_mul_ps(albedo, _mm_add_ps(ambient_ground, _mm_mul_ps(_mm_set1_ps(up), ambient_delta))));
-          ++tb.count[local];
-        }
-        const Eigen::Vector3f* to_sun = &d.sun_dir;
-        if (soft_sun) {
-          const size_t pi = static_cast<size_t>(ty0 + local / kTile) * width + tx0 + local % kTile;
-          to_sun = &d.sun_samples[(static_cast<uint32_t>(Mix64(pi * 0x9e3779b97f4a7c15ull + 7)) * spp_u +
-                                   static_cast<uint32_t>(s)) &
-                                  (kSunSamples - 1)];
-        }
-        const float cos_sun = normal.dot(*to_sun);
-        if (cos_sun <= 0.0f) continue;
-        const __m128 direct =
-            raw ? albedo : _mm_mul_ps(_mm_mul_ps(albedo, sun_radiance), _mm_set1_ps(cos_sun * kInvPi));
-        if (!settings.shadows) {
-          if (!raw) tb.sum[local] = _mm_add_ps(tb.sum[local], direct);
-          continue;
-        }
-        const Eigen::Vector3f dir(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
-        const float t = rh.ray.tfar;
-        const float offset = 1e-4f * (1.0f + t);
-        const Eigen::Vector3f shadow_origin = origin + t * dir + offset * normal;
-        RTCRay& sr = tb.shadow[num_shadow];
-        sr.org_x = shadow_origin.x();
-        sr.org_y = shadow_origin.y();
-        sr.org_z = shadow_origin.z();
-        sr.dir_x = to_sun->x();
-        sr.dir_y = to_sun->y();
-        sr.dir_z = to_sun->z();
-        sr.tnear = offset;
-        sr.tfar = std::numeric_limits<float>::infinity();
-        sr.mask = 0xffffffffu;
-        sr.time = 0.0f;
-        sr.id = 0;
-        sr.flags = 0;
-        tb.shadow_pixel[num_shadow] = local;
-        tb.direct[num_shadow] = direct;
-        ++num_shadow;
-      }
-      if (num_shadow == 0) continue;
-      rtcOccluded1M(d.trace_scene, &shadow_context, tb.shadow, static_cast<unsigned>(num_shadow), sizeof(RTCRay));
-      if (raw) continue;
-      for (int k = 0; k < num_shadow; ++k) {
-        // Embree sets tfar to -inf for occluded rays.
-        if (tb.shadow[k].tfar >= 0.0f) tb.sum[tb.shadow_pixel[k]] = _mm_add_ps(tb.sum[tb.shadow_pixel[k]], tb.direct[k]);
-      }
-    }
-    if (raw) return;
-
-    // Resolve: box filter, exposure, optional vignetting and noise, sRGB. The encoding clamps to
-    // [0, 1] (NaN -> 0) and reads the 64k table at round(65535 x).
-    const __m128 one = _mm_set1_ps(1.0f), scale = _mm_set1_ps(65535.0f), half = _mm_set1_ps(0.5f);
-    for (int ly = 0; ly < th; ++ly) {
-      uint8_t* out = image->rgb.data() + (static_cast<size_t>(ty0 + ly) * width + tx0) * 3;
-      for (int lx = 0; lx < tw; ++lx, out += 3) {
-        const int local = ly * kTile + lx;
-        if (tb.count[local] == 0) {
-          out[0] = out[1] = out[2] = 0;
-          continue;
-        }
-        const size_t pi = static_cast<size_t>(ty0 + ly) * width + tx0 + lx;
-        float gain = exposure_over_count[tb.count[local]];
-        if (settings.vignetting > 0.0f) {
-          const Eigen::Vector3f& b = rays.bearing[pi];
-          const float theta = std::atan2(std::hypot(b.x(), b.y()), b.z());
-          const float rel = theta / theta_max;
-          gain *= std::max(0.0f, 1.0f - settings.vignetting * rel * rel);
-        }
-        const __m128 c = _mm_min_ps(_mm_max_ps(_mm_mul_ps(tb.sum[local], _mm_set1_ps(gain)), _mm_setzero_ps()), one);
-        const __m128i i4 = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(c, scale), half));
-        const int index[3] = {_mm_cvtsi128_si32(i4), _mm_cvtsi128_si32(_mm_shuffle_epi32(i4, 1)),
-                              _mm_cvtsi128_si32(_mm_shuffle_epi32(i4, 2))};
-        for (int k = 0; k < 3; ++k) {
-          uint8_t value = srgb[index[k]];
-          if (settings.noise_sigma > 0.0f) {
-            // Box-Muller from two hashed uniforms: deterministic per (seed, pixel, channel).
-            const uint64_t h = Mix64(settings.noise_seed ^ Mix64(pi * 3 + k));
-            const float u1 = std::max(UnitFloat(h), 1e-7f);
-            const float u2 = UnitFloat(Mix64(h));
-            const float g = std::sqrt(-2.0f * std::log(u1)) * std::cos(6.2831853f * u2);
-            value = static_cast<uint8_t>(std::clamp(std::lround(value + settings.noise_sigma * g), 0L, 255L));
-          }
-          out[k] = value;
-        }
-      }
-    }
-  };
-
-  const int num_tiles = tiles_x * tiles_y;
+  const int num_tiles = job.tiles_x * job.tiles_y;
   tbb::parallel_for(tbb::blocked_range<int>(0, num_tiles, 16), [&](const tbb::blocked_range<int>& range) {
     SetFlushDenormals();
     thread_local std::unique_ptr<TileBuffers> buffers;
     if (!buffers) buffers = std::make_unique<TileBuffers>();
-    for (int tile = range.begin(); tile < range.end(); ++tile) render_tile(tile, *buffers);
+    for (int tile = range.begin(); tile < range.end(); ++tile) RenderTile(job, tile, *buffers);
   });
 }
 

@@ -440,24 +440,63 @@ struct ArchitectureMaterials {
   int metal = -1;
 };
 
-// One building: storefront ground floor, facade walls, roof, and real geometry that lines up with
-// the facade texture's windows (facade relief that recesses the windows, glass-wall fins,
-// balconies), awnings over the shops, a roofline (cornice, parapet or hipped roof) and rooftop
-// structures. `arch` draws every random choice, in a fixed order per building.
-void AddBuilding(MeshBuilder& b, const BuildingPlan& p, const FacadeLayout& fl, int m_facade, int m_shop,
-                 const ArchitectureMaterials& am, const CityStyle& st, SceneRng& arch) {
-  const double texel = kFacadeTileMetres / 1024.0;  // metres per facade texel (both axes)
-  // Window placement as MakeFacadeTexture paints it (integer pixel arithmetic reproduced).
-  const int bay_px = 1024 / fl.bays;
-  const int win_w_px = static_cast<int>(bay_px * fl.window_width_fraction);
-  const int win_h_px = static_cast<int>(256 * fl.window_height_fraction);
-  const int win_top_px = (256 - win_h_px) / 2 - 8;  // below the floor's top
-  const int floors = std::max(1, static_cast<int>(std::lround((p.height - 0.4 - kStorefrontHeightMetres) / kFloorHeightMetres)));
+// The street-facing wall of a building's base box, and where the facade texture paints its windows
+// (MakeFacadeTexture's integer pixel arithmetic reproduced) in wall coordinates d (metres from origin).
+struct StreetFacade {
+  Eigen::Vector2d origin, along;  // wall start and unit direction (outward normal on its right)
+  double length = 0.0;
+  double texel = 0.0;  // metres per facade texel (both axes)
+  int bay_px = 0, win_w_px = 0, win_h_px = 0;
+  int win_top_px = 0;  // below the floor's top
+  int floors = 0;
+  double top = 0.0;  // base box top (parapet included)
+  std::vector<double> bay_edges, window_centres;
+  std::function<Vec2f(double, double)> facade_uv;  // uv of the facade texture at (d, z)
+  double FloorTop(int k) const { return kStorefrontHeightMetres + (k + 1) * kFloorHeightMetres; }
+};
 
-  const double r_relief = arch.Uniform(), r_balcony = arch.Uniform(), r_roof = arch.Uniform(), r_awning = arch.Uniform(),
-               r_rooftop = arch.Uniform();
-  const bool hip_roof = !p.has_setback && p.height <= 17.0 && fl.style != 3 && r_roof < 0.45;
+StreetFacade MakeStreetFacade(const BuildingPlan& p, const FacadeLayout& fl) {
+  StreetFacade f;
+  f.texel = kFacadeTileMetres / 1024.0;
+  f.bay_px = 1024 / fl.bays;
+  f.win_w_px = static_cast<int>(f.bay_px * fl.window_width_fraction);
+  f.win_h_px = static_cast<int>(256 * fl.window_height_fraction);
+  f.win_top_px = (256 - f.win_h_px) / 2 - 8;
+  f.floors =
+      std::max(1, static_cast<int>(std::lround((p.height - 0.4 - kStorefrontHeightMetres) / kFloorHeightMetres)));
+  const Eigen::Vector2d corners[4] = {p.footprint.min,
+                                      {p.footprint.max.x(), p.footprint.min.y()},
+                                      p.footprint.max,
+                                      {p.footprint.min.x(), p.footprint.max.y()}};
+  int street = 0;
+  for (int e = 0; e < 4; ++e) {
+    const Eigen::Vector2d along = (corners[(e + 1) % 4] - corners[e]).normalized();
+    if (Eigen::Vector2d(along.y(), -along.x()).dot(p.facing) > 0.5) street = e;
+  }
+  f.origin = corners[street];
+  f.along = (corners[(street + 1) % 4] - f.origin).normalized();
+  f.length = (corners[(street + 1) % 4] - f.origin).norm();
+  const double u_offset = p.u_offset;
+  f.facade_uv = [u_offset](double d, double z) {
+    return Vec2f(static_cast<float>((u_offset + d) / kFacadeTileMetres),
+                 static_cast<float>(100.0 - (z - kStorefrontHeightMetres) / kFacadeTileMetres));
+  };
+  // Wall coordinate d of texture column x (pixels, any tile).
+  auto d_of_px = [&](double x) { return x * f.texel - p.u_offset; };
+  const int tile_first = static_cast<int>(std::floor(p.u_offset / kFacadeTileMetres)) - 1;
+  const int tile_last = static_cast<int>(std::ceil((p.u_offset + f.length) / kFacadeTileMetres)) + 1;
+  for (int t = tile_first; t <= tile_last; ++t)
+    for (int k = 0; k < fl.bays; ++k) {
+      const double x0 = 1024.0 * t + k * f.bay_px;
+      f.bay_edges.push_back(d_of_px(x0));
+      f.window_centres.push_back(d_of_px(x0 + (f.bay_px - f.win_w_px) / 2 + 0.5 * f.win_w_px));
+    }
+  f.top = p.height;
+  return f;
+}
 
+// Storefront ground floor, facade walls and flat roofs of the base box and of the setback.
+void AddBuildingWalls(MeshBuilder& b, const BuildingPlan& p, int m_facade, int m_shop, int m_roof, bool hip_roof) {
   auto walls = [&](const Box2& fp, double z0, double z1, bool shops, bool roof) {
     const Eigen::Vector2d c[4] = {fp.min, {fp.max.x(), fp.min.y()}, fp.max, {fp.min.x(), fp.max.y()}};
     for (int e = 0; e < 4; ++e) {
@@ -473,157 +512,156 @@ void AddBuilding(MeshBuilder& b, const BuildingPlan& p, const FacadeLayout& fl, 
       const double v0 = 100.0 - (zs - kStorefrontHeightMetres) / kFacadeTileMetres;
       b.Wall(a, bb, zs, z1, p.u_offset, kFacadeTileMetres, v0, kFacadeTileMetres, m_facade);
     }
-    if (roof) b.Floor(fp.min, fp.max, z1, kRoofTileMetres, am.roof);
+    if (roof) b.Floor(fp.min, fp.max, z1, kRoofTileMetres, m_roof);
   };
   walls(p.footprint, 0.0, p.height, true, !hip_roof);
   if (p.has_setback) walls(p.upper_footprint, p.height, p.upper_height, false, true);
+}
 
-  // The street-facing wall of the base box: origin, direction (outward normal on its right), length.
-  const Eigen::Vector2d corners[4] = {p.footprint.min, {p.footprint.max.x(), p.footprint.min.y()}, p.footprint.max,
-                                      {p.footprint.min.x(), p.footprint.max.y()}};
-  int street = 0;
-  for (int e = 0; e < 4; ++e) {
-    const Eigen::Vector2d along = (corners[(e + 1) % 4] - corners[e]).normalized();
-    if (Eigen::Vector2d(along.y(), -along.x()).dot(p.facing) > 0.5) street = e;
-  }
-  const Eigen::Vector2d origin = corners[street];
-  const Eigen::Vector2d along = (corners[(street + 1) % 4] - origin).normalized();
-  const double length = (corners[(street + 1) % 4] - origin).norm();
-  auto facade_uv = [&](double d, double z) {
-    return Vec2f(static_cast<float>((p.u_offset + d) / kFacadeTileMetres),
-                 static_cast<float>(100.0 - (z - kStorefrontHeightMetres) / kFacadeTileMetres));
-  };
-  // Wall coordinate d of texture column x (pixels, any tile).
-  auto d_of_px = [&](double x) { return x * texel - p.u_offset; };
-  const int tile_first = static_cast<int>(std::floor(p.u_offset / kFacadeTileMetres)) - 1;
-  const int tile_last = static_cast<int>(std::ceil((p.u_offset + length) / kFacadeTileMetres)) + 1;
-  std::vector<double> bay_edges, window_centres;
-  for (int t = tile_first; t <= tile_last; ++t)
-    for (int k = 0; k < fl.bays; ++k) {
-      const double x0 = 1024.0 * t + k * bay_px;
-      bay_edges.push_back(d_of_px(x0));
-      window_centres.push_back(d_of_px(x0 + (bay_px - win_w_px) / 2 + 0.5 * win_w_px));
-    }
-  const double top = p.height;  // base box top (parapet included)
-  auto floor_top = [&](int k) { return kStorefrontHeightMetres + (k + 1) * kFloorHeightMetres; };
-
-  // Facade relief: the wall between the windows steps forward, so the windows sit in recesses.
+// Facade relief: the wall between the windows steps forward, so the windows sit in recesses.
+void AddFacadeRelief(MeshBuilder& b, const StreetFacade& f, const FacadeLayout& fl, double r_relief, int m_facade,
+                     SceneRng& arch) {
+  const double texel = f.texel, length = f.length, top = f.top;
   if (fl.style == 3) {
     if (r_relief < 0.7) {  // glass curtain wall: thin vertical fins at the mullion lines
-      const double fin_w = std::min(0.1, 0.6 * (bay_px - win_w_px) * texel), fin_d = arch.Uniform(0.3, 0.5);
-      for (double d : bay_edges)
+      const double fin_w = std::min(0.1, 0.6 * (f.bay_px - f.win_w_px) * texel), fin_d = arch.Uniform(0.3, 0.5);
+      for (double d : f.bay_edges)
         if (d - fin_w > 0.2 && d + fin_w < length - 0.2)
-          b.WallBlock(origin, along, d - 0.5 * fin_w, d + 0.5 * fin_w, 0.0, fin_d, kStorefrontHeightMetres, top, facade_uv, m_facade);
+          b.WallBlock(f.origin, f.along, d - 0.5 * fin_w, d + 0.5 * fin_w, 0.0, fin_d, kStorefrontHeightMetres, top,
+                      f.facade_uv, m_facade);
     }
   } else if (r_relief < 0.6) {
     const double depth = arch.Uniform(0.12, 0.3);
     const int kind = arch.UniformInt(0, 2);  // 0 pilasters, 1 floor bands, 2 both
     if (kind != 1) {
-      const double w = std::min(0.45, 0.7 * (bay_px - win_w_px) * texel);
+      const double w = std::min(0.45, 0.7 * (f.bay_px - f.win_w_px) * texel);
       // Corner pilasters where no painted window column reaches the corner.
       auto clear_of_windows = [&](double d0, double d1) {
-        for (double dc : window_centres)
-          if (d1 > dc - 0.5 * win_w_px * texel && d0 < dc + 0.5 * win_w_px * texel) return false;
+        for (double dc : f.window_centres)
+          if (d1 > dc - 0.5 * f.win_w_px * texel && d0 < dc + 0.5 * f.win_w_px * texel) return false;
         return true;
       };
-      if (clear_of_windows(0.0, w)) b.WallBlock(origin, along, 0.0, w, 0.0, depth, kStorefrontHeightMetres, top, facade_uv, m_facade);
+      if (clear_of_windows(0.0, w))
+        b.WallBlock(f.origin, f.along, 0.0, w, 0.0, depth, kStorefrontHeightMetres, top, f.facade_uv, m_facade);
       if (clear_of_windows(length - w, length))
-        b.WallBlock(origin, along, length - w, length, 0.0, depth, kStorefrontHeightMetres, top, facade_uv, m_facade);
-      for (double d : bay_edges)
+        b.WallBlock(f.origin, f.along, length - w, length, 0.0, depth, kStorefrontHeightMetres, top, f.facade_uv,
+                    m_facade);
+      for (double d : f.bay_edges)
         if (d - w > 0.3 && d + w < length - 0.3)
-          b.WallBlock(origin, along, d - 0.5 * w, d + 0.5 * w, 0.0, depth, kStorefrontHeightMetres, top, facade_uv, m_facade);
+          b.WallBlock(f.origin, f.along, d - 0.5 * w, d + 0.5 * w, 0.0, depth, kStorefrontHeightMetres, top,
+                      f.facade_uv, m_facade);
     }
     if (kind != 0) {
       // From the window top of one floor to the window bottom of the next (the storefront top and
       // the roof close the first and last band).
-      for (int k = 0; k <= floors; ++k) {
-        const double z0 = k == 0 ? kStorefrontHeightMetres : floor_top(k - 1) - win_top_px * texel;
-        const double z1 = k == floors ? top : floor_top(k) - (win_top_px + win_h_px) * texel;
-        if (z1 - z0 > 0.05) b.WallBlock(origin, along, 0.0, length, 0.0, depth, z0, z1, facade_uv, m_facade);
+      for (int k = 0; k <= f.floors; ++k) {
+        const double z0 = k == 0 ? kStorefrontHeightMetres : f.FloorTop(k - 1) - f.win_top_px * texel;
+        const double z1 = k == f.floors ? top : f.FloorTop(k) - (f.win_top_px + f.win_h_px) * texel;
+        if (z1 - z0 > 0.05) b.WallBlock(f.origin, f.along, 0.0, length, 0.0, depth, z0, z1, f.facade_uv, m_facade);
       }
     }
   }
+}
 
-  // Balconies under the windows of the street side: slab, front and side railing panels.
-  if (fl.style != 3 && floors >= 2 && r_balcony < 0.3) {
-    const double depth = arch.Uniform(0.9, 1.3);
-    const int stride = arch.UniformInt(1, 2), phase = arch.UniformInt(0, 1), first_floor = arch.UniformInt(0, 1);
-    const int rail = am.railing[arch.UniformInt(0, static_cast<int>(am.railing.size()) - 1)];
-    const int slab = am.trim[arch.UniformInt(0, static_cast<int>(am.trim.size()) - 1)];
-    const double half = std::min(0.5 * win_w_px * texel + 0.3, 0.5 * bay_px * texel - 0.05);
-    auto plain_uv = [](double d, double z) { return Vec2f(static_cast<float>(d / kRoofTileMetres), static_cast<float>(-z / kRoofTileMetres)); };
-    int count = 0;
-    for (size_t i = 0; i < window_centres.size(); ++i) {
-      const double dc = window_centres[i];
-      if (static_cast<int>(i) % stride != phase % stride || dc - half < 0.3 || dc + half > length - 0.3) continue;
-      for (int k = first_floor; k < floors && count < 120; ++k, ++count) {
-        const double z = kStorefrontHeightMetres + k * kFloorHeightMetres;  // floor level
-        b.WallBlock(origin, along, dc - half, dc + half, 0.0, depth, z - 0.18, z, plain_uv, slab);
-        b.WallBlock(origin, along, dc - half, dc + half, depth - 0.05, depth, z, z + 1.0, plain_uv, rail);
-        b.WallBlock(origin, along, dc - half, dc - half + 0.05, 0.0, depth - 0.05, z, z + 1.0, plain_uv, rail);
-        b.WallBlock(origin, along, dc + half - 0.05, dc + half, 0.0, depth - 0.05, z, z + 1.0, plain_uv, rail);
-      }
+// Balconies under the windows of the street side: slab, front and side railing panels.
+void AddBalconies(MeshBuilder& b, const StreetFacade& f, const ArchitectureMaterials& am, SceneRng& arch) {
+  const double texel = f.texel, length = f.length;
+  const double depth = arch.Uniform(0.9, 1.3);
+  const int stride = arch.UniformInt(1, 2), phase = arch.UniformInt(0, 1), first_floor = arch.UniformInt(0, 1);
+  const int rail = am.railing[arch.UniformInt(0, static_cast<int>(am.railing.size()) - 1)];
+  const int slab = am.trim[arch.UniformInt(0, static_cast<int>(am.trim.size()) - 1)];
+  const double half = std::min(0.5 * f.win_w_px * texel + 0.3, 0.5 * f.bay_px * texel - 0.05);
+  auto plain_uv = [](double d, double z) {
+    return Vec2f(static_cast<float>(d / kRoofTileMetres), static_cast<float>(-z / kRoofTileMetres));
+  };
+  int count = 0;
+  for (size_t i = 0; i < f.window_centres.size(); ++i) {
+    const double dc = f.window_centres[i];
+    if (static_cast<int>(i) % stride != phase % stride || dc - half < 0.3 || dc + half > length - 0.3) continue;
+    for (int k = first_floor; k < f.floors && count < 120; ++k, ++count) {
+      const double z = kStorefrontHeightMetres + k * kFloorHeightMetres;  // floor level
+      b.WallBlock(f.origin, f.along, dc - half, dc + half, 0.0, depth, z - 0.18, z, plain_uv, slab);
+      b.WallBlock(f.origin, f.along, dc - half, dc + half, depth - 0.05, depth, z, z + 1.0, plain_uv, rail);
+      b.WallBlock(f.origin, f.along, dc - half, dc - half + 0.05, 0.0, depth - 0.05, z, z + 1.0, plain_uv, rail);
+      b.WallBlock(f.origin, f.along, dc + half - 0.05, dc + half, 0.0, depth - 0.05, z, z + 1.0, plain_uv, rail);
     }
   }
+}
 
-  // Awnings over the shop windows: a sloped cloth, a front valance and closed sides.
-  if (r_awning < 0.45 && length > 3.0) {
-    const double reach = std::min(1.3, st.sidewalk_width_m - 0.8);
-    const int n = arch.UniformInt(1, 3);
-    const double part = length / n;
-    for (int i = 0; i < n; ++i) {
-      const double w = arch.Uniform(std::min(2.0, part - 0.8), part - 0.8);
-      const double d0 = i * part + 0.4 + arch.Uniform(0.0, part - 0.8 - w), d1 = d0 + w;
-      const int m = am.awning[arch.UniformInt(0, static_cast<int>(am.awning.size()) - 1)];
-      if (w < 1.0) continue;
-      const double z_wall = 3.15, z_edge = 2.6, z_low = 2.35;
-      const Eigen::Vector2d normal(along.y(), -along.x());
-      auto at = [&](double d, double nn, double z) {
-        const Eigen::Vector2d xy = origin + d * along + nn * normal;
-        return MeshBuilder::P(xy.x(), xy.y(), z);
-      };
-      const float u0 = static_cast<float>(d0 / 2.56), u1 = static_cast<float>(d1 / 2.56);
-      const float v_edge = static_cast<float>(std::hypot(reach, z_wall - z_edge) / 0.64);
-      const float v_low = v_edge + static_cast<float>((z_edge - z_low) / 0.64);
-      b.Quad(at(d0, reach, z_edge), at(d1, reach, z_edge), at(d1, 0.0, z_wall), at(d0, 0.0, z_wall), {u0, v_edge}, {u1, v_edge},
-             {u1, 0}, {u0, 0}, m);
-      b.Quad(at(d0, reach, z_low), at(d1, reach, z_low), at(d1, reach, z_edge), at(d0, reach, z_edge), {u0, v_low}, {u1, v_low},
-             {u1, v_edge}, {u0, v_edge}, m);
-      b.Tri(at(d0, 0.0, z_wall), at(d0, reach, z_low), at(d0, reach, z_edge), {0, 0}, {0.2f, v_low}, {0.2f, v_edge}, m);
-      b.Tri(at(d1, 0.0, z_wall), at(d1, reach, z_edge), at(d1, reach, z_low), {0, 0}, {0.2f, v_edge}, {0.2f, v_low}, m);
-    }
+// Awnings over the shop windows: a sloped cloth, a front valance and closed sides.
+void AddAwnings(MeshBuilder& b, const StreetFacade& f, const ArchitectureMaterials& am, const CityStyle& st,
+                SceneRng& arch) {
+  const Eigen::Vector2d& origin = f.origin;
+  const Eigen::Vector2d& along = f.along;
+  const double length = f.length;
+  const double reach = std::min(1.3, st.sidewalk_width_m - 0.8);
+  const int n = arch.UniformInt(1, 3);
+  const double part = length / n;
+  for (int i = 0; i < n; ++i) {
+    const double w = arch.Uniform(std::min(2.0, part - 0.8), part - 0.8);
+    const double d0 = i * part + 0.4 + arch.Uniform(0.0, part - 0.8 - w), d1 = d0 + w;
+    const int m = am.awning[arch.UniformInt(0, static_cast<int>(am.awning.size()) - 1)];
+    if (w < 1.0) continue;
+    const double z_wall = 3.15, z_edge = 2.6, z_low = 2.35;
+    const Eigen::Vector2d normal(along.y(), -along.x());
+    auto at = [&](double d, double nn, double z) {
+      const Eigen::Vector2d xy = origin + d * along + nn * normal;
+      return MeshBuilder::P(xy.x(), xy.y(), z);
+    };
+    const float u0 = static_cast<float>(d0 / 2.56), u1 = static_cast<float>(d1 / 2.56);
+    const float v_edge = static_cast<float>(std::hypot(reach, z_wall - z_edge) / 0.64);
+    const float v_low = v_edge + static_cast<float>((z_edge - z_low) / 0.64);
+    b.Quad(at(d0, reach, z_edge), at(d1, reach, z_edge), at(d1, 0.0, z_wall), at(d0, 0.0, z_wall), {u0, v_edge},
+           {u1, v_edge}, {u1, 0}, {u0, 0}, m);
+    b.Quad(at(d0, reach, z_low), at(d1, reach, z_low), at(d1, reach, z_edge), at(d0, reach, z_edge), {u0, v_low},
+           {u1, v_low}, {u1, v_edge}, {u0, v_edge}, m);
+    b.Tri(at(d0, 0.0, z_wall), at(d0, reach, z_low), at(d0, reach, z_edge), {0, 0}, {0.2f, v_low}, {0.2f, v_edge}, m);
+    b.Tri(at(d1, 0.0, z_wall), at(d1, reach, z_edge), at(d1, reach, z_low), {0, 0}, {0.2f, v_edge}, {0.2f, v_low}, m);
   }
+}
 
-  // Roofline: a hipped roof on some low buildings, else a cornice or a parapet.
+// A hipped roof over `roof_fp` at height `roof_z`, with eaves and a soffit of material `trim`.
+void AddHipRoof(MeshBuilder& b, const Box2& roof_fp, double roof_z, int trim, const ArchitectureMaterials& am,
+                SceneRng& arch) {
+  const double eave = arch.Uniform(0.3, 0.6), pitch = arch.Uniform(22.0, 35.0) * M_PI / 180.0;
+  const int tiles = am.roof_tiles[arch.UniformInt(0, static_cast<int>(am.roof_tiles.size()) - 1)];
+  const Eigen::Vector2d lo = roof_fp.min.array() - eave, hi = roof_fp.max.array() + eave;
+  // Local frame: a along the ridge, c across it.
+  const bool ridge_x = hi.x() - lo.x() >= hi.y() - lo.y();
+  const double a0 = ridge_x ? lo.x() : lo.y(), a1 = ridge_x ? hi.x() : hi.y();
+  const double c0 = ridge_x ? lo.y() : lo.x(), c1 = ridge_x ? hi.y() : hi.x();
+  const double half = 0.5 * (c1 - c0), cm = 0.5 * (c0 + c1), rise = half * std::tan(pitch);
+  auto P = [&](double a, double c, double z) { return ridge_x ? MeshBuilder::P(a, c, z) : MeshBuilder::P(c, a, z); };
+  auto uv = [&](double a, double c) {
+    return Vec2f(static_cast<float>(a / kRoofTileMetres), static_cast<float>(c / kRoofTileMetres));
+  };
+  const double z = roof_z, zr = roof_z + rise;
+  // With ridge_x false the local frame is mirrored; the tracer shades both sides of a triangle.
+  b.Quad(P(a0, c0, z), P(a1, c0, z), P(a1 - half, cm, zr), P(a0 + half, cm, zr), uv(a0, c0), uv(a1, c0),
+         uv(a1 - half, cm), uv(a0 + half, cm), tiles);
+  b.Quad(P(a1, c1, z), P(a0, c1, z), P(a0 + half, cm, zr), P(a1 - half, cm, zr), uv(a1, c1), uv(a0, c1),
+         uv(a0 + half, cm), uv(a1 - half, cm), tiles);
+  b.Tri(P(a0, c1, z), P(a0, c0, z), P(a0 + half, cm, zr), uv(c1, a0), uv(c0, a0), uv(cm, a0 + half), tiles);
+  b.Tri(P(a1, c0, z), P(a1, c1, z), P(a1 - half, cm, zr), uv(c0, a1), uv(c1, a1), uv(cm, a1 - half), tiles);
+  b.Floor(lo, hi, z, kRoofTileMetres, trim);  // eave soffit (and ceiling under the roof)
+}
+
+// Roofline: a hipped roof on some low buildings, else a cornice or a parapet. Returns the trim
+// material it drew (the rooftop structures use it too).
+int AddRoofline(MeshBuilder& b, const BuildingPlan& p, bool hip_roof, double r_roof, const ArchitectureMaterials& am,
+                SceneRng& arch) {
   const int trim = am.trim[arch.UniformInt(0, static_cast<int>(am.trim.size()) - 1)];
   const Box2& roof_fp = p.has_setback ? p.upper_footprint : p.footprint;
   const double roof_z = p.has_setback ? p.upper_height : p.height;
   if (hip_roof) {
-    const double eave = arch.Uniform(0.3, 0.6), pitch = arch.Uniform(22.0, 35.0) * M_PI / 180.0;
-    const int tiles = am.roof_tiles[arch.UniformInt(0, static_cast<int>(am.roof_tiles.size()) - 1)];
-    const Eigen::Vector2d lo = roof_fp.min.array() - eave, hi = roof_fp.max.array() + eave;
-    // Local frame: a along the ridge, c across it.
-    const bool ridge_x = hi.x() - lo.x() >= hi.y() - lo.y();
-    const double a0 = ridge_x ? lo.x() : lo.y(), a1 = ridge_x ? hi.x() : hi.y();
-    const double c0 = ridge_x ? lo.y() : lo.x(), c1 = ridge_x ? hi.y() : hi.x();
-    const double half = 0.5 * (c1 - c0), cm = 0.5 * (c0 + c1), rise = half * std::tan(pitch);
-    auto P = [&](double a, double c, double z) { return ridge_x ? MeshBuilder::P(a, c, z) : MeshBuilder::P(c, a, z); };
-    auto uv = [&](double a, double c) { return Vec2f(static_cast<float>(a / kRoofTileMetres), static_cast<float>(c / kRoofTileMetres)); };
-    const double z = roof_z, zr = roof_z + rise;
-    // With ridge_x false the local frame is mirrored; the tracer shades both sides of a triangle.
-    b.Quad(P(a0, c0, z), P(a1, c0, z), P(a1 - half, cm, zr), P(a0 + half, cm, zr), uv(a0, c0), uv(a1, c0), uv(a1 - half, cm),
-           uv(a0 + half, cm), tiles);
-    b.Quad(P(a1, c1, z), P(a0, c1, z), P(a0 + half, cm, zr), P(a1 - half, cm, zr), uv(a1, c1), uv(a0, c1), uv(a0 + half, cm),
-           uv(a1 - half, cm), tiles);
-    b.Tri(P(a0, c1, z), P(a0, c0, z), P(a0 + half, cm, zr), uv(c1, a0), uv(c0, a0), uv(cm, a0 + half), tiles);
-    b.Tri(P(a1, c0, z), P(a1, c1, z), P(a1 - half, cm, zr), uv(c0, a1), uv(c1, a1), uv(cm, a1 - half), tiles);
-    b.Floor(lo, hi, z, kRoofTileMetres, trim);  // eave soffit (and ceiling under the roof)
+    AddHipRoof(b, roof_fp, roof_z, trim, am, arch);
   } else if (r_roof < 0.75) {
     const double over = arch.Uniform(0.25, 0.45), height = arch.Uniform(0.4, 0.7);
     const int faces[5] = {trim, trim, trim, trim, am.roof};
     auto cornice = [&](const Box2& fp, double z) {
-      b.Box(MeshBuilder::P(fp.min.x() - over, fp.min.y() - over, z - height), MeshBuilder::P(fp.max.x() + over, fp.max.y() + over, z + 0.05),
-            faces, static_cast<float>(kRoofTileMetres), true);
+      b.Box(MeshBuilder::P(fp.min.x() - over, fp.min.y() - over, z - height),
+            MeshBuilder::P(fp.max.x() + over, fp.max.y() + over, z + 0.05), faces, static_cast<float>(kRoofTileMetres),
+            true);
     };
     cornice(p.footprint, p.height);
     if (p.has_setback) cornice(p.upper_footprint, p.upper_height);
@@ -640,32 +678,348 @@ void AddBuilding(MeshBuilder& b, const BuildingPlan& p, const FacadeLayout& fl, 
     box(fp.min.x(), fp.min.y() + t, fp.min.x() + t, fp.max.y() - t);
     box(fp.max.x() - t, fp.min.y() + t, fp.max.x(), fp.max.y() - t);
   }
+  return trim;
+}
 
-  // Rooftop structures on flat roofs: stair house, air conditioners, sometimes a water tank.
+// Rooftop structures on a flat roof: stair house, air conditioners, sometimes a water tank.
+void AddRooftopStructures(MeshBuilder& b, const BuildingPlan& p, int trim, const ArchitectureMaterials& am,
+                          SceneRng& arch) {
+  const Box2& roof_fp = p.has_setback ? p.upper_footprint : p.footprint;
+  const double roof_z = p.has_setback ? p.upper_height : p.height;
   const Eigen::Vector2d room = roof_fp.max - roof_fp.min;
-  if (!hip_roof && r_rooftop < 0.55 && room.minCoeff() > 5.0) {
-    const int faces[5] = {trim, trim, trim, trim, am.roof};
-    const float z = static_cast<float>(roof_z);
-    auto spot = [&](double sx, double sy) {
-      return Eigen::Vector2d(arch.Uniform(roof_fp.min.x() + 1.0, roof_fp.max.x() - 1.0 - sx),
-                             arch.Uniform(roof_fp.min.y() + 1.0, roof_fp.max.y() - 1.0 - sy));
-    };
-    const double sx = std::min(room.x() - 2.5, arch.Uniform(2.2, 3.5)), sy = std::min(room.y() - 2.5, arch.Uniform(2.2, 3.5));
-    const Eigen::Vector2d s0 = spot(sx, sy);
-    b.Box(MeshBuilder::P(s0.x(), s0.y(), z), MeshBuilder::P(s0.x() + sx, s0.y() + sy, z + arch.Uniform(2.4, 3.0)), faces,
-          static_cast<float>(kRoofTileMetres));
-    const int units = arch.UniformInt(0, 3);
-    const int metal[5] = {am.metal, am.metal, am.metal, am.metal, am.metal};
-    for (int i = 0; i < units; ++i) {
-      const Eigen::Vector2d u0 = spot(1.2, 0.8);
-      b.Box(MeshBuilder::P(u0.x(), u0.y(), z), MeshBuilder::P(u0.x() + 1.2, u0.y() + 0.8, z + 0.9), metal);
+  const int faces[5] = {trim, trim, trim, trim, am.roof};
+  const float z = static_cast<float>(roof_z);
+  auto spot = [&](double sx, double sy) {
+    return Eigen::Vector2d(arch.Uniform(roof_fp.min.x() + 1.0, roof_fp.max.x() - 1.0 - sx),
+                           arch.Uniform(roof_fp.min.y() + 1.0, roof_fp.max.y() - 1.0 - sy));
+  };
+  const double sx = std::min(room.x() - 2.5, arch.Uniform(2.2, 3.5)),
+               sy = std::min(room.y() - 2.5, arch.Uniform(2.2, 3.5));
+  const Eigen::Vector2d s0 = spot(sx, sy);
+  b.Box(MeshBuilder::P(s0.x(), s0.y(), z), MeshBuilder::P(s0.x() + sx, s0.y() + sy, z + arch.Uniform(2.4, 3.0)), faces,
+        static_cast<float>(kRoofTileMetres));
+  const int units = arch.UniformInt(0, 3);
+  const int metal[5] = {am.metal, am.metal, am.metal, am.metal, am.metal};
+  for (int i = 0; i < units; ++i) {
+    const Eigen::Vector2d u0 = spot(1.2, 0.8);
+    b.Box(MeshBuilder::P(u0.x(), u0.y(), z), MeshBuilder::P(u0.x() + 1.2, u0.y() + 0.8, z + 0.9), metal);
+  }
+  if (arch.Bernoulli(0.3)) {
+    const double r = arch.Uniform(0.8, 1.2);
+    const Eigen::Vector2d t0 = spot(2 * r, 2 * r);
+    b.Prism(MeshBuilder::P(t0.x() + r, t0.y() + r, 0), static_cast<float>(r), z,
+            z + static_cast<float>(arch.Uniform(2.0, 3.0)), 10, am.metal, am.metal);
+  }
+}
+
+// One building: storefront ground floor, facade walls, roof, and real geometry that lines up with
+// the facade texture's windows (facade relief that recesses the windows, glass-wall fins,
+// balconies), awnings over the shops, a roofline (cornice, parapet or hipped roof) and rooftop
+// structures. `arch` draws every random choice, in a fixed order per building.
+void AddBuilding(MeshBuilder& b, const BuildingPlan& p, const FacadeLayout& fl, int m_facade, int m_shop,
+                 const ArchitectureMaterials& am, const CityStyle& st, SceneRng& arch) {
+  const StreetFacade facade = MakeStreetFacade(p, fl);
+  const double r_relief = arch.Uniform(), r_balcony = arch.Uniform(), r_roof = arch.Uniform(),
+               r_awning = arch.Uniform(), r_rooftop = arch.Uniform();
+  const bool hip_roof = !p.has_setback && p.height <= 17.0 && fl.style != 3 && r_roof < 0.45;
+
+  AddBuildingWalls(b, p, m_facade, m_shop, am.roof, hip_roof);
+  AddFacadeRelief(b, facade, fl, r_relief, m_facade, arch);
+  if (fl.style != 3 && facade.floors >= 2 && r_balcony < 0.3) AddBalconies(b, facade, am, arch);
+  if (r_awning < 0.45 && facade.length > 3.0) AddAwnings(b, facade, am, st, arch);
+  const int trim = AddRoofline(b, p, hip_roof, r_roof, am, arch);
+  const Box2& roof_fp = p.has_setback ? p.upper_footprint : p.footprint;
+  const Eigen::Vector2d room = roof_fp.max - roof_fp.min;
+  if (!hip_roof && r_rooftop < 0.55 && room.minCoeff() > 5.0) AddRooftopStructures(b, p, trim, am, arch);
+}
+
+// Texture indices of the generated textures (in scene.textures).
+struct CityTextures {
+  int num_facades = 0, num_storefronts = 0, num_awnings = 0;  // facades first, then storefronts
+  int road = 0, intersection = 0, sidewalk = 0, concrete = 0, ground = 0, bark = 0, foliage = 0, sign = 0, awning = 0;
+  CarTextures car;
+};
+
+// Generates every texture in parallel (each from its own seed, so the result does not depend on threads).
+CityTextures GenerateTextures(Scene& scene, const CityStyle& st, uint64_t texture_seed, bool quick) {
+  CityTextures t;
+  t.num_facades = quick ? std::max(4, st.facade_textures / 3) : st.facade_textures;
+  t.num_storefronts = quick ? std::max(3, st.storefront_textures / 2) : st.storefront_textures;
+  t.num_awnings = quick ? 3 : 6;
+  std::vector<std::function<Texture()>> jobs;
+  for (int i = 0; i < t.num_facades; ++i) jobs.push_back([=] { return MakeFacadeTexture(texture_seed, i); });
+  for (int i = 0; i < t.num_storefronts; ++i) jobs.push_back([=] { return MakeStorefrontTexture(texture_seed, i); });
+  const auto next = [&jobs] { return static_cast<int>(jobs.size()); };
+  t.road = next();
+  for (int i = 0; i < 2; ++i) jobs.push_back([=] { return MakeRoadTexture(texture_seed, i, st.road_width_m, st.parking_lane_m); });
+  t.intersection = next();
+  jobs.push_back([=] { return MakeIntersectionTexture(texture_seed, st.road_width_m); });
+  t.sidewalk = next();
+  jobs.push_back([=] { return MakeSidewalkTexture(texture_seed); });
+  t.concrete = next();
+  jobs.push_back([=] { return MakeConcreteTexture(texture_seed); });
+  t.ground = next();
+  jobs.push_back([=] { return MakeGroundTexture(texture_seed); });
+  t.car.side = next();
+  jobs.push_back([=] { return MakeCarSideTexture(texture_seed); });
+  t.car.end = next();
+  jobs.push_back([=] { return MakeCarEndTexture(texture_seed); });
+  t.car.glass = next();
+  jobs.push_back([=] { return MakeCarGlassTexture(texture_seed); });
+  t.bark = next();
+  jobs.push_back([=] { return MakeBarkTexture(texture_seed); });
+  t.foliage = next();
+  jobs.push_back([=] { return MakeFoliageTexture(texture_seed); });
+  t.sign = next();
+  for (int k = 0; k < kSignKinds; ++k) jobs.push_back([=] { return MakeSignTexture(texture_seed, k); });
+  t.awning = next();
+  for (int k = 0; k < t.num_awnings; ++k) jobs.push_back([=] { return MakeAwningTexture(texture_seed, k); });
+  scene.textures.resize(jobs.size());
+  tbb::parallel_for(size_t{0}, jobs.size(), [&](size_t i) { scene.textures[i] = jobs[i](); });
+  return t;
+}
+
+// Materials shared by the whole city (material indices).
+struct CityMaterials {
+  int road[2] = {0, 0};
+  int intersection = 0, sidewalk = 0, curb = 0, roof = 0, ground = 0, metal = 0, lamp = 0, bark = 0, foliage = 0;
+};
+
+CityMaterials AddSharedMaterials(Scene& scene, const CityTextures& t) {
+  CityMaterials m;
+  m.road[0] = AddMaterial(scene, "road_0", {1, 1, 1}, t.road);
+  m.road[1] = AddMaterial(scene, "road_1", {1, 1, 1}, t.road + 1);
+  m.intersection = AddMaterial(scene, "intersection", {1, 1, 1}, t.intersection);
+  m.sidewalk = AddMaterial(scene, "sidewalk", {1, 1, 1}, t.sidewalk);
+  m.curb = AddMaterial(scene, "curb", {0.95f, 0.95f, 0.95f}, t.concrete);
+  m.roof = AddMaterial(scene, "roof", {0.8f, 0.78f, 0.75f}, t.concrete);
+  m.ground = AddMaterial(scene, "ground", {1, 1, 1}, t.ground);
+  m.metal = AddMaterial(scene, "pole_metal", {0.25f, 0.27f, 0.28f}, -1);
+  m.lamp = AddMaterial(scene, "lamp", {0.9f, 0.9f, 0.8f}, -1);
+  m.bark = AddMaterial(scene, "bark", {1, 1, 1}, t.bark);
+  m.foliage = AddMaterial(scene, "foliage", {1, 1, 1}, t.foliage);
+  return m;
+}
+
+// Ground beyond the city.
+void AddGround(Scene& scene, const StreetGrid& g, int m_ground) {
+  MeshBuilder b("ground");
+  const Eigen::Vector2d lo(g.MinX() - 1500, g.MinY() - 1500), hi(g.MaxX() + 1500, g.MaxY() + 1500);
+  b.Floor(lo, hi, -0.02, kGroundTileMetres, m_ground);
+  AddStatic(scene, "ground", AddMesh(scene, b.Finish()), Rigid3::Identity());
+}
+
+// Roads: segments between intersections (u along the street, v across from the left curb) and
+// intersection squares.
+void AddRoads(Scene& scene, const StreetGrid& g, const CityMaterials& m, SceneRng& rng) {
+  const double W = g.road_width_m, hw = 0.5 * W;
+  MeshBuilder b("roads");
+  const int nx = static_cast<int>(g.xs.size()), ny = static_cast<int>(g.ys.size());
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i) {  // along +x at y = ys[j]
+      const double x0 = g.xs[i] + hw, x1 = g.xs[i + 1] - hw, y = g.ys[j];
+      const float u0 = static_cast<float>(rng.Uniform(0, 1)), u1 = u0 + static_cast<float>((x1 - x0) / W);
+      b.Quad(MeshBuilder::P(x0, y - hw, 0), MeshBuilder::P(x1, y - hw, 0), MeshBuilder::P(x1, y + hw, 0),
+             MeshBuilder::P(x0, y + hw, 0), {u0, 1}, {u1, 1}, {u1, 0}, {u0, 0}, m.road[rng.UniformInt(0, 1)]);
     }
-    if (arch.Bernoulli(0.3)) {
-      const double r = arch.Uniform(0.8, 1.2);
-      const Eigen::Vector2d t0 = spot(2 * r, 2 * r);
-      b.Prism(MeshBuilder::P(t0.x() + r, t0.y() + r, 0), static_cast<float>(r), z, z + static_cast<float>(arch.Uniform(2.0, 3.0)), 10,
-              am.metal, am.metal);
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j + 1 < ny; ++j) {  // along +y at x = xs[i]; left curb is at -x
+      const double y0 = g.ys[j] + hw, y1 = g.ys[j + 1] - hw, x = g.xs[i];
+      const float u0 = static_cast<float>(rng.Uniform(0, 1)), u1 = u0 + static_cast<float>((y1 - y0) / W);
+      b.Quad(MeshBuilder::P(x + hw, y0, 0), MeshBuilder::P(x + hw, y1, 0), MeshBuilder::P(x - hw, y1, 0),
+             MeshBuilder::P(x - hw, y0, 0), {u0, 1}, {u1, 1}, {u1, 0}, {u0, 0}, m.road[rng.UniformInt(0, 1)]);
     }
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j) {
+      const double x = g.xs[i], y = g.ys[j];
+      b.Quad(MeshBuilder::P(x - hw, y - hw, 0), MeshBuilder::P(x + hw, y - hw, 0), MeshBuilder::P(x + hw, y + hw, 0),
+             MeshBuilder::P(x - hw, y + hw, 0), {0, 1}, {1, 1}, {1, 0}, {0, 0}, m.intersection);
+    }
+  AddStatic(scene, "roads", AddMesh(scene, b.Finish()), Rigid3::Identity());
+}
+
+// Sidewalk slabs with curbs, one per block.
+void AddSidewalks(Scene& scene, const std::vector<Box2>& blocks, const CityMaterials& m) {
+  MeshBuilder b("sidewalks");
+  for (const Box2& blk : blocks) {
+    b.Floor(blk.min, blk.max, kCurbHeight, kSidewalkTileMetres, m.sidewalk);
+    const Eigen::Vector2d c[4] = {blk.min, {blk.max.x(), blk.min.y()}, blk.max, {blk.min.x(), blk.max.y()}};
+    // Corners counter-clockwise seen from above: walking them in order keeps the block on the
+    // left, so each curb face's outward normal is on the right of a->b (as Wall expects).
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector2d a = c[k], bb = c[(k + 1) % 4];
+      b.Wall(a, bb, 0.0, kCurbHeight, 0.0, kRoofTileMetres, 0.0, kRoofTileMetres, m.curb);
+    }
+  }
+  AddStatic(scene, "sidewalks", AddMesh(scene, b.Finish()), Rigid3::Identity());
+}
+
+// Buildings (AddBuilding): storefronts, facades, relief, balconies, awnings, rooflines.
+void AddBuildings(Scene& scene, const CityLayout& L, const CityTextures& t, const CityMaterials& m,
+                  uint64_t layout_seed, uint64_t texture_seed) {
+  ArchitectureMaterials am;
+  am.roof = m.roof;
+  am.metal = AddMaterial(scene, "rooftop_metal", {0.62f, 0.64f, 0.66f}, t.concrete);
+  const Vec3f trims[] = {{0.95f, 0.93f, 0.88f}, {0.7f, 0.7f, 0.72f}, {0.85f, 0.78f, 0.65f}, {0.45f, 0.43f, 0.42f}};
+  for (size_t i = 0; i < 4; ++i)
+    am.trim.push_back(AddMaterial(scene, "trim_" + std::to_string(i), trims[i], t.concrete));
+  am.roof_tiles.push_back(AddMaterial(scene, "roof_tiles_0", {0.62f, 0.3f, 0.2f}, t.concrete));
+  am.roof_tiles.push_back(AddMaterial(scene, "roof_tiles_1", {0.3f, 0.32f, 0.36f}, t.concrete));
+  const Vec3f rails[] = {{0.12f, 0.12f, 0.13f}, {0.85f, 0.85f, 0.83f}, {0.3f, 0.42f, 0.42f}};
+  for (size_t i = 0; i < 3; ++i) am.railing.push_back(AddMaterial(scene, "railing_" + std::to_string(i), rails[i], -1));
+  for (int i = 0; i < t.num_awnings; ++i)
+    am.awning.push_back(AddMaterial(scene, "awning_" + std::to_string(i), {1, 1, 1}, t.awning + i));
+  SceneRng arch(SubSeed(layout_seed, "architecture"));
+  MeshBuilder b("buildings");
+  for (size_t k = 0; k < L.buildings.size(); ++k) {
+    const BuildingPlan& p = L.buildings[k];
+    const std::string name = "building_" + std::to_string(k);
+    const int m_facade = AddMaterial(scene, name + "_facade", p.tint, p.facade);
+    const int m_shop = AddMaterial(scene, name + "_shop", p.tint, t.num_facades + p.storefront);
+    AddBuilding(b, p, GetFacadeLayout(texture_seed, p.facade), m_facade, m_shop, am, L.style, arch);
+  }
+  AddStatic(scene, "buildings", AddMesh(scene, b.Finish()), Rigid3::Identity());
+}
+
+// Street light mesh: arm along +x (towards the road).
+int AddStreetLightMesh(Scene& scene, const CityMaterials& m) {
+  MeshBuilder b("street_light");
+  b.Prism({0, 0, 0}, 0.09f, 0.0f, 6.5f, 8, m.metal, m.metal);
+  const int arm[5] = {m.metal, m.metal, m.metal, m.metal, m.metal};
+  b.Box({0, -0.05f, 6.3f}, {1.6f, 0.05f, 6.42f}, arm);
+  const int lamp[5] = {m.metal, m.metal, m.metal, m.metal, m.metal};
+  b.Box({1.3f, -0.18f, 6.15f}, {1.9f, 0.18f, 6.3f}, lamp);
+  b.Floor({1.35, -0.15}, {1.85, 0.15}, 6.149, 1.0, m.lamp);
+  return AddMesh(scene, b.Finish());
+}
+
+// Tree variant v: a trunk and a crown (octahedron subdivided twice, vertices jittered; spherical UVs).
+int AddTreeMesh(Scene& scene, const CityMaterials& m, uint64_t layout_seed, int v) {
+  MeshBuilder b("tree_" + std::to_string(v));
+  const float crown = 1.7f + 0.4f * v, centre = 4.3f + 0.3f * v;
+  b.Prism({0, 0, 0}, 0.14f + 0.03f * v, 0.0f, centre, 6, m.bark, m.bark);
+  std::vector<Vec3f> tris = {{1, 0, 0},  {0, 1, 0},  {0, 0, 1},  {0, 1, 0},  {-1, 0, 0}, {0, 0, 1},
+                             {-1, 0, 0}, {0, -1, 0}, {0, 0, 1},  {0, -1, 0}, {1, 0, 0},  {0, 0, 1},
+                             {0, 1, 0},  {1, 0, 0},  {0, 0, -1}, {-1, 0, 0}, {0, 1, 0},  {0, 0, -1},
+                             {0, -1, 0}, {-1, 0, 0}, {0, 0, -1}, {1, 0, 0},  {0, -1, 0}, {0, 0, -1}};
+  for (int level = 0; level < 2; ++level) {
+    std::vector<Vec3f> next;
+    for (size_t t = 0; t < tris.size(); t += 3) {
+      const Vec3f a = tris[t], bb = tris[t + 1], c = tris[t + 2];
+      const Vec3f ab = (a + bb).normalized(), bc = (bb + c).normalized(), ca = (c + a).normalized();
+      next.insert(next.end(), {a, ab, ca, ab, bb, bc, ca, bc, c, ab, bc, ca});
+    }
+    tris = next;
+  }
+  auto jitter = [&](const Vec3f& d) {
+    // Deterministic per direction: hash the quantized direction so shared vertices move together.
+    const int64_t key =
+        std::lround(d.x() * 1000) * 1000003 + std::lround(d.y() * 1000) * 1009 + std::lround(d.z() * 1000);
+    SceneRng r(SubSeed(layout_seed ^ static_cast<uint64_t>(key), "crown", static_cast<uint64_t>(v)));
+    const float scale = crown * static_cast<float>(r.Uniform(0.8, 1.15));
+    return Vec3f(d.x() * scale, d.y() * scale, d.z() * scale * 0.85f + centre + 0.6f);
+  };
+  auto uv = [](const Vec3f& d) {
+    return Vec2f(static_cast<float>(2.0 * (std::atan2(d.y(), d.x()) / (2 * M_PI) + 0.5)),
+                 static_cast<float>(2.0 * std::acos(std::clamp(d.z(), -1.0f, 1.0f)) / M_PI));
+  };
+  for (size_t t = 0; t < tris.size(); t += 3) {
+    b.Tri(jitter(tris[t]), jitter(tris[t + 1]), jitter(tris[t + 2]), uv(tris[t]), uv(tris[t + 1]), uv(tris[t + 2]),
+          m.foliage);
+  }
+  return AddMesh(scene, b.Finish());
+}
+
+// Road sign kind k: pole and a 0.6 m plate whose face (sign texture) looks along the mesh's +x.
+int AddSignMesh(Scene& scene, const CityMaterials& m, const CityTextures& t, int k) {
+  MeshBuilder b("sign_" + std::to_string(k));
+  const int m_face = AddMaterial(scene, "sign_" + std::to_string(k), {1, 1, 1}, t.sign + k);
+  b.Prism({-0.05f, 0, 0}, 0.04f, 0.0f, 2.9f, 6, m.metal, m.metal);
+  const int plate[5] = {m.metal, m_face, m.metal, m.metal, m.metal};
+  b.Box({0.0f, -0.3f, 2.3f}, {0.025f, 0.3f, 2.9f}, plate);
+  return AddMesh(scene, b.Finish());
+}
+
+// One sign at about half of the block corners, 0.7 m from both curbs, facing traffic on one of
+// the two streets.
+void PlaceSigns(Scene& scene, const CityLayout& L, const int (&mesh_sign)[kSignKinds], SceneRng& rng) {
+  const StreetGrid& g = L.grid;
+  int signs = 0;
+  for (const Box2& blk : L.blocks) {
+    const bool inner_x = blk.min.x() > g.MinX() && blk.max.x() < g.MaxX();
+    const bool inner_y = blk.min.y() > g.MinY() && blk.max.y() < g.MaxY();
+    if (!inner_x && !inner_y) continue;  // outer corner blocks face no intersection
+    for (int corner = 0; corner < 4; ++corner) {
+      if (!rng.Bernoulli(0.5)) continue;
+      const double sx = corner & 1 ? 1.0 : -1.0, sy = corner & 2 ? 1.0 : -1.0;
+      const double x = (sx > 0 ? blk.max.x() : blk.min.x()) - 0.7 * sx,
+                   y = (sy > 0 ? blk.max.y() : blk.min.y()) - 0.7 * sy;
+      // Face traffic approaching along x (yaw 0 or pi) or along y (yaw +-pi/2) on this corner's side.
+      const double yaw = rng.Bernoulli(0.5) ? (sx > 0 ? 0.0 : M_PI) : (sy > 0 ? M_PI / 2 : -M_PI / 2);
+      AddStatic(scene, "sign_" + std::to_string(signs++), mesh_sign[rng.UniformInt(0, kSignKinds - 1)],
+                PlaceYaw(x, y, yaw, kCurbHeight));
+    }
+  }
+}
+
+// Along every street segment side: lights every ~28 m, trees between them, parked cars in the lane.
+void FurnishStreets(Scene& scene, const CityLayout& L, int mesh_light, const int (&mesh_tree)[3], CarFactory& cars,
+                    SceneRng& rng) {
+  const CityStyle& st = L.style;
+  const StreetGrid& g = L.grid;
+  const double hw = 0.5 * g.road_width_m;
+  int lights = 0, trees = 0;
+  const int nx = static_cast<int>(g.xs.size()), ny = static_cast<int>(g.ys.size());
+  auto furnish = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& dir, double length,
+                     const Eigen::Vector2d& to_road) {
+    // a: start of the curb line; dir: along the street; to_road: unit normal from sidewalk to road.
+    const double yaw_to_road = std::atan2(to_road.y(), to_road.x());
+    for (double s = 6.0; s < length - 6.0; s += 28.0) {
+      const Eigen::Vector2d p = a + s * dir - 0.45 * to_road;
+      AddStatic(scene, "light_" + std::to_string(lights++), mesh_light,
+                PlaceYaw(p.x(), p.y(), yaw_to_road, kCurbHeight));
+      if (st.trees && s + 14.0 < length - 6.0 && rng.Bernoulli(0.8)) {
+        const Eigen::Vector2d q = a + (s + 14.0) * dir - 1.0 * to_road;
+        AddStatic(scene, "tree_" + std::to_string(trees++), mesh_tree[rng.UniformInt(0, 2)],
+                  PlaceYaw(q.x(), q.y(), rng.Uniform(0, 2 * M_PI), kCurbHeight));
+      }
+    }
+    if (st.parked_cars && st.parking_lane_m > 0) {
+      for (double s = 9.0; s < length - 9.0; s += 6.5) {
+        if (!rng.Bernoulli(0.45)) continue;
+        const Eigen::Vector2d p = a + s * dir + (0.5 * st.parking_lane_m + 0.15) * to_road;
+        const int mesh = cars.Get(rng.UniformInt(0, kNumCarShapes - 1), rng.UniformInt(0, kNumCarColors - 1));
+        AddStatic(scene, "parked_car", mesh,
+                  PlaceYaw(p.x(), p.y(), std::atan2(dir.y(), dir.x()) + rng.Normal(0, 0.02)));
+      }
+    }
+  };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i) {
+      const double x0 = g.xs[i] + hw, len = g.xs[i + 1] - hw - x0;
+      furnish({x0, g.ys[j] - hw}, {1, 0}, len, {0, 1});
+      furnish({x0 + len, g.ys[j] + hw}, {-1, 0}, len, {0, -1});
+    }
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j + 1 < ny; ++j) {
+      const double y0 = g.ys[j] + hw, len = g.ys[j + 1] - hw - y0;
+      furnish({g.xs[i] + hw, y0}, {0, 1}, len, {-1, 0});
+      furnish({g.xs[i] - hw, y0 + len}, {0, -1}, len, {1, 0});
+    }
+}
+
+// Moving vehicles (ids 1..N for the masks).
+void AddTraffic(Scene& scene, const CityLayout& L, uint64_t traffic_seed, double frame_rate, CarFactory& cars) {
+  const int frames = static_cast<int>(L.trajectory.size());
+  const std::vector<VehicleTrack> tracks = PlanTraffic(L, traffic_seed, frames, frame_rate);
+  uint16_t id = 1;
+  for (const VehicleTrack& v : tracks) {
+    Object o;
+    o.name = "vehicle_" + std::to_string(id) + "_" + v.kind;
+    o.mesh = cars.Get(v.shape, v.color);
+    o.id = id++;
+    o.world_from_object_per_frame = v.world_from_object;
+    scene.objects.push_back(std::move(o));
   }
 }
 
@@ -690,255 +1044,24 @@ Scene GenerateScene(const std::string& preset_name, uint64_t seed, bool quick) {
   scene.rig_trajectory = L.trajectory;
   scene.lighting = MakeLighting(preset.lighting, SubSeed(seed, preset.lighting.c_str()), st.high_sun_along_streets);
 
-  // Textures, generated in parallel (each from its own seed, so the result does not depend on threads).
-  const int num_facades = quick ? std::max(4, st.facade_textures / 3) : st.facade_textures;
-  const int num_storefronts = quick ? std::max(3, st.storefront_textures / 2) : st.storefront_textures;
-  std::vector<std::function<Texture()>> jobs;
-  for (int i = 0; i < num_facades; ++i) jobs.push_back([=] { return MakeFacadeTexture(texture_seed, i); });
-  for (int i = 0; i < num_storefronts; ++i) jobs.push_back([=] { return MakeStorefrontTexture(texture_seed, i); });
-  const int t_road = static_cast<int>(jobs.size());
-  for (int i = 0; i < 2; ++i) jobs.push_back([=] { return MakeRoadTexture(texture_seed, i, st.road_width_m, st.parking_lane_m); });
-  const int t_intersection = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeIntersectionTexture(texture_seed, st.road_width_m); });
-  const int t_sidewalk = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeSidewalkTexture(texture_seed); });
-  const int t_concrete = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeConcreteTexture(texture_seed); });
-  const int t_ground = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeGroundTexture(texture_seed); });
-  CarTextures car_tex;
-  car_tex.side = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeCarSideTexture(texture_seed); });
-  car_tex.end = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeCarEndTexture(texture_seed); });
-  car_tex.glass = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeCarGlassTexture(texture_seed); });
-  const int t_bark = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeBarkTexture(texture_seed); });
-  const int t_foliage = static_cast<int>(jobs.size());
-  jobs.push_back([=] { return MakeFoliageTexture(texture_seed); });
-  const int t_sign = static_cast<int>(jobs.size());
-  for (int k = 0; k < kSignKinds; ++k) jobs.push_back([=] { return MakeSignTexture(texture_seed, k); });
-  const int t_awning = static_cast<int>(jobs.size()), num_awnings = quick ? 3 : 6;
-  for (int k = 0; k < num_awnings; ++k) jobs.push_back([=] { return MakeAwningTexture(texture_seed, k); });
-  scene.textures.resize(jobs.size());
-  tbb::parallel_for(size_t{0}, jobs.size(), [&](size_t i) { scene.textures[i] = jobs[i](); });
-
-  // Shared materials.
-  const int m_road[2] = {AddMaterial(scene, "road_0", {1, 1, 1}, t_road), AddMaterial(scene, "road_1", {1, 1, 1}, t_road + 1)};
-  const int m_intersection = AddMaterial(scene, "intersection", {1, 1, 1}, t_intersection);
-  const int m_sidewalk = AddMaterial(scene, "sidewalk", {1, 1, 1}, t_sidewalk);
-  const int m_curb = AddMaterial(scene, "curb", {0.95f, 0.95f, 0.95f}, t_concrete);
-  const int m_roof = AddMaterial(scene, "roof", {0.8f, 0.78f, 0.75f}, t_concrete);
-  const int m_ground = AddMaterial(scene, "ground", {1, 1, 1}, t_ground);
-  const int m_metal = AddMaterial(scene, "pole_metal", {0.25f, 0.27f, 0.28f}, -1);
-  const int m_lamp = AddMaterial(scene, "lamp", {0.9f, 0.9f, 0.8f}, -1);
-  const int m_bark = AddMaterial(scene, "bark", {1, 1, 1}, t_bark);
-  const int m_foliage = AddMaterial(scene, "foliage", {1, 1, 1}, t_foliage);
-
-  const StreetGrid& g = L.grid;
-  const double W = g.road_width_m, hw = 0.5 * W;
-
-  // Ground beyond the city.
-  {
-    MeshBuilder b("ground");
-    const Eigen::Vector2d lo(g.MinX() - 1500, g.MinY() - 1500), hi(g.MaxX() + 1500, g.MaxY() + 1500);
-    b.Floor(lo, hi, -0.02, kGroundTileMetres, m_ground);
-    AddStatic(scene, "ground", AddMesh(scene, b.Finish()), Rigid3::Identity());
-  }
-  // Roads: segments between intersections (u along the street, v across from the left curb) and
-  // intersection squares.
-  {
-    MeshBuilder b("roads");
-    const int nx = static_cast<int>(g.xs.size()), ny = static_cast<int>(g.ys.size());
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i + 1 < nx; ++i) {  // along +x at y = ys[j]
-        const double x0 = g.xs[i] + hw, x1 = g.xs[i + 1] - hw, y = g.ys[j];
-        const float u0 = static_cast<float>(rng.Uniform(0, 1)), u1 = u0 + static_cast<float>((x1 - x0) / W);
-        b.Quad(MeshBuilder::P(x0, y - hw, 0), MeshBuilder::P(x1, y - hw, 0), MeshBuilder::P(x1, y + hw, 0),
-               MeshBuilder::P(x0, y + hw, 0), {u0, 1}, {u1, 1}, {u1, 0}, {u0, 0}, m_road[rng.UniformInt(0, 1)]);
-      }
-    for (int i = 0; i < nx; ++i)
-      for (int j = 0; j + 1 < ny; ++j) {  // along +y at x = xs[i]; left curb is at -x
-        const double y0 = g.ys[j] + hw, y1 = g.ys[j + 1] - hw, x = g.xs[i];
-        const float u0 = static_cast<float>(rng.Uniform(0, 1)), u1 = u0 + static_cast<float>((y1 - y0) / W);
-        b.Quad(MeshBuilder::P(x + hw, y0, 0), MeshBuilder::P(x + hw, y1, 0), MeshBuilder::P(x - hw, y1, 0),
-               MeshBuilder::P(x - hw, y0, 0), {u0, 1}, {u1, 1}, {u1, 0}, {u0, 0}, m_road[rng.UniformInt(0, 1)]);
-      }
-    for (int i = 0; i < nx; ++i)
-      for (int j = 0; j < ny; ++j) {
-        const double x = g.xs[i], y = g.ys[j];
-        b.Quad(MeshBuilder::P(x - hw, y - hw, 0), MeshBuilder::P(x + hw, y - hw, 0), MeshBuilder::P(x + hw, y + hw, 0),
-               MeshBuilder::P(x - hw, y + hw, 0), {0, 1}, {1, 1}, {1, 0}, {0, 0}, m_intersection);
-      }
-    AddStatic(scene, "roads", AddMesh(scene, b.Finish()), Rigid3::Identity());
-  }
-  // Sidewalk slabs with curbs, one per block.
-  {
-    MeshBuilder b("sidewalks");
-    for (const Box2& blk : L.blocks) {
-      b.Floor(blk.min, blk.max, kCurbHeight, kSidewalkTileMetres, m_sidewalk);
-      const Eigen::Vector2d c[4] = {blk.min, {blk.max.x(), blk.min.y()}, blk.max, {blk.min.x(), blk.max.y()}};
-      // Corners counter-clockwise seen from above: walking them in order keeps the block on the
-      // left, so each curb face's outward normal is on the right of a->b (as Wall expects).
-      for (int k = 0; k < 4; ++k) {
-        const Eigen::Vector2d a = c[k], bb = c[(k + 1) % 4];
-        b.Wall(a, bb, 0.0, kCurbHeight, 0.0, kRoofTileMetres, 0.0, kRoofTileMetres, m_curb);
-      }
-    }
-    AddStatic(scene, "sidewalks", AddMesh(scene, b.Finish()), Rigid3::Identity());
-  }
-  // Buildings (AddBuilding): storefronts, facades, relief, balconies, awnings, rooflines.
-  {
-    ArchitectureMaterials am;
-    am.roof = m_roof;
-    am.metal = AddMaterial(scene, "rooftop_metal", {0.62f, 0.64f, 0.66f}, t_concrete);
-    const Vec3f trims[] = {{0.95f, 0.93f, 0.88f}, {0.7f, 0.7f, 0.72f}, {0.85f, 0.78f, 0.65f}, {0.45f, 0.43f, 0.42f}};
-    for (size_t i = 0; i < 4; ++i) am.trim.push_back(AddMaterial(scene, "trim_" + std::to_string(i), trims[i], t_concrete));
-    am.roof_tiles.push_back(AddMaterial(scene, "roof_tiles_0", {0.62f, 0.3f, 0.2f}, t_concrete));
-    am.roof_tiles.push_back(AddMaterial(scene, "roof_tiles_1", {0.3f, 0.32f, 0.36f}, t_concrete));
-    const Vec3f rails[] = {{0.12f, 0.12f, 0.13f}, {0.85f, 0.85f, 0.83f}, {0.3f, 0.42f, 0.42f}};
-    for (size_t i = 0; i < 3; ++i) am.railing.push_back(AddMaterial(scene, "railing_" + std::to_string(i), rails[i], -1));
-    for (int i = 0; i < num_awnings; ++i) am.awning.push_back(AddMaterial(scene, "awning_" + std::to_string(i), {1, 1, 1}, t_awning + i));
-    SceneRng arch(SubSeed(layout_seed, "architecture"));
-    MeshBuilder b("buildings");
-    for (size_t k = 0; k < L.buildings.size(); ++k) {
-      const BuildingPlan& p = L.buildings[k];
-      const std::string name = "building_" + std::to_string(k);
-      const int m_facade = AddMaterial(scene, name + "_facade", p.tint, p.facade);
-      const int m_shop = AddMaterial(scene, name + "_shop", p.tint, num_facades + p.storefront);
-      AddBuilding(b, p, GetFacadeLayout(texture_seed, p.facade), m_facade, m_shop, am, st, arch);
-    }
-    AddStatic(scene, "buildings", AddMesh(scene, b.Finish()), Rigid3::Identity());
-  }
+  const CityTextures textures = GenerateTextures(scene, st, texture_seed, quick);
+  const CityMaterials materials = AddSharedMaterials(scene, textures);
+  AddGround(scene, L.grid, materials.ground);
+  AddRoads(scene, L.grid, materials, rng);
+  AddSidewalks(scene, L.blocks, materials);
+  AddBuildings(scene, L, textures, materials, layout_seed, texture_seed);
 
   // Street furniture: shared meshes placed along the curbs.
-  int mesh_light, mesh_tree[3];
-  {
-    MeshBuilder b("street_light");  // arm along +x (towards the road)
-    b.Prism({0, 0, 0}, 0.09f, 0.0f, 6.5f, 8, m_metal, m_metal);
-    const int arm[5] = {m_metal, m_metal, m_metal, m_metal, m_metal};
-    b.Box({0, -0.05f, 6.3f}, {1.6f, 0.05f, 6.42f}, arm);
-    const int lamp[5] = {m_metal, m_metal, m_metal, m_metal, m_metal};
-    b.Box({1.3f, -0.18f, 6.15f}, {1.9f, 0.18f, 6.3f}, lamp);
-    b.Floor({1.35, -0.15}, {1.85, 0.15}, 6.149, 1.0, m_lamp);
-    mesh_light = AddMesh(scene, b.Finish());
-  }
-  for (int v = 0; v < 3; ++v) {
-    MeshBuilder b("tree_" + std::to_string(v));
-    const float crown = 1.7f + 0.4f * v, centre = 4.3f + 0.3f * v;
-    b.Prism({0, 0, 0}, 0.14f + 0.03f * v, 0.0f, centre, 6, m_bark, m_bark);
-    // Crown: octahedron subdivided twice, vertices jittered; spherical UVs.
-    std::vector<Vec3f> tris = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0, 1, 0}, {-1, 0, 0}, {0, 0, 1}, {-1, 0, 0}, {0, -1, 0},
-                               {0, 0, 1}, {0, -1, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, {1, 0, 0}, {0, 0, -1}, {-1, 0, 0},
-                               {0, 1, 0}, {0, 0, -1}, {0, -1, 0}, {-1, 0, 0}, {0, 0, -1}, {1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
-    for (int level = 0; level < 2; ++level) {
-      std::vector<Vec3f> next;
-      for (size_t t = 0; t < tris.size(); t += 3) {
-        const Vec3f a = tris[t], bb = tris[t + 1], c = tris[t + 2];
-        const Vec3f ab = (a + bb).normalized(), bc = (bb + c).normalized(), ca = (c + a).normalized();
-        next.insert(next.end(), {a, ab, ca, ab, bb, bc, ca, bc, c, ab, bc, ca});
-      }
-      tris = next;
-    }
-    auto jitter = [&](const Vec3f& d) {
-      // Deterministic per direction: hash the quantized direction so shared vertices move together.
-      const int64_t key = std::lround(d.x() * 1000) * 1000003 + std::lround(d.y() * 1000) * 1009 + std::lround(d.z() * 1000);
-      SceneRng r(SubSeed(layout_seed ^ static_cast<uint64_t>(key), "crown", static_cast<uint64_t>(v)));
-      const float scale = crown * static_cast<float>(r.Uniform(0.8, 1.15));
-      return Vec3f(d.x() * scale, d.y() * scale, d.z() * scale * 0.85f + centre + 0.6f);
-    };
-    auto uv = [](const Vec3f& d) {
-      return Vec2f(static_cast<float>(2.0 * (std::atan2(d.y(), d.x()) / (2 * M_PI) + 0.5)), static_cast<float>(2.0 * std::acos(std::clamp(d.z(), -1.0f, 1.0f)) / M_PI));
-    };
-    for (size_t t = 0; t < tris.size(); t += 3) {
-      b.Tri(jitter(tris[t]), jitter(tris[t + 1]), jitter(tris[t + 2]), uv(tris[t]), uv(tris[t + 1]), uv(tris[t + 2]), m_foliage);
-    }
-    mesh_tree[v] = AddMesh(scene, b.Finish());
-  }
-  // Road signs: pole and a 0.6 m plate whose face (sign texture) looks along the mesh's +x.
+  const int mesh_light = AddStreetLightMesh(scene, materials);
+  int mesh_tree[3];
+  for (int v = 0; v < 3; ++v) mesh_tree[v] = AddTreeMesh(scene, materials, layout_seed, v);
   int mesh_sign[kSignKinds];
-  for (int k = 0; k < kSignKinds; ++k) {
-    MeshBuilder b("sign_" + std::to_string(k));
-    const int m_face = AddMaterial(scene, "sign_" + std::to_string(k), {1, 1, 1}, t_sign + k);
-    b.Prism({-0.05f, 0, 0}, 0.04f, 0.0f, 2.9f, 6, m_metal, m_metal);
-    const int plate[5] = {m_metal, m_face, m_metal, m_metal, m_metal};
-    b.Box({0.0f, -0.3f, 2.3f}, {0.025f, 0.3f, 2.9f}, plate);
-    mesh_sign[k] = AddMesh(scene, b.Finish());
-  }
-  // One sign at about half of the block corners, 0.7 m from both curbs, facing traffic on one of
-  // the two streets.
-  {
-    int signs = 0;
-    for (const Box2& blk : L.blocks) {
-      const bool inner_x = blk.min.x() > g.MinX() && blk.max.x() < g.MaxX();
-      const bool inner_y = blk.min.y() > g.MinY() && blk.max.y() < g.MaxY();
-      if (!inner_x && !inner_y) continue;  // outer corner blocks face no intersection
-      for (int corner = 0; corner < 4; ++corner) {
-        if (!rng.Bernoulli(0.5)) continue;
-        const double sx = corner & 1 ? 1.0 : -1.0, sy = corner & 2 ? 1.0 : -1.0;
-        const double x = (sx > 0 ? blk.max.x() : blk.min.x()) - 0.7 * sx, y = (sy > 0 ? blk.max.y() : blk.min.y()) - 0.7 * sy;
-        // Face traffic approaching along x (yaw 0 or pi) or along y (yaw +-pi/2) on this corner's side.
-        const double yaw = rng.Bernoulli(0.5) ? (sx > 0 ? 0.0 : M_PI) : (sy > 0 ? M_PI / 2 : -M_PI / 2);
-        AddStatic(scene, "sign_" + std::to_string(signs++), mesh_sign[rng.UniformInt(0, kSignKinds - 1)],
-                  PlaceYaw(x, y, yaw, kCurbHeight));
-      }
-    }
-  }
-  CarFactory cars(scene, car_tex);
-  {
-    int lights = 0, trees = 0;
-    // Along every street segment side: lights every ~28 m, trees between them, parked cars in the lane.
-    const int nx = static_cast<int>(g.xs.size()), ny = static_cast<int>(g.ys.size());
-    auto furnish = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& dir, double length, const Eigen::Vector2d& to_road) {
-      // a: start of the curb line; dir: along the street; to_road: unit normal from sidewalk to road.
-      const double yaw_to_road = std::atan2(to_road.y(), to_road.x());
-      for (double s = 6.0; s < length - 6.0; s += 28.0) {
-        const Eigen::Vector2d p = a + s * dir - 0.45 * to_road;
-        AddStatic(scene, "light_" + std::to_string(lights++), mesh_light, PlaceYaw(p.x(), p.y(), yaw_to_road, kCurbHeight));
-        if (st.trees && s + 14.0 < length - 6.0 && rng.Bernoulli(0.8)) {
-          const Eigen::Vector2d q = a + (s + 14.0) * dir - 1.0 * to_road;
-          AddStatic(scene, "tree_" + std::to_string(trees++), mesh_tree[rng.UniformInt(0, 2)],
-                    PlaceYaw(q.x(), q.y(), rng.Uniform(0, 2 * M_PI), kCurbHeight));
-        }
-      }
-      if (st.parked_cars && st.parking_lane_m > 0) {
-        for (double s = 9.0; s < length - 9.0; s += 6.5) {
-          if (!rng.Bernoulli(0.45)) continue;
-          const Eigen::Vector2d p = a + s * dir + (0.5 * st.parking_lane_m + 0.15) * to_road;
-          const int mesh = cars.Get(rng.UniformInt(0, kNumCarShapes - 1), rng.UniformInt(0, kNumCarColors - 1));
-          AddStatic(scene, "parked_car", mesh, PlaceYaw(p.x(), p.y(), std::atan2(dir.y(), dir.x()) + rng.Normal(0, 0.02)));
-        }
-      }
-    };
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i + 1 < nx; ++i) {
-        const double x0 = g.xs[i] + hw, len = g.xs[i + 1] - hw - x0;
-        furnish({x0, g.ys[j] - hw}, {1, 0}, len, {0, 1});
-        furnish({x0 + len, g.ys[j] + hw}, {-1, 0}, len, {0, -1});
-      }
-    for (int i = 0; i < nx; ++i)
-      for (int j = 0; j + 1 < ny; ++j) {
-        const double y0 = g.ys[j] + hw, len = g.ys[j + 1] - hw - y0;
-        furnish({g.xs[i] + hw, y0}, {0, 1}, len, {-1, 0});
-        furnish({g.xs[i] - hw, y0 + len}, {0, -1}, len, {1, 0});
-      }
-  }
+  for (int k = 0; k < kSignKinds; ++k) mesh_sign[k] = AddSignMesh(scene, materials, textures, k);
+  PlaceSigns(scene, L, mesh_sign, rng);
+  CarFactory cars(scene, textures.car);
+  FurnishStreets(scene, L, mesh_light, mesh_tree, cars, rng);
 
-  // Moving vehicles (ids 1..N for the masks).
-  if (preset.traffic) {
-    const int frames = static_cast<int>(L.trajectory.size());
-    const std::vector<VehicleTrack> tracks = PlanTraffic(L, layout_seed ^ seed, frames, preset.frame_rate);
-    uint16_t id = 1;
-    for (const VehicleTrack& v : tracks) {
-      Object o;
-      o.name = "vehicle_" + std::to_string(id) + "_" + v.kind;
-      o.mesh = cars.Get(v.shape, v.color);
-      o.id = id++;
-      o.world_from_object_per_frame = v.world_from_object;
-      scene.objects.push_back(std::move(o));
-    }
-  }
+  if (preset.traffic) AddTraffic(scene, L, layout_seed ^ seed, preset.frame_rate, cars);
   return scene;
 }
 

@@ -349,6 +349,148 @@ double QuickPathLength(const ScenePreset& preset) {
   return preset.path_length_m * (preset.quick_frames - 1) / std::max(1, preset.frames - 1);
 }
 
+namespace {
+
+// Facade texture counts of a preset's style (GenerateScene makes the same numbers).
+struct FacadeCounts {
+  int facades = 0, storefronts = 0;
+  uint64_t texture_seed = 0;
+};
+
+// One building on the lot [a, b] of strip `side` (0 south, 1 north, 2 west, 3 east) of `lots`.
+BuildingPlan PlanBuilding(const CityStyle& st, const Box2& lots, int side, double a, double b, double depth,
+                          const FacadeCounts& counts, SceneRng& rng) {
+  const bool along_x = side < 2;
+  const double d = depth * rng.Uniform(0.7, 1.0);
+  BuildingPlan p;
+  switch (side) {
+    case 0:
+      p.footprint = {{a, lots.min.y()}, {b, lots.min.y() + d}}, p.facing = {0, -1};
+      break;
+    case 1:
+      p.footprint = {{a, lots.max.y() - d}, {b, lots.max.y()}}, p.facing = {0, 1};
+      break;
+    case 2:
+      p.footprint = {{lots.min.x(), a}, {lots.min.x() + d, b}}, p.facing = {-1, 0};
+      break;
+    default:
+      p.footprint = {{lots.max.x() - d, a}, {lots.max.x(), b}}, p.facing = {1, 0};
+      break;
+  }
+  static const Eigen::Vector3f kPalette[] = {{1.0f, 0.93f, 0.8f},  {0.95f, 0.7f, 0.55f}, {0.85f, 0.85f, 0.85f},
+                                             {0.8f, 0.88f, 1.0f},  {1.0f, 0.85f, 0.55f}, {1.0f, 1.0f, 1.0f},
+                                             {0.75f, 0.6f, 0.5f},  {0.9f, 1.0f, 0.85f},  {1.0f, 0.8f, 0.8f}};
+  // Whole storeys: a 4 m shop floor, 3.2 m upper floors, a 0.4 m parapet.
+  const double h = rng.Uniform(st.height_min_m, st.height_max_m) * (rng.Bernoulli(0.1) ? 1.5 : 1.0);
+  p.height = kStorefrontHeightMetres +
+             std::max(1L, std::lround((h - kStorefrontHeightMetres) / kFloorHeightMetres)) * kFloorHeightMetres + 0.4;
+  p.facade = rng.UniformInt(0, counts.facades - 1);
+  p.storefront = rng.UniformInt(0, counts.storefronts - 1);
+  const Eigen::Vector3f base = kPalette[rng.UniformInt(0, 8)];
+  for (int c = 0; c < 3; ++c) p.tint[c] = std::min(1.0f, base[c] * static_cast<float>(rng.Uniform(0.85, 1.08)));
+  const int bays = FacadeBays(counts.texture_seed, p.facade);
+  p.u_offset = rng.UniformInt(0, bays - 1) * kFacadeTileMetres / bays;
+  if (p.height > 12 && rng.Bernoulli(0.3)) {
+    p.has_setback = true;
+    Box2 up = p.footprint;
+    const double back = rng.Uniform(2.0, 4.0);
+    // Step back from the street side; keep 1 m from the lot's side walls.
+    if (p.facing.x() < 0) up.min.x() += back;
+    if (p.facing.x() > 0) up.max.x() -= back;
+    if (p.facing.y() < 0) up.min.y() += back;
+    if (p.facing.y() > 0) up.max.y() -= back;
+    if (along_x)
+      up.min.x() += 1.0, up.max.x() -= 1.0;
+    else
+      up.min.y() += 1.0, up.max.y() -= 1.0;
+    p.upper_footprint = up;
+    p.upper_height = p.height + rng.UniformInt(1, 3) * kFloorHeightMetres;
+    if ((up.max - up.min).minCoeff() < 3.0) p.has_setback = false;
+  }
+  return p;
+}
+
+// Blocks between the street lines `ex` x `ey` (block edges) and their buildings: four strips of
+// lots per block; south and north span the full width, west and east fill between them.
+void PlanBlocks(CityLayout* L, const std::vector<double>& ex, const std::vector<double>& ey, const FacadeCounts& counts,
+                SceneRng& rng) {
+  const CityStyle& st = L->style;
+  const double hw = 0.5 * st.road_width_m;
+  for (size_t bx = 0; bx + 1 < ex.size(); ++bx) {
+    for (size_t by = 0; by + 1 < ey.size(); ++by) {
+      Box2 block{{ex[bx] + hw, ey[by] + hw}, {ex[bx + 1] - hw, ey[by + 1] - hw}};
+      L->blocks.push_back(block);
+      const Box2 lots{block.min.array() + st.sidewalk_width_m, block.max.array() - st.sidewalk_width_m};
+      const Eigen::Vector2d size = lots.max - lots.min;
+      const double depth = std::min(rng.Uniform(st.lot_depth_min_m, st.lot_depth_max_m), 0.5 * size.minCoeff() - 0.5);
+      for (int side = 0; side < 4; ++side) {
+        const bool along_x = side < 2;
+        const double a0 = along_x ? lots.min.x() : lots.min.y() + depth;
+        const double a1 = along_x ? lots.max.x() : lots.max.y() - depth;
+        double a = a0;
+        while (a1 - a > 1.0) {
+          double w = rng.Uniform(st.lot_width_min_m, st.lot_width_max_m);
+          if (a1 - (a + w) < st.lot_width_min_m) w = a1 - a;
+          const double b = a + w;
+          const bool gap = st.trees && rng.Bernoulli(0.07);
+          const BuildingPlan p = PlanBuilding(st, lots, side, a, b, depth, counts, rng);
+          if (!gap && w > 2.0) L->buildings.push_back(p);
+          a = b;
+        }
+      }
+    }
+  }
+}
+
+// The rig's drive: start near the centre; retry routes until the timing is feasible.
+void PlanRigDrive(CityLayout* L, int streets, double length, double tail, double first_edge, int frames,
+                  SceneRng& rng) {
+  const CityStyle& st = L->style;
+  const StreetGrid& g = L->grid;
+  const Eigen::Vector2i centre(streets / 2, streets / 2);
+  for (int attempt = 0; attempt < 50; ++attempt) {
+    const int dir = rng.UniformInt(0, 3);
+    L->route = RandomRoute(g, rng, length + tail + first_edge, st.straight_preference, centre, dir);
+    L->rig_path = PathAlongRoute(g, L->route, 0.5 * (st.road_width_m - 2 * st.parking_lane_m) * 0.5);
+    // Start 12 m after the first intersection (short quick drives then stay on one straight block).
+    L->path_begin_s = 12.0;
+    if (L->path_begin_s + length + tail > L->rig_path.Length()) continue;
+    if (PlanDrive(L->rig_path, L->path_begin_s, length, frames, L->preset.frame_rate, &L->drive)) break;
+    L->drive.s.clear();
+  }
+  if (L->drive.s.empty()) throw std::runtime_error("MakeCityLayout: no feasible drive for preset " + L->preset.name);
+}
+
+// Rig poses: yaw along the path, body roll/pitch from the accelerations, small vibrations.
+void MakeRigTrajectory(CityLayout* L, uint64_t seed, int frames) {
+  SceneRng vib(SubSeed(seed, "vibration"));
+  double amp[6], freq[6], phase[6];
+  for (int k = 0; k < 6; ++k) {
+    amp[k] = vib.Uniform(0.05, 0.12);  // degrees
+    freq[k] = vib.Uniform(0.3, 1.3);   // Hz
+    phase[k] = vib.Uniform(0, 2 * M_PI);
+  }
+  const double bob_freq = vib.Uniform(0.8, 1.2), bob_phase = vib.Uniform(0, 2 * M_PI);
+  L->trajectory.resize(frames);
+  for (int f = 0; f < frames; ++f) {
+    const double t = f / L->preset.frame_rate, s = L->drive.s[f];
+    const Eigen::Vector2d xy = L->rig_path.Position(s);
+    const double yaw = L->rig_path.Heading(s);
+    const double v = L->drive.speed[f];
+    const double lateral = v * v * L->rig_path.Curvature(s);
+    double roll = 0.3 * lateral, pitch = -0.3 * L->drive.accel_longitudinal[f];
+    for (int k = 0; k < 3; ++k) roll += amp[k] * std::sin(2 * M_PI * freq[k] * t + phase[k]);
+    for (int k = 3; k < 6; ++k) pitch += amp[k] * std::sin(2 * M_PI * freq[k] * t + phase[k]);
+    const double z = kRigHeight + 0.004 * std::sin(2 * M_PI * bob_freq * t + bob_phase);
+    StampedPose& p = L->trajectory[f];
+    p.timestamp = t;
+    p.world_from_rig =
+        Rigid3(QuaternionFromRollPitchYawDeg(roll, pitch, yaw * 180.0 / M_PI), Eigen::Vector3d(xy.x(), xy.y(), z));
+  }
+}
+
+}  // namespace
+
 CityLayout MakeCityLayout(const ScenePreset& preset, uint64_t seed, bool quick) {
   CityLayout L;
   L.preset = preset;
@@ -373,7 +515,8 @@ CityLayout MakeCityLayout(const ScenePreset& preset, uint64_t seed, bool quick) 
   g.parking_lane_m = st.parking_lane_m;
   for (auto* axis : {&g.xs, &g.ys}) {
     axis->push_back(0.0);
-    for (int i = 1; i < streets; ++i) axis->push_back(axis->back() + st.road_width_m + rng.Uniform(st.block_min_m, st.block_max_m));
+    for (int i = 1; i < streets; ++i)
+      axis->push_back(axis->back() + st.road_width_m + rng.Uniform(st.block_min_m, st.block_max_m));
   }
 
   // Blocks: between streets, plus one ring outside (whose outer side faces open ground).
@@ -385,110 +528,14 @@ CityLayout MakeCityLayout(const ScenePreset& preset, uint64_t seed, bool quick) 
     return e;
   };
   const std::vector<double> ex = edges(g.xs), ey = edges(g.ys);
-  const double hw = 0.5 * st.road_width_m;
-  static const Eigen::Vector3f kPalette[] = {{1.0f, 0.93f, 0.8f},  {0.95f, 0.7f, 0.55f}, {0.85f, 0.85f, 0.85f},
-                                             {0.8f, 0.88f, 1.0f},  {1.0f, 0.85f, 0.55f}, {1.0f, 1.0f, 1.0f},
-                                             {0.75f, 0.6f, 0.5f},  {0.9f, 1.0f, 0.85f},  {1.0f, 0.8f, 0.8f}};
-  const int num_facades = quick ? std::max(4, st.facade_textures / 3) : st.facade_textures;
-  const int num_storefronts = quick ? std::max(3, st.storefront_textures / 2) : st.storefront_textures;
-  const uint64_t texture_seed = SubSeed(layout_seed, "textures");
+  FacadeCounts counts;
+  counts.facades = quick ? std::max(4, st.facade_textures / 3) : st.facade_textures;
+  counts.storefronts = quick ? std::max(3, st.storefront_textures / 2) : st.storefront_textures;
+  counts.texture_seed = SubSeed(layout_seed, "textures");
+  PlanBlocks(&L, ex, ey, counts, rng);
 
-  for (size_t bx = 0; bx + 1 < ex.size(); ++bx) {
-    for (size_t by = 0; by + 1 < ey.size(); ++by) {
-      Box2 block{{ex[bx] + hw, ey[by] + hw}, {ex[bx + 1] - hw, ey[by + 1] - hw}};
-      L.blocks.push_back(block);
-      const Box2 lots{block.min.array() + st.sidewalk_width_m, block.max.array() - st.sidewalk_width_m};
-      const Eigen::Vector2d size = lots.max - lots.min;
-      const double depth = std::min(rng.Uniform(st.lot_depth_min_m, st.lot_depth_max_m), 0.5 * size.minCoeff() - 0.5);
-      // Four strips: south and north span the full width; west and east fill between them.
-      for (int side = 0; side < 4; ++side) {
-        const bool along_x = side < 2;
-        const double a0 = along_x ? lots.min.x() : lots.min.y() + depth;
-        const double a1 = along_x ? lots.max.x() : lots.max.y() - depth;
-        double a = a0;
-        while (a1 - a > 1.0) {
-          double w = rng.Uniform(st.lot_width_min_m, st.lot_width_max_m);
-          if (a1 - (a + w) < st.lot_width_min_m) w = a1 - a;
-          const double b = a + w;
-          const bool gap = st.trees && rng.Bernoulli(0.07);
-          const double d = depth * rng.Uniform(0.7, 1.0);
-          BuildingPlan p;
-          switch (side) {
-            case 0: p.footprint = {{a, lots.min.y()}, {b, lots.min.y() + d}}, p.facing = {0, -1}; break;
-            case 1: p.footprint = {{a, lots.max.y() - d}, {b, lots.max.y()}}, p.facing = {0, 1}; break;
-            case 2: p.footprint = {{lots.min.x(), a}, {lots.min.x() + d, b}}, p.facing = {-1, 0}; break;
-            default: p.footprint = {{lots.max.x() - d, a}, {lots.max.x(), b}}, p.facing = {1, 0}; break;
-          }
-          // Whole storeys: a 4 m shop floor, 3.2 m upper floors, a 0.4 m parapet.
-          const double h = rng.Uniform(st.height_min_m, st.height_max_m) * (rng.Bernoulli(0.1) ? 1.5 : 1.0);
-          p.height = kStorefrontHeightMetres + std::max(1L, std::lround((h - kStorefrontHeightMetres) / kFloorHeightMetres)) * kFloorHeightMetres + 0.4;
-          p.facade = rng.UniformInt(0, num_facades - 1);
-          p.storefront = rng.UniformInt(0, num_storefronts - 1);
-          const Eigen::Vector3f base = kPalette[rng.UniformInt(0, 8)];
-          for (int c = 0; c < 3; ++c) p.tint[c] = std::min(1.0f, base[c] * static_cast<float>(rng.Uniform(0.85, 1.08)));
-          const int bays = FacadeBays(texture_seed, p.facade);
-          p.u_offset = rng.UniformInt(0, bays - 1) * kFacadeTileMetres / bays;
-          if (p.height > 12 && rng.Bernoulli(0.3)) {
-            p.has_setback = true;
-            Box2 up = p.footprint;
-            const double back = rng.Uniform(2.0, 4.0);
-            // Step back from the street side; keep 1 m from the lot's side walls.
-            if (p.facing.x() < 0) up.min.x() += back;
-            if (p.facing.x() > 0) up.max.x() -= back;
-            if (p.facing.y() < 0) up.min.y() += back;
-            if (p.facing.y() > 0) up.max.y() -= back;
-            if (along_x) up.min.x() += 1.0, up.max.x() -= 1.0;
-            else up.min.y() += 1.0, up.max.y() -= 1.0;
-            p.upper_footprint = up;
-            p.upper_height = p.height + rng.UniformInt(1, 3) * kFloorHeightMetres;
-            if ((up.max - up.min).minCoeff() < 3.0) p.has_setback = false;
-          }
-          if (!gap && w > 2.0) L.buildings.push_back(p);
-          a = b;
-        }
-      }
-    }
-  }
-
-  // The rig's drive: start near the centre; retry routes until the timing is feasible.
-  const Eigen::Vector2i centre(streets / 2, streets / 2);
-  for (int attempt = 0; attempt < 50; ++attempt) {
-    const int dir = rng.UniformInt(0, 3);
-    const double first_edge = avg_block;
-    L.route = RandomRoute(g, rng, length + tail + first_edge, st.straight_preference, centre, dir);
-    L.rig_path = PathAlongRoute(g, L.route, 0.5 * (st.road_width_m - 2 * st.parking_lane_m) * 0.5);
-    // Start 12 m after the first intersection (short quick drives then stay on one straight block).
-    L.path_begin_s = 12.0;
-    if (L.path_begin_s + length + tail > L.rig_path.Length()) continue;
-    if (PlanDrive(L.rig_path, L.path_begin_s, length, frames, preset.frame_rate, &L.drive)) break;
-    L.drive.s.clear();
-  }
-  if (L.drive.s.empty()) throw std::runtime_error("MakeCityLayout: no feasible drive for preset " + preset.name);
-
-  // Rig poses: yaw along the path, body roll/pitch from the accelerations, small vibrations.
-  SceneRng vib(SubSeed(seed, "vibration"));
-  double amp[6], freq[6], phase[6];
-  for (int k = 0; k < 6; ++k) {
-    amp[k] = vib.Uniform(0.05, 0.12);  // degrees
-    freq[k] = vib.Uniform(0.3, 1.3);   // Hz
-    phase[k] = vib.Uniform(0, 2 * M_PI);
-  }
-  const double bob_freq = vib.Uniform(0.8, 1.2), bob_phase = vib.Uniform(0, 2 * M_PI);
-  L.trajectory.resize(frames);
-  for (int f = 0; f < frames; ++f) {
-    const double t = f / preset.frame_rate, s = L.drive.s[f];
-    const Eigen::Vector2d xy = L.rig_path.Position(s);
-    const double yaw = L.rig_path.Heading(s);
-    const double v = L.drive.speed[f];
-    const double lateral = v * v * L.rig_path.Curvature(s);
-    double roll = 0.3 * lateral, pitch = -0.3 * L.drive.accel_longitudinal[f];
-    for (int k = 0; k < 3; ++k) roll += amp[k] * std::sin(2 * M_PI * freq[k] * t + phase[k]);
-    for (int k = 3; k < 6; ++k) pitch += amp[k] * std::sin(2 * M_PI * freq[k] * t + phase[k]);
-    const double z = kRigHeight + 0.004 * std::sin(2 * M_PI * bob_freq * t + bob_phase);
-    StampedPose& p = L.trajectory[f];
-    p.timestamp = t;
-    p.world_from_rig = Rigid3(QuaternionFromRollPitchYawDeg(roll, pitch, yaw * 180.0 / M_PI), Eigen::Vector3d(xy.x(), xy.y(), z));
-  }
+  PlanRigDrive(&L, streets, length, tail, avg_block, frames, rng);
+  MakeRigTrajectory(&L, seed, frames);
   L.path_length_m = PathLength(L.trajectory);
   return L;
 }

@@ -375,28 +375,22 @@ void SaveScene(const Scene& scene, const std::string& dir) {
   WriteJsonFileAtomic((fs::path(dir) / "scene.json").string(), root);
 }
 
-Scene LoadScene(const std::string& dir) {
-  if (!HostIsLittleEndian()) throw std::runtime_error("LoadScene: big-endian hosts are not supported");
-  const std::string file = (fs::path(dir) / "scene.json").string();
-  const json doc = ReadJsonFile(file);
-  const Field root(doc, file, "");
-  if (root["format"].String() != "rovo-scene") Fail(file, "format", "expected \"rovo-scene\"");
-  const int64_t version = root["format_version"].Int(1, 1000);
-  if (version != kFormatVersion) Fail(file, "format_version", "unsupported version " + std::to_string(version));
+namespace {
 
-  Scene scene;
+// scene.json's metadata, frame rate, rig preset and lighting.
+void ReadSceneHeader(const Field& root, const std::string& file, Scene* scene) {
   const Field meta = root["metadata"];
-  scene.metadata.generator = meta["generator"].String();
-  scene.metadata.generator_version = meta["generator_version"].String();
-  scene.metadata.preset = meta["preset"].String();
-  scene.metadata.seed = meta["seed"].UInt64();
-  scene.metadata.source = meta["source"].String();
-  scene.frame_rate = root["frame_rate"].Number();
-  if (!(scene.frame_rate > 0)) Fail(file, "frame_rate", "must be positive");
-  scene.rig_preset = root["rig_preset"].String();
+  scene->metadata.generator = meta["generator"].String();
+  scene->metadata.generator_version = meta["generator_version"].String();
+  scene->metadata.preset = meta["preset"].String();
+  scene->metadata.seed = meta["seed"].UInt64();
+  scene->metadata.source = meta["source"].String();
+  scene->frame_rate = root["frame_rate"].Number();
+  if (!(scene->frame_rate > 0)) Fail(file, "frame_rate", "must be positive");
+  scene->rig_preset = root["rig_preset"].String();
 
   const Field jl = root["lighting"];
-  Lighting& l = scene.lighting;
+  Lighting& l = scene->lighting;
   l.preset = jl["preset"].String();
   l.direction_to_sun = jl["direction_to_sun"].Vector<3>();
   l.sun_radiance = jl["sun_radiance"].Vector<3>().cast<float>();
@@ -406,19 +400,16 @@ Scene LoadScene(const std::string& dir) {
   l.ground_albedo = jl["ground_albedo"].Vector<3>().cast<float>();
   l.ambient = static_cast<float>(jl["ambient"].Number());
   l.exposure = static_cast<float>(jl["exposure"].Number());
+}
 
-  const std::string trajectory_name = root["trajectory"].String();
-  const std::string trajectory_path = (fs::path(dir) / trajectory_name).string();
-  if (!fs::exists(trajectory_path)) Fail(file, "trajectory", "file '" + trajectory_path + "' does not exist");
-  scene.rig_trajectory = ParseSceneTum(trajectory_path);
-  const int64_t frames = static_cast<int64_t>(scene.rig_trajectory.size());
-
+// The texture list and the PNGs it names.
+void ReadTextures(const Field& root, const std::string& dir, const std::string& file, Scene* scene) {
   const Field jt = root["textures"];
-  scene.textures.resize(jt.ArraySize());
-  std::vector<std::string> png_paths(scene.textures.size());
-  for (size_t i = 0; i < scene.textures.size(); ++i) {
+  scene->textures.resize(jt.ArraySize());
+  std::vector<std::string> png_paths(scene->textures.size());
+  for (size_t i = 0; i < scene->textures.size(); ++i) {
     const Field f = jt[i];
-    Texture& t = scene.textures[i];
+    Texture& t = scene->textures[i];
     t.name = f["name"].String();
     t.width = static_cast<int>(f["width"].Int(1, 1 << 16));
     t.height = static_cast<int>(f["height"].Int(1, 1 << 16));
@@ -429,100 +420,134 @@ Scene LoadScene(const std::string& dir) {
     png_paths[i] = (fs::path(dir) / png).string();
   }
   // PNG decoding dominates loading; the first failure (by TBB's rules) is rethrown here.
-  tbb::parallel_for(size_t{0}, scene.textures.size(), [&](size_t i) {
-    ReadPng(png_paths[i], scene.textures[i], file, "textures[" + std::to_string(i) + "].file");
+  tbb::parallel_for(size_t{0}, scene->textures.size(), [&](size_t i) {
+    ReadPng(png_paths[i], scene->textures[i], file, "textures[" + std::to_string(i) + "].file");
   });
+}
 
+void ReadMaterials(const Field& root, Scene* scene) {
   const Field jmat = root["materials"];
-  scene.materials.resize(jmat.ArraySize());
-  for (size_t i = 0; i < scene.materials.size(); ++i) {
+  scene->materials.resize(jmat.ArraySize());
+  for (size_t i = 0; i < scene->materials.size(); ++i) {
     const Field f = jmat[i];
-    Material& m = scene.materials[i];
+    Material& m = scene->materials[i];
     m.name = f["name"].String();
     m.base_color = f["base_color"].Vector<3>().cast<float>();
-    m.texture = static_cast<int>(f["texture"].Int(-1, static_cast<int64_t>(scene.textures.size()) - 1));
+    m.texture = static_cast<int>(f["texture"].Int(-1, static_cast<int64_t>(scene->textures.size()) - 1));
   }
-  const int64_t num_materials = static_cast<int64_t>(scene.materials.size());
+}
+
+// One mesh of /meshes: its arrays from the named buffer, checked (finite vertices, indices in range).
+Mesh ReadMesh(const Field& f, BufferCache& buffers, const std::string& file, int64_t num_materials) {
+  Mesh m;
+  m.name = f["name"].String();
+  m.material = static_cast<int>(f["material"].Int(0, num_materials - 1));
+  const std::string buffer_name = f["buffer"].String();
+  const std::string& buffer = buffers.Get(buffer_name, file, f.path() + ".buffer");
+  const int64_t nv = f["vertex_count"].Int(0, INT32_MAX);
+  const int64_t nt = f["triangle_count"].Int(0, INT32_MAX);
+  m.positions.resize(nv);
+  CopyFromBuffer(buffer, f["positions_offset"].Int(0, INT64_MAX), nv, 3 * sizeof(float), m.positions.data(), file,
+                 f.path() + ".positions_offset", buffer_name);
+  const int64_t uv_offset = f["uvs_offset"].Int(-1, INT64_MAX);
+  if (uv_offset >= 0) {
+    m.uvs.resize(nv);
+    CopyFromBuffer(buffer, uv_offset, nv, 2 * sizeof(float), m.uvs.data(), file, f.path() + ".uvs_offset", buffer_name);
+  }
+  m.triangles.resize(nt);
+  CopyFromBuffer(buffer, f["triangles_offset"].Int(0, INT64_MAX), nt, 3 * sizeof(int32_t), m.triangles.data(), file,
+                 f.path() + ".triangles_offset", buffer_name);
+  const int64_t tm_offset = f["triangle_materials_offset"].Int(-1, INT64_MAX);
+  if (tm_offset >= 0) {
+    m.triangle_materials.resize(nt);
+    CopyFromBuffer(buffer, tm_offset, nt, sizeof(int32_t), m.triangle_materials.data(), file,
+                   f.path() + ".triangle_materials_offset", buffer_name);
+  }
+  for (size_t k = 0; k < m.positions.size(); ++k) {
+    if (!m.positions[k].allFinite())
+      Fail(file, f.path() + ".positions_offset", "vertex " + std::to_string(k) + " is not finite");
+  }
+  for (size_t k = 0; k < m.triangles.size(); ++k) {
+    const Eigen::Vector3i& tri = m.triangles[k];
+    if (tri.minCoeff() < 0 || tri.maxCoeff() >= nv) {
+      Fail(file, f.path() + ".triangles_offset",
+           "triangle " + std::to_string(k) + " has a vertex index outside [0, " + std::to_string(nv) + ")");
+    }
+  }
+  for (size_t k = 0; k < m.triangle_materials.size(); ++k) {
+    if (m.triangle_materials[k] < 0 || m.triangle_materials[k] >= num_materials) {
+      Fail(file, f.path() + ".triangle_materials_offset",
+           "triangle " + std::to_string(k) + " has material " + std::to_string(m.triangle_materials[k]) +
+               " outside [0, " + std::to_string(num_materials) + ")");
+    }
+  }
+  return m;
+}
+
+// One object of /objects: a static pose or `frames` poses from a motion buffer.
+Object ReadObject(const Field& f, BufferCache& buffers, const std::string& file, int64_t num_meshes, int64_t frames) {
+  Object o;
+  o.name = f["name"].String();
+  o.mesh = static_cast<int>(f["mesh"].Int(0, num_meshes - 1));
+  o.id = static_cast<uint16_t>(f["id"].Int(0, 65535));
+  const bool has_static = f.Has("world_from_object"), has_motion = f.Has("motion");
+  if (has_static == has_motion) Fail(file, f.path(), "needs exactly one of world_from_object or motion");
+  if (has_static) {
+    o.world_from_object = RigidFromJson(f["world_from_object"]);
+    return o;
+  }
+  const Field fm = f["motion"];
+  const std::string buffer_name = fm["buffer"].String();
+  const std::string& buffer = buffers.Get(buffer_name, file, fm.path() + ".buffer");
+  const int64_t n = fm["frames"].Int(1, INT32_MAX);
+  if (n != frames) {
+    Fail(file, fm.path() + ".frames",
+         std::to_string(n) + " transforms but the trajectory has " + std::to_string(frames) + " poses");
+  }
+  std::vector<double> rec(static_cast<size_t>(n) * 7);
+  CopyFromBuffer(buffer, fm["offset"].Int(0, INT64_MAX), static_cast<size_t>(n), 7 * sizeof(double), rec.data(), file,
+                 fm.path() + ".offset", buffer_name);
+  o.world_from_object_per_frame.resize(n);
+  for (int64_t k = 0; k < n; ++k) {
+    const double* r = &rec[k * 7];
+    Rigid3& x = o.world_from_object_per_frame[k];
+    x.rotation = QuaternionFromXyzw(r[0], r[1], r[2], r[3], file, fm.path() + " frame " + std::to_string(k));
+    x.translation = Eigen::Vector3d(r[4], r[5], r[6]);
+    if (!x.translation.allFinite()) Fail(file, fm.path(), "frame " + std::to_string(k) + " translation is not finite");
+  }
+  return o;
+}
+
+}  // namespace
+
+Scene LoadScene(const std::string& dir) {
+  if (!HostIsLittleEndian()) throw std::runtime_error("LoadScene: big-endian hosts are not supported");
+  const std::string file = (fs::path(dir) / "scene.json").string();
+  const json doc = ReadJsonFile(file);
+  const Field root(doc, file, "");
+  if (root["format"].String() != "rovo-scene") Fail(file, "format", "expected \"rovo-scene\"");
+  const int64_t version = root["format_version"].Int(1, 1000);
+  if (version != kFormatVersion) Fail(file, "format_version", "unsupported version " + std::to_string(version));
+
+  Scene scene;
+  ReadSceneHeader(root, file, &scene);
+  const std::string trajectory_name = root["trajectory"].String();
+  const std::string trajectory_path = (fs::path(dir) / trajectory_name).string();
+  if (!fs::exists(trajectory_path)) Fail(file, "trajectory", "file '" + trajectory_path + "' does not exist");
+  scene.rig_trajectory = ParseSceneTum(trajectory_path);
+  const int64_t frames = static_cast<int64_t>(scene.rig_trajectory.size());
+  ReadTextures(root, dir, file, &scene);
+  ReadMaterials(root, &scene);
 
   BufferCache buffers(dir);
   const Field jmesh = root["meshes"];
   scene.meshes.resize(jmesh.ArraySize());
-  for (size_t i = 0; i < scene.meshes.size(); ++i) {
-    const Field f = jmesh[i];
-    Mesh& m = scene.meshes[i];
-    m.name = f["name"].String();
-    m.material = static_cast<int>(f["material"].Int(0, num_materials - 1));
-    const std::string buffer_name = f["buffer"].String();
-    const std::string& buffer = buffers.Get(buffer_name, file, f.path() + ".buffer");
-    const int64_t nv = f["vertex_count"].Int(0, INT32_MAX);
-    const int64_t nt = f["triangle_count"].Int(0, INT32_MAX);
-    m.positions.resize(nv);
-    CopyFromBuffer(buffer, f["positions_offset"].Int(0, INT64_MAX), nv, 3 * sizeof(float), m.positions.data(), file,
-                   f.path() + ".positions_offset", buffer_name);
-    const int64_t uv_offset = f["uvs_offset"].Int(-1, INT64_MAX);
-    if (uv_offset >= 0) {
-      m.uvs.resize(nv);
-      CopyFromBuffer(buffer, uv_offset, nv, 2 * sizeof(float), m.uvs.data(), file, f.path() + ".uvs_offset", buffer_name);
-    }
-    m.triangles.resize(nt);
-    CopyFromBuffer(buffer, f["triangles_offset"].Int(0, INT64_MAX), nt, 3 * sizeof(int32_t), m.triangles.data(), file,
-                   f.path() + ".triangles_offset", buffer_name);
-    const int64_t tm_offset = f["triangle_materials_offset"].Int(-1, INT64_MAX);
-    if (tm_offset >= 0) {
-      m.triangle_materials.resize(nt);
-      CopyFromBuffer(buffer, tm_offset, nt, sizeof(int32_t), m.triangle_materials.data(), file,
-                     f.path() + ".triangle_materials_offset", buffer_name);
-    }
-    for (size_t k = 0; k < m.positions.size(); ++k) {
-      if (!m.positions[k].allFinite()) Fail(file, f.path() + ".positions_offset", "vertex " + std::to_string(k) + " is not finite");
-    }
-    for (size_t k = 0; k < m.triangles.size(); ++k) {
-      const Eigen::Vector3i& tri = m.triangles[k];
-      if (tri.minCoeff() < 0 || tri.maxCoeff() >= nv) {
-        Fail(file, f.path() + ".triangles_offset", "triangle " + std::to_string(k) + " has a vertex index outside [0, " + std::to_string(nv) + ")");
-      }
-    }
-    for (size_t k = 0; k < m.triangle_materials.size(); ++k) {
-      if (m.triangle_materials[k] < 0 || m.triangle_materials[k] >= num_materials) {
-        Fail(file, f.path() + ".triangle_materials_offset", "triangle " + std::to_string(k) + " has material " +
-             std::to_string(m.triangle_materials[k]) + " outside [0, " + std::to_string(num_materials) + ")");
-      }
-    }
-  }
-
+  for (size_t i = 0; i < scene.meshes.size(); ++i)
+    scene.meshes[i] = ReadMesh(jmesh[i], buffers, file, static_cast<int64_t>(scene.materials.size()));
   const Field jo = root["objects"];
   scene.objects.resize(jo.ArraySize());
-  for (size_t i = 0; i < scene.objects.size(); ++i) {
-    const Field f = jo[i];
-    Object& o = scene.objects[i];
-    o.name = f["name"].String();
-    o.mesh = static_cast<int>(f["mesh"].Int(0, static_cast<int64_t>(scene.meshes.size()) - 1));
-    o.id = static_cast<uint16_t>(f["id"].Int(0, 65535));
-    const bool has_static = f.Has("world_from_object"), has_motion = f.Has("motion");
-    if (has_static == has_motion) Fail(file, f.path(), "needs exactly one of world_from_object or motion");
-    if (has_static) {
-      o.world_from_object = RigidFromJson(f["world_from_object"]);
-      continue;
-    }
-    const Field fm = f["motion"];
-    const std::string buffer_name = fm["buffer"].String();
-    const std::string& buffer = buffers.Get(buffer_name, file, fm.path() + ".buffer");
-    const int64_t n = fm["frames"].Int(1, INT32_MAX);
-    if (n != frames) {
-      Fail(file, fm.path() + ".frames", std::to_string(n) + " transforms but the trajectory has " + std::to_string(frames) + " poses");
-    }
-    std::vector<double> rec(static_cast<size_t>(n) * 7);
-    CopyFromBuffer(buffer, fm["offset"].Int(0, INT64_MAX), static_cast<size_t>(n), 7 * sizeof(double), rec.data(), file,
-                   fm.path() + ".offset", buffer_name);
-    o.world_from_object_per_frame.resize(n);
-    for (int64_t k = 0; k < n; ++k) {
-      const double* r = &rec[k * 7];
-      Rigid3& x = o.world_from_object_per_frame[k];
-      x.rotation = QuaternionFromXyzw(r[0], r[1], r[2], r[3], file, fm.path() + " frame " + std::to_string(k));
-      x.translation = Eigen::Vector3d(r[4], r[5], r[6]);
-      if (!x.translation.allFinite()) Fail(file, fm.path(), "frame " + std::to_string(k) + " translation is not finite");
-    }
-  }
+  for (size_t i = 0; i < scene.objects.size(); ++i)
+    scene.objects[i] = ReadObject(jo[i], buffers, file, static_cast<int64_t>(scene.meshes.size()), frames);
   return scene;
 }
 

@@ -110,6 +110,16 @@ struct Frontend::Impl {
   std::vector<ViewMatch> last_matches;
   uint64_t last_id = 0;
 
+  // Steps of Frontend::Process (bearings_in_cam: per view, the bearing of every tracked point).
+  using ViewBearings = std::vector<std::vector<std::optional<Eigen::Vector3d>>>;
+  void CheckImages(const std::vector<cv::Mat>& fisheye_images) const;
+  void RunViewStages(const std::vector<cv::Mat>& fisheye_images, ViewBearings* bearings_in_cam, FrontendFrame* frame,
+                     double* bearings_ms, double* bearings_cpu_ms);
+  void MatchViewsAndUnifyIds(ViewBearings* bearings_in_cam, FrontendFrame* frame);
+  std::vector<MatchView> MakeMatchViews(const ViewBearings& bearings_in_cam) const;
+  void UnifyIds(const std::vector<std::vector<InterviewMatch>>& pair_matches, FrontendFrame* frame);
+  void CollectFeatures(const ViewBearings& bearings_in_cam, FrontendFrame* frame) const;
+
   void UpdatePairs() {
     pairs.clear();
     std::set<std::pair<int, int>> seen;
@@ -229,31 +239,32 @@ std::vector<Refinement> RefineNewMatches(const ViewTracker& tracker_a, const Vie
 
 }  // namespace
 
-FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
-  Impl& s = *impl_;
-  const int n = s.rig.NumCameras();
+void Frontend::Impl::CheckImages(const std::vector<cv::Mat>& fisheye_images) const {
+  const int n = rig.NumCameras();
   if (static_cast<int>(fisheye_images.size()) != n) {
     throw std::invalid_argument("Frontend::Process: " + std::to_string(fisheye_images.size()) + " images for " +
                                 std::to_string(n) + " cameras");
   }
   for (int i = 0; i < n; ++i) {
-    const Camera& camera = s.rig.cameras[i].camera;
+    const Camera& camera = rig.cameras[i].camera;
     if (fisheye_images[i].cols != camera.width || fisheye_images[i].rows != camera.height) {
       throw std::invalid_argument("Frontend::Process: image of camera " + std::to_string(i) + " is " +
                                   std::to_string(fisheye_images[i].cols) + "x" + std::to_string(fisheye_images[i].rows) +
                                   ", expected " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
     }
   }
-  FrontendFrame frame;
-  const ScopedOpenCvThreads serial_opencv;
+}
 
-  // The per-view stages (warp, track, detect + describe, bearings) run fused in one parallel loop
-  // over the views, without a barrier between stages. Stage times are the section's wall and CPU
-  // time apportioned by each stage's share of the per-view wall durations summed over the views.
+// The per-view stages (warp, track, detect + describe, bearings) run fused in one parallel loop
+// over the views, without a barrier between stages. Stage times are the section's wall and CPU
+// time apportioned by each stage's share of the per-view wall durations summed over the views; the
+// bearings' share is returned for the matching time.
+void Frontend::Impl::RunViewStages(const std::vector<cv::Mat>& fisheye_images, ViewBearings* bearings_in_cam,
+                                   FrontendFrame* frame, double* bearings_ms, double* bearings_cpu_ms) {
+  const int n = rig.NumCameras();
   enum { kWarp, kTrack, kDetect, kBearings, kStages };
   std::vector<std::array<double, kStages>> view_ms(n);
-  // Bearings of all points (exact, from the warped pixels), shared by matching and the output.
-  std::vector<std::vector<std::optional<Eigen::Vector3d>>> bearings_in_cam(n);
+  bearings_in_cam->assign(n, {});
   const auto section_start = std::chrono::steady_clock::now();
   const double section_cpu_start = CpuMs();
   tbb::parallel_for(0, n, [&](int i) {
@@ -263,27 +274,27 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
       view_ms[i][stage] = std::chrono::duration<double, std::milli>(now - start).count();
       start = now;
     };
-    s.fisheye_gray[i] = ToGray(fisheye_images[i], i);
-    // A fresh buffer: the tracker still holds the previous warped image (s.warped[i] shares it).
-    cv::Mat warped;
-    s.projections[i].Warp(s.fisheye_gray[i], &warped);
-    s.warped[i] = warped;
+    fisheye_gray[i] = ToGray(fisheye_images[i], i);
+    // A fresh buffer: the tracker still holds the previous warped image (warped[i] shares it).
+    cv::Mat warped_image;
+    projections[i].Warp(fisheye_gray[i], &warped_image);
+    warped[i] = warped_image;
     lap(kWarp);
-    s.trackers[i].Track(s.warped[i], s.projections[i].valid_mask());
+    trackers[i].Track(warped[i], projections[i].valid_mask());
     lap(kTrack);
-    s.trackers[i].DetectAndDescribe([] { return uint64_t{0}; });  // ids below
+    trackers[i].DetectAndDescribe([] { return uint64_t{0}; });  // ids below
     lap(kDetect);
-    const auto& points = s.trackers[i].points();
-    bearings_in_cam[i].reserve(points.size());
+    const auto& points = trackers[i].points();
+    (*bearings_in_cam)[i].reserve(points.size());
     for (const TrackedPoint& p : points) {
-      bearings_in_cam[i].push_back(s.projections[i].BearingFromWarped(Eigen::Vector2d(p.px.x, p.px.y)));
+      (*bearings_in_cam)[i].push_back(projections[i].BearingFromWarped(Eigen::Vector2d(p.px.x, p.px.y)));
     }
     lap(kBearings);
   });
   // New points got id 0 in parallel; ids in camera order (deterministic).
   for (int i = 0; i < n; ++i) {
-    for (TrackedPoint& p : s.trackers[i].points()) {
-      if (p.track_id == 0) p.track_id = ++s.last_id;
+    for (TrackedPoint& p : trackers[i].points()) {
+      if (p.track_id == 0) p.track_id = ++last_id;
     }
   }
   const double section_ms = MsSince(section_start), section_cpu_ms = CpuMs() - section_cpu_start;
@@ -294,93 +305,106 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
   double all_stages = 0;
   for (double t : stage_sum) all_stages += t;
   const auto share = [&](int stage) { return all_stages > 0 ? stage_sum[stage] / all_stages : 0.25; };
-  frame.ms_warp = section_ms * share(kWarp);
-  frame.ms_track = section_ms * share(kTrack);
-  frame.ms_detect = section_ms * share(kDetect);
-  frame.cpu_ms_warp = section_cpu_ms * share(kWarp);
-  frame.cpu_ms_track = section_cpu_ms * share(kTrack);
-  frame.cpu_ms_detect = section_cpu_ms * share(kDetect);
+  frame->ms_warp = section_ms * share(kWarp);
+  frame->ms_track = section_ms * share(kTrack);
+  frame->ms_detect = section_ms * share(kDetect);
+  frame->cpu_ms_warp = section_cpu_ms * share(kWarp);
+  frame->cpu_ms_track = section_cpu_ms * share(kTrack);
+  frame->cpu_ms_detect = section_cpu_ms * share(kDetect);
+  *bearings_ms = section_ms * share(kBearings);
+  *bearings_cpu_ms = section_cpu_ms * share(kBearings);
+}
 
-  const auto start = std::chrono::steady_clock::now();
-  const double cpu_start = CpuMs();
-  s.last_matches.clear();
-  if (s.options.match_between_views && !s.pairs.empty()) {
-    std::vector<MatchView> views(n);
-    for (int i = 0; i < n; ++i) {
-      const Eigen::Matrix3d rig_from_cam = s.rig.cameras[i].cam_from_rig.RotationMatrix().transpose();
-      views[i].points = &s.trackers[i].points();
-      views[i].centre_in_rig = s.rig.cameras[i].cam_from_rig.Inverse().translation;
-      views[i].image = &s.warped[i];
-      const HybridProjection* projection = &s.projections[i];
-      const Eigen::Matrix3d cam_from_rig = rig_from_cam.transpose();
-      views[i].pixel_from_direction_in_rig = [projection, cam_from_rig](const Eigen::Vector3d& d) {
-        return projection->WarpedInImageFromBearing(cam_from_rig * d);
-      };
-      views[i].bearings_in_rig.reserve(bearings_in_cam[i].size());
-      for (const auto& bearing : bearings_in_cam[i]) {
-        views[i].bearings_in_rig.push_back(bearing ? Eigen::Vector3d(rig_from_cam * *bearing) : Eigen::Vector3d::Zero());
-      }
-    }
-    std::vector<std::vector<InterviewMatch>> pair_matches(s.pairs.size());
-    std::vector<std::vector<Refinement>> refinements(s.pairs.size());
-    tbb::parallel_for(0, static_cast<int>(s.pairs.size()), [&](int k) {
-      const auto [a, b] = s.pairs[k];
-      PairGeometry geometry;
-      geometry.up_in_rig = s.layouts[a].up_in_rig;
-      geometry.plane_normal_in_rig = s.layouts[a].right_normal_in_rig;
-      geometry.focal_px = 0.5 * (s.projections[a].focal_px() + s.projections[b].focal_px());
-      pair_matches[k] = MatchViews(geometry, views[a], views[b], s.options.matching);
-      if (s.options.refine_matches) {
-        refinements[k] = RefineNewMatches(s.trackers[a], s.trackers[b], a, b, pair_matches[k], s.options.klt_window_px);
-      }
-    });
-    for (const auto& list : refinements) {
-      for (const Refinement& r : list) {
-        TrackedPoint& p = s.trackers[r.camera].points()[r.index];
-        p.px = r.px;
-        bearings_in_cam[r.camera][r.index] = s.projections[r.camera].BearingFromWarped(Eigen::Vector2d(r.px.x, r.px.y));
-      }
-    }
-
-    // Unify ids sequentially: `from` = the younger (larger) id, `into` = the older one. A merge that
-    // would put one id twice into a view is refused.
-    std::vector<std::unordered_map<uint64_t, int>> index_of(n);
-    for (int i = 0; i < n; ++i) {
-      const auto& points = s.trackers[i].points();
-      for (int k = 0; k < static_cast<int>(points.size()); ++k) index_of[i][points[k].track_id] = k;
-    }
-    for (size_t k = 0; k < s.pairs.size(); ++k) {
-      const auto [a, b] = s.pairs[k];
-      for (const InterviewMatch& m : pair_matches[k]) {
-        auto& pa = s.trackers[a].points()[m.index_a];
-        auto& pb = s.trackers[b].points()[m.index_b];
-        if (pa.track_id != pb.track_id) {
-          const uint64_t into = std::min(pa.track_id, pb.track_id);
-          const uint64_t from = std::max(pa.track_id, pb.track_id);
-          bool conflict = false;
-          for (int i = 0; i < n && !conflict; ++i) conflict = index_of[i].count(from) && index_of[i].count(into);
-          if (conflict) continue;
-          for (int i = 0; i < n; ++i) {
-            const auto it = index_of[i].find(from);
-            if (it == index_of[i].end()) continue;
-            const int index = it->second;
-            s.trackers[i].points()[index].track_id = into;
-            index_of[i].erase(it);
-            index_of[i][into] = index;
-          }
-          frame.merged_ids.emplace_back(from, into);
-        }
-        s.last_matches.push_back({a, b, m.index_a, m.index_b});
-      }
+std::vector<MatchView> Frontend::Impl::MakeMatchViews(const ViewBearings& bearings_in_cam) const {
+  const int n = rig.NumCameras();
+  std::vector<MatchView> views(n);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Matrix3d rig_from_cam = rig.cameras[i].cam_from_rig.RotationMatrix().transpose();
+    views[i].points = &trackers[i].points();
+    views[i].centre_in_rig = rig.cameras[i].cam_from_rig.Inverse().translation;
+    views[i].image = &warped[i];
+    const HybridProjection* projection = &projections[i];
+    const Eigen::Matrix3d cam_from_rig = rig_from_cam.transpose();
+    views[i].pixel_from_direction_in_rig = [projection, cam_from_rig](const Eigen::Vector3d& d) {
+      return projection->WarpedInImageFromBearing(cam_from_rig * d);
+    };
+    views[i].bearings_in_rig.reserve(bearings_in_cam[i].size());
+    for (const auto& bearing : bearings_in_cam[i]) {
+      views[i].bearings_in_rig.push_back(bearing ? Eigen::Vector3d(rig_from_cam * *bearing) : Eigen::Vector3d::Zero());
     }
   }
-  frame.ms_match = MsSince(start) + section_ms * share(kBearings);
-  frame.cpu_ms_match = CpuMs() - cpu_start + section_cpu_ms * share(kBearings);
+  return views;
+}
 
-  frame.features_per_camera.resize(n);
+// Unify ids sequentially: `from` = the younger (larger) id, `into` = the older one. A merge that
+// would put one id twice into a view is refused. Fills last_matches and frame->merged_ids.
+void Frontend::Impl::UnifyIds(const std::vector<std::vector<InterviewMatch>>& pair_matches, FrontendFrame* frame) {
+  const int n = rig.NumCameras();
+  std::vector<std::unordered_map<uint64_t, int>> index_of(n);
   for (int i = 0; i < n; ++i) {
-    auto& out = frame.features_per_camera[i];
-    const auto& points = s.trackers[i].points();
+    const auto& points = trackers[i].points();
+    for (int k = 0; k < static_cast<int>(points.size()); ++k) index_of[i][points[k].track_id] = k;
+  }
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const auto [a, b] = pairs[k];
+    for (const InterviewMatch& m : pair_matches[k]) {
+      auto& pa = trackers[a].points()[m.index_a];
+      auto& pb = trackers[b].points()[m.index_b];
+      if (pa.track_id != pb.track_id) {
+        const uint64_t into = std::min(pa.track_id, pb.track_id);
+        const uint64_t from = std::max(pa.track_id, pb.track_id);
+        bool conflict = false;
+        for (int i = 0; i < n && !conflict; ++i) conflict = index_of[i].count(from) && index_of[i].count(into);
+        if (conflict) continue;
+        for (int i = 0; i < n; ++i) {
+          const auto it = index_of[i].find(from);
+          if (it == index_of[i].end()) continue;
+          const int index = it->second;
+          trackers[i].points()[index].track_id = into;
+          index_of[i].erase(it);
+          index_of[i][into] = index;
+        }
+        frame->merged_ids.emplace_back(from, into);
+      }
+      last_matches.push_back({a, b, m.index_a, m.index_b});
+    }
+  }
+}
+
+// Inter-view matching of every pair (in parallel), sub-pixel refinement of new matches (their
+// bearings updated), then id unification.
+void Frontend::Impl::MatchViewsAndUnifyIds(ViewBearings* bearings_in_cam, FrontendFrame* frame) {
+  const std::vector<MatchView> views = MakeMatchViews(*bearings_in_cam);
+  std::vector<std::vector<InterviewMatch>> pair_matches(pairs.size());
+  std::vector<std::vector<Refinement>> refinements(pairs.size());
+  tbb::parallel_for(0, static_cast<int>(pairs.size()), [&](int k) {
+    const auto [a, b] = pairs[k];
+    PairGeometry geometry;
+    geometry.up_in_rig = layouts[a].up_in_rig;
+    geometry.plane_normal_in_rig = layouts[a].right_normal_in_rig;
+    geometry.focal_px = 0.5 * (projections[a].focal_px() + projections[b].focal_px());
+    pair_matches[k] = MatchViews(geometry, views[a], views[b], options.matching);
+    if (options.refine_matches) {
+      refinements[k] = RefineNewMatches(trackers[a], trackers[b], a, b, pair_matches[k], options.klt_window_px);
+    }
+  });
+  for (const auto& list : refinements) {
+    for (const Refinement& r : list) {
+      TrackedPoint& p = trackers[r.camera].points()[r.index];
+      p.px = r.px;
+      (*bearings_in_cam)[r.camera][r.index] = projections[r.camera].BearingFromWarped(Eigen::Vector2d(r.px.x, r.px.y));
+    }
+  }
+  UnifyIds(pair_matches, frame);
+}
+
+// The output features: every tracked point with a bearing.
+void Frontend::Impl::CollectFeatures(const ViewBearings& bearings_in_cam, FrontendFrame* frame) const {
+  const int n = rig.NumCameras();
+  frame->features_per_camera.resize(n);
+  for (int i = 0; i < n; ++i) {
+    auto& out = frame->features_per_camera[i];
+    const auto& points = trackers[i].points();
     for (size_t k = 0; k < points.size(); ++k) {
       const TrackedPoint& p = points[k];
       const auto& bearing = bearings_in_cam[i][k];
@@ -394,6 +418,26 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
       out.push_back(f);
     }
   }
+}
+
+FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
+  Impl& s = *impl_;
+  s.CheckImages(fisheye_images);
+  FrontendFrame frame;
+  const ScopedOpenCvThreads serial_opencv;
+  // Bearings of all points (exact, from the warped pixels), shared by matching and the output.
+  Impl::ViewBearings bearings_in_cam;
+  double bearings_ms = 0, bearings_cpu_ms = 0;
+  s.RunViewStages(fisheye_images, &bearings_in_cam, &frame, &bearings_ms, &bearings_cpu_ms);
+
+  const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = CpuMs();
+  s.last_matches.clear();
+  if (s.options.match_between_views && !s.pairs.empty()) s.MatchViewsAndUnifyIds(&bearings_in_cam, &frame);
+  frame.ms_match = MsSince(start) + bearings_ms;
+  frame.cpu_ms_match = CpuMs() - cpu_start + bearings_cpu_ms;
+
+  s.CollectFeatures(bearings_in_cam, &frame);
   return frame;
 }
 

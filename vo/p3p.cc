@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace rovo {
 namespace {
@@ -51,46 +52,83 @@ Eigen::Matrix3d PairForm(int i, int j, double b) {
   return m;
 }
 
-}  // namespace
+// The three distance equations |lambda_i y_i - lambda_j y_j|^2 = a_ij as quadratic forms in lambda:
+// lambda^T m_ij lambda = a_ij with b_ij = -2 y_i . y_j.
+struct P3PEquations {
+  double b12, b13, b23, a12, a13, a23;
+  Eigen::Matrix3d m12, m13, m23;
 
-std::vector<Rigid3> SolveP3P(const std::array<Eigen::Vector3d, 3>& bearings_in_cam,
-                             const std::array<Eigen::Vector3d, 3>& points_in_world) {
-  std::vector<Rigid3> solutions;
-  const auto& y = bearings_in_cam;
-  const auto& x = points_in_world;
-  const double b12 = -2.0 * y[0].dot(y[1]);
-  const double b13 = -2.0 * y[0].dot(y[2]);
-  const double b23 = -2.0 * y[1].dot(y[2]);
-  const double a12 = (x[0] - x[1]).squaredNorm();
-  const double a13 = (x[0] - x[2]).squaredNorm();
-  const double a23 = (x[1] - x[2]).squaredNorm();
-  // Collinear or coincident world points have no unique solution.
-  if ((x[1] - x[0]).cross(x[2] - x[0]).squaredNorm() < 1e-20 * std::max(a12, a13) * std::max(a12, a13)) {
-    return solutions;
+  Eigen::Vector3d Residual(const Eigen::Vector3d& l) const {
+    return Eigen::Vector3d(l(0) * l(0) + l(1) * l(1) + b12 * l(0) * l(1) - a12,
+                           l(0) * l(0) + l(2) * l(2) + b13 * l(0) * l(2) - a13,
+                           l(1) * l(1) + l(2) * l(2) + b23 * l(1) * l(2) - a23);
   }
-  const Eigen::Matrix3d m12 = PairForm(0, 1, b12);
-  const Eigen::Matrix3d m13 = PairForm(0, 2, b13);
-  const Eigen::Matrix3d m23 = PairForm(1, 2, b23);
-  const Eigen::Matrix3d d1 = a23 * m12 - a12 * m23;
-  const Eigen::Matrix3d d2 = a23 * m13 - a13 * m23;
+};
 
+// A degenerate member d0 of the pencil D1 + g D2 (D_k = a23 m_1k - a1k m23) and the other form;
+// false when the pencil vanishes.
+bool DegeneratePencilMember(const P3PEquations& e, Eigen::Matrix3d* d0, Eigen::Matrix3d* other) {
+  const Eigen::Matrix3d d1 = e.a23 * e.m12 - e.a12 * e.m23;
+  const Eigen::Matrix3d d2 = e.a23 * e.m13 - e.a13 * e.m23;
   // det(D1 + g D2) = c3 g^3 + c2 g^2 + c1 g + c0.
   const double c3 = d2.determinant();
   const double c2 = (d1 * Adjugate(d2)).trace();
   const double c1 = (Adjugate(d1) * d2).trace();
   const double c0 = d1.determinant();
   const double cmax = std::max({std::abs(c0), std::abs(c1), std::abs(c2), std::abs(c3)});
-  if (!(cmax > 0.0)) return solutions;
-  Eigen::Matrix3d d0, other;
+  if (!(cmax > 0.0)) return false;
   if (std::abs(c3) < 1e-12 * cmax) {  // D2 itself is degenerate (g -> infinity)
-    d0 = d2;
-    other = d1;
+    *d0 = d2;
+    *other = d1;
   } else {
     const double g = RealCubicRoot(c2 / c3, c1 / c3, c0 / c3);
-    d0 = d1 + g * d2;
-    other = d2;
+    *d0 = d1 + g * d2;
+    *other = d2;
   }
+  return true;
+}
 
+// Scales direction v onto the equations (from the best-conditioned quadratic form), orients it
+// positive and polishes it with Gauss-Newton; nullopt when it is not a valid positive solution.
+std::optional<Eigen::Vector3d> DepthsAlong(const P3PEquations& e, const Eigen::Vector3d& v) {
+  const double q23 = v.dot(e.m23 * v), q12 = v.dot(e.m12 * v), q13 = v.dot(e.m13 * v);
+  double k2;
+  if (q23 >= q12 && q23 >= q13) {
+    k2 = e.a23 / q23;
+  } else if (q12 >= q13) {
+    k2 = e.a12 / q12;
+  } else {
+    k2 = e.a13 / q13;
+  }
+  if (!(k2 > 0.0)) return std::nullopt;
+  Eigen::Vector3d lambda = std::sqrt(k2) * v;
+  if (lambda.sum() < 0.0) lambda = -lambda;
+  if (lambda.minCoeff() <= 0.0) return std::nullopt;
+  // Gauss-Newton on the three distance equations.
+  Eigen::Vector3d res = e.Residual(lambda);
+  for (int it = 0; it < 5 && res.squaredNorm() > 0.0; ++it) {
+    const Eigen::Vector3d& l = lambda;
+    Eigen::Matrix3d jac;
+    jac << 2 * l(0) + e.b12 * l(1), 2 * l(1) + e.b12 * l(0), 0.0,  //
+        2 * l(0) + e.b13 * l(2), 0.0, 2 * l(2) + e.b13 * l(0),     //
+        0.0, 2 * l(1) + e.b23 * l(2), 2 * l(2) + e.b23 * l(1);
+    if (std::abs(jac.determinant()) < 1e-300) break;
+    const Eigen::Vector3d next = lambda - jac.partialPivLu().solve(res);
+    const Eigen::Vector3d next_res = e.Residual(next);
+    if (!(next_res.squaredNorm() < res.squaredNorm())) break;
+    lambda = next;
+    res = next_res;
+  }
+  const double scale = std::max({e.a12, e.a13, e.a23});
+  if (lambda.minCoeff() <= 0.0 || res.lpNorm<Eigen::Infinity>() > 1e-6 * scale) return std::nullopt;
+  return lambda;
+}
+
+// The depth triples: the degenerate conic d0 splits into two planes; on each, the other form's
+// conic gives up to two directions.
+std::vector<Eigen::Vector3d> DepthSolutions(const P3PEquations& e, const Eigen::Matrix3d& d0,
+                                            const Eigen::Matrix3d& other) {
+  std::vector<Eigen::Vector3d> lambdas;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(d0);
   const Eigen::Vector3d sig = eig.eigenvalues();
   int k0 = 0;  // the (numerically) zero eigenvalue
@@ -99,11 +137,10 @@ std::vector<Rigid3> SolveP3P(const std::array<Eigen::Vector3d, 3>& bearings_in_c
   }
   const int ka = (k0 + 1) % 3, kb = (k0 + 2) % 3;
   const double sa = sig(ka), sb = sig(kb);
-  if (sa * sb > 0.0 || sa == 0.0) return solutions;  // definite conic: no real solutions
+  if (sa * sb > 0.0 || sa == 0.0) return lambdas;  // definite conic: no real solutions
   const double s = std::sqrt(-sb / sa);
   const Eigen::Vector3d ea = eig.eigenvectors().col(ka), eb = eig.eigenvectors().col(kb);
 
-  std::vector<Eigen::Vector3d> lambdas;
   for (const double sign : {1.0, -1.0}) {
     const Eigen::Vector3d w = (ea - sign * s * eb).normalized();
     // Orthonormal basis n1, n2 of the plane w . lambda = 0.
@@ -125,64 +162,58 @@ std::vector<Rigid3> SolveP3P(const std::array<Eigen::Vector3d, 3>& bearings_in_c
         const double r = (-nq(0, 1) + root_sign * sq) / nq(1, 1);
         v = n1 + r * n2;
       }
-      // Scale from the equation with the best-conditioned quadratic form.
-      const double q23 = v.dot(m23 * v), q12 = v.dot(m12 * v), q13 = v.dot(m13 * v);
-      double k2;
-      if (q23 >= q12 && q23 >= q13) {
-        k2 = a23 / q23;
-      } else if (q12 >= q13) {
-        k2 = a12 / q12;
-      } else {
-        k2 = a13 / q13;
-      }
-      if (!(k2 > 0.0)) continue;
-      Eigen::Vector3d lambda = std::sqrt(k2) * v;
-      if (lambda.sum() < 0.0) lambda = -lambda;
-      if (lambda.minCoeff() <= 0.0) continue;
-      // Gauss-Newton on the three distance equations.
-      auto residual = [&](const Eigen::Vector3d& l) {
-        return Eigen::Vector3d(l(0) * l(0) + l(1) * l(1) + b12 * l(0) * l(1) - a12,
-                               l(0) * l(0) + l(2) * l(2) + b13 * l(0) * l(2) - a13,
-                               l(1) * l(1) + l(2) * l(2) + b23 * l(1) * l(2) - a23);
-      };
-      Eigen::Vector3d res = residual(lambda);
-      for (int it = 0; it < 5 && res.squaredNorm() > 0.0; ++it) {
-        const Eigen::Vector3d& l = lambda;
-        Eigen::Matrix3d jac;
-        jac << 2 * l(0) + b12 * l(1), 2 * l(1) + b12 * l(0), 0.0,  //
-            2 * l(0) + b13 * l(2), 0.0, 2 * l(2) + b13 * l(0),     //
-            0.0, 2 * l(1) + b23 * l(2), 2 * l(2) + b23 * l(1);
-        if (std::abs(jac.determinant()) < 1e-300) break;
-        const Eigen::Vector3d next = lambda - jac.partialPivLu().solve(res);
-        const Eigen::Vector3d next_res = residual(next);
-        if (!(next_res.squaredNorm() < res.squaredNorm())) break;
-        lambda = next;
-        res = next_res;
-      }
-      const double scale = std::max({a12, a13, a23});
-      if (lambda.minCoeff() <= 0.0 || res.lpNorm<Eigen::Infinity>() > 1e-6 * scale) continue;
+      const std::optional<Eigen::Vector3d> lambda = DepthsAlong(e, v);
+      if (!lambda) continue;
       bool duplicate = false;
       for (const auto& other_lambda : lambdas) {
-        if ((other_lambda - lambda).norm() < 1e-9 * lambda.norm()) duplicate = true;
+        if ((other_lambda - *lambda).norm() < 1e-9 * lambda->norm()) duplicate = true;
       }
-      if (!duplicate) lambdas.push_back(lambda);
+      if (!duplicate) lambdas.push_back(*lambda);
     }
   }
+  return lambdas;
+}
 
-  for (const Eigen::Vector3d& lambda : lambdas) {
-    // Kabsch: R, t minimising sum |lambda_i y_i - (R X_i + t)|^2.
-    Eigen::Vector3d p[3];
-    for (int i = 0; i < 3; ++i) p[i] = lambda(i) * y[i];
-    const Eigen::Vector3d cx = (x[0] + x[1] + x[2]) / 3.0;
-    const Eigen::Vector3d cp = (p[0] + p[1] + p[2]) / 3.0;
-    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-    for (int i = 0; i < 3; ++i) h += (x[i] - cx) * (p[i] - cp).transpose();
-    Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Eigen::Matrix3d fix = Eigen::Matrix3d::Identity();
-    fix(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
-    const Eigen::Matrix3d rot = svd.matrixV() * fix * svd.matrixU().transpose();
-    solutions.emplace_back(rot, cp - rot * cx);
+// Kabsch: R, t minimising sum |lambda_i y_i - (R X_i + t)|^2.
+Rigid3 PoseFromDepths(const Eigen::Vector3d& lambda, const std::array<Eigen::Vector3d, 3>& y,
+                      const std::array<Eigen::Vector3d, 3>& x) {
+  Eigen::Vector3d p[3];
+  for (int i = 0; i < 3; ++i) p[i] = lambda(i) * y[i];
+  const Eigen::Vector3d cx = (x[0] + x[1] + x[2]) / 3.0;
+  const Eigen::Vector3d cp = (p[0] + p[1] + p[2]) / 3.0;
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < 3; ++i) h += (x[i] - cx) * (p[i] - cp).transpose();
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d fix = Eigen::Matrix3d::Identity();
+  fix(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+  const Eigen::Matrix3d rot = svd.matrixV() * fix * svd.matrixU().transpose();
+  return Rigid3(rot, cp - rot * cx);
+}
+
+}  // namespace
+
+std::vector<Rigid3> SolveP3P(const std::array<Eigen::Vector3d, 3>& bearings_in_cam,
+                             const std::array<Eigen::Vector3d, 3>& points_in_world) {
+  std::vector<Rigid3> solutions;
+  const auto& y = bearings_in_cam;
+  const auto& x = points_in_world;
+  P3PEquations e;
+  e.b12 = -2.0 * y[0].dot(y[1]);
+  e.b13 = -2.0 * y[0].dot(y[2]);
+  e.b23 = -2.0 * y[1].dot(y[2]);
+  e.a12 = (x[0] - x[1]).squaredNorm();
+  e.a13 = (x[0] - x[2]).squaredNorm();
+  e.a23 = (x[1] - x[2]).squaredNorm();
+  // Collinear or coincident world points have no unique solution.
+  if ((x[1] - x[0]).cross(x[2] - x[0]).squaredNorm() < 1e-20 * std::max(e.a12, e.a13) * std::max(e.a12, e.a13)) {
+    return solutions;
   }
+  e.m12 = PairForm(0, 1, e.b12);
+  e.m13 = PairForm(0, 2, e.b13);
+  e.m23 = PairForm(1, 2, e.b23);
+  Eigen::Matrix3d d0, other;
+  if (!DegeneratePencilMember(e, &d0, &other)) return solutions;
+  for (const Eigen::Vector3d& lambda : DepthSolutions(e, d0, other)) solutions.push_back(PoseFromDepths(lambda, y, x));
   return solutions;
 }
 

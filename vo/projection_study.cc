@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -207,50 +208,53 @@ void AccumulateDescriptorDrift(Arm* arm, int camera, int t) {
   arm->history[camera] = std::move(live);
 }
 
-}  // namespace
+// The fixed inputs of one study run: the rig, the front-end, the neighbouring view pairs and masks.
+struct StudySetup {
+  const ProjectionStudyOptions& options;
+  const Rig& rig;
+  int n = 0;
+  std::vector<HybridLayout> layouts;
+  std::vector<std::pair<int, int>> pairs;  // neighbouring views (a, b), each pair once
+  std::vector<cv::Mat> fisheye_masks;      // valid pixels of each lens
+  InterviewMatchOptions nn_options;        // part (b): mutual nearest descriptors, no other filter
+};
 
-ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) {
-  const DatasetInfo info = ReadDatasetInfo(options.dataset_dir);
-  if (!info.has_depth) {
-    throw std::runtime_error(DatasetJsonPath(options.dataset_dir) +
-                             ": has_depth is false; the study needs depth (render with --depth)");
-  }
-  const Rig& rig = info.rig;
-  const int n = rig.NumCameras();
-  const int frames = std::min(options.frames, info.frame_count);
-  if (frames < 2) throw std::runtime_error(DatasetJsonPath(options.dataset_dir) + ": frame_count < 2");
-  EnsureWritableDir(options.out_dir);
+// One frame's images: fisheye, warped (hybrid) and depth.
+struct StudyFrame {
+  std::vector<cv::Mat> images, warped, depths;
+};
 
-  FrontendOptions frontend_options;
-  frontend_options.matching = options.frontend_matching;
-  frontend_options.upright_descriptors = options.upright_descriptors;
-  Frontend frontend(rig, frontend_options);
-  const std::vector<HybridLayout> layouts = ComputeHybridLayouts(rig);
+// Both arms' accumulators plus the front-end column.
+struct StudyTally {
+  Arm fisheye, hybrid;
+  std::vector<DrawnMatch> drawn_frontend;
+  std::vector<int64_t> frontend_error_bins = std::vector<int64_t>(kErrorBins, 0);
+  cv::Mat last_fisheye_a, last_fisheye_b;
+};
+
+// Neighbouring view pairs (a, right neighbour of a), each unordered pair once.
+std::vector<std::pair<int, int>> NeighbourPairs(const std::vector<HybridLayout>& layouts) {
   std::vector<std::pair<int, int>> pairs;
-  {
-    std::set<std::pair<int, int>> seen;
-    for (int i = 0; i < n; ++i) {
-      const int j = layouts[i].right_neighbour;
-      if (j != i && seen.insert({std::min(i, j), std::max(i, j)}).second) pairs.emplace_back(i, j);
-    }
+  std::set<std::pair<int, int>> seen;
+  for (int i = 0; i < static_cast<int>(layouts.size()); ++i) {
+    const int j = layouts[i].right_neighbour;
+    if (j != i && seen.insert({std::min(i, j), std::max(i, j)}).second) pairs.emplace_back(i, j);
   }
+  return pairs;
+}
 
-  TrackerOptions tracker_options = TrackerOptionsFrom(frontend_options);
-  tracker_options.target_features = options.features_per_view;
-  Arm fisheye_arm, hybrid_arm;
-  for (Arm* arm : {&fisheye_arm, &hybrid_arm}) {
-    arm->trackers.assign(n, ViewTracker(tracker_options));
-    arm->history.resize(n);
-    arm->contributing.resize(n);
-  }
-  std::vector<cv::Mat> fisheye_masks(n);
-  for (int i = 0; i < n; ++i) {
+std::vector<cv::Mat> FisheyeMasks(const Rig& rig) {
+  std::vector<cv::Mat> masks(rig.NumCameras());
+  for (int i = 0; i < rig.NumCameras(); ++i) {
     const Camera& camera = rig.cameras[i].camera;
     const std::vector<unsigned char> mask = camera.ValidPixelMask();
-    fisheye_masks[i] = cv::Mat(camera.height, camera.width, CV_8UC1, const_cast<unsigned char*>(mask.data())).clone();
+    masks[i] = cv::Mat(camera.height, camera.width, CV_8UC1, const_cast<unsigned char*>(mask.data())).clone();
   }
+  return masks;
+}
 
-  // Part (b) matcher: mutual nearest descriptors over the overlap features; epipolar check applied after.
+// Part (b) matcher: mutual nearest descriptors over the overlap features; epipolar check applied after.
+InterviewMatchOptions NearestNeighbourMatchOptions() {
   InterviewMatchOptions nn_options;
   nn_options.use_y_distance = false;
   nn_options.use_zncc = false;
@@ -259,197 +263,241 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
   nn_options.max_descriptor_distance = 256;
   nn_options.max_epipolar_angle_deg = 180.0;
   nn_options.max_ratio = 1.0;
-  // A direction (rig frame) is in the overlap of (a, b) when it falls inside both hybrid images.
-  const auto in_hybrid_image = [&](int camera, const Eigen::Vector3d& bearing_in_rig) {
-    const HybridProjection& projection = frontend.projection(camera);
-    const Eigen::Vector3d bearing_in_cam = rig.cameras[camera].cam_from_rig.RotationMatrix() * bearing_in_rig;
-    const auto px = projection.WarpedInImageFromBearing(bearing_in_cam);
-    if (!px) return false;
-    const int u = static_cast<int>(std::lround(px->x())), v = static_cast<int>(std::lround(px->y()));
-    return projection.valid_mask().at<uint8_t>(v, u) != 0;
-  };
+  return nn_options;
+}
 
-  ProjectionStudyResult result;
-  result.frames = frames;
-  std::vector<DrawnMatch> drawn_frontend;
-  std::vector<int64_t> frontend_error_bins(kErrorBins, 0);
-  cv::Mat last_fisheye_a, last_fisheye_b;
-  uint64_t next_id = 0;
-  const auto id_source = [&next_id] { return ++next_id; };
-  Progress progress("projection study", frames, "frames", options.quiet);
-  for (int t = 0; t < frames; ++t) {
-    std::vector<cv::Mat> images(n), depths(n);
-    tbb::parallel_for(0, n, [&](int i) {
-      images[i] = ReadGray(ImagePath(options.dataset_dir, rig.cameras[i].name, t));
-      depths[i] = ReadDepthImage(DepthPath(options.dataset_dir, rig.cameras[i].name, t));
-    });
-    frontend.Process(images);
+// A direction (rig frame) is in the overlap of (a, b) when it falls inside both hybrid images.
+bool InHybridImage(const Frontend& frontend, const Rig& rig, int camera, const Eigen::Vector3d& bearing_in_rig) {
+  const HybridProjection& projection = frontend.projection(camera);
+  const Eigen::Vector3d bearing_in_cam = rig.cameras[camera].cam_from_rig.RotationMatrix() * bearing_in_rig;
+  const auto px = projection.WarpedInImageFromBearing(bearing_in_cam);
+  if (!px) return false;
+  const int u = static_cast<int>(std::lround(px->x())), v = static_cast<int>(std::lround(px->y()));
+  return projection.valid_mask().at<uint8_t>(v, u) != 0;
+}
 
-    std::vector<cv::Mat> warped(n);
-    tbb::parallel_for(0, n, [&](int i) {
-      warped[i] = frontend.warped_image(i);
-      fisheye_arm.trackers[i].Track(images[i], fisheye_masks[i]);
-      hybrid_arm.trackers[i].Track(warped[i], frontend.projection(i).valid_mask());
-    });
-    // Ids from one sequential source (deterministic).
-    for (Arm* arm : {&fisheye_arm, &hybrid_arm}) {
-      for (int i = 0; i < n; ++i) arm->trackers[i].DetectAndDescribe(id_source);
-    }
-
-    // (a) descriptor drift along the tracks.
-    for (Arm* arm : {&fisheye_arm, &hybrid_arm}) {
-      for (int i = 0; i < n; ++i) AccumulateDescriptorDrift(arm, i, t);
-    }
-
-    // (b) inter-view matching in the overlaps, verified with depth.
-    const bool last = t + 1 == frames;
-    for (Arm* arm : {&fisheye_arm, &hybrid_arm}) {
-      const bool hybrid = arm == &hybrid_arm;
-      std::vector<std::vector<Eigen::Vector3d>> bearings_in_rig(n);
-      for (int i = 0; i < n; ++i) {
-        const Eigen::Matrix3d rig_from_cam = rig.cameras[i].cam_from_rig.RotationMatrix().transpose();
-        for (const TrackedPoint& p : arm->trackers[i].points()) {
-          const Eigen::Vector2d px(p.px.x, p.px.y);
-          const auto bearing =
-              hybrid ? frontend.projection(i).BearingFromWarped(px) : rig.cameras[i].camera.Unproject(px);
-          bearings_in_rig[i].push_back(bearing ? Eigen::Vector3d(rig_from_cam * *bearing) : Eigen::Vector3d::Zero());
-        }
-      }
-      if (last) arm->drawn.clear();
-      for (size_t k = 0; k < pairs.size(); ++k) {
-        const auto [a, b] = pairs[k];
-        // The overlap features of both views.
-        std::vector<TrackedPoint> points[2];
-        MatchView views[2];
-        for (int side = 0; side < 2; ++side) {
-          const int camera = side == 0 ? a : b;
-          const auto& all = arm->trackers[camera].points();
-          for (int q = 0; q < static_cast<int>(all.size()); ++q) {
-            const Eigen::Vector3d& d = bearings_in_rig[camera][q];
-            if (!all[q].has_descriptor || d.isZero() || !in_hybrid_image(a, d) || !in_hybrid_image(b, d)) continue;
-            points[side].push_back(all[q]);
-            views[side].bearings_in_rig.push_back(d);
-          }
-          views[side].points = &points[side];
-          views[side].centre_in_rig = rig.cameras[camera].cam_from_rig.Inverse().translation;
-          views[side].image = hybrid ? &warped[camera] : &images[camera];
-          const Eigen::Matrix3d cam_from_rig = rig.cameras[camera].cam_from_rig.RotationMatrix();
-          if (hybrid) {
-            const HybridProjection* projection = &frontend.projection(camera);
-            views[side].pixel_from_direction_in_rig = [projection, cam_from_rig](const Eigen::Vector3d& d) {
-              return projection->WarpedInImageFromBearing(cam_from_rig * d);
-            };
-          } else {
-            const Camera* lens = &rig.cameras[camera].camera;
-            const cv::Mat* mask = &fisheye_masks[camera];
-            views[side].pixel_from_direction_in_rig = [lens, mask, cam_from_rig](const Eigen::Vector3d& d) {
-              auto px = lens->Project(Eigen::Vector3d(cam_from_rig * d));
-              if (px && !MaskAt(*mask, *px)) px.reset();
-              return px;
-            };
-          }
-        }
-        // The verdict of a match between views[0] point ia and views[1] point ib (-1: no depth).
-        const auto verdict_of = [&](int ia, int ib, double* error) {
-          const cv::Point2f pa = points[0][ia].px, pb = points[1][ib].px;
-          std::optional<Eigen::Vector2d> fa(Eigen::Vector2d(pa.x, pa.y)), fb(Eigen::Vector2d(pb.x, pb.y));
-          if (hybrid) {
-            fa = frontend.projection(a).FisheyeFromWarped(*fa);
-            fb = frontend.projection(b).FisheyeFromWarped(*fb);
-            if (!fa || !fb) return -1;
-          }
-          const Eigen::Vector3d bearing_a = rig.cameras[a].cam_from_rig.RotationMatrix() * views[0].bearings_in_rig[ia];
-          return GroundTruthMatchVerdict(rig, a, bearing_a, *fa, b, *fb, depths[a], depths[b], options.inlier_px, error);
-        };
-        PairGeometry geometry;
-        geometry.up_in_rig = layouts[a].up_in_rig;
-        geometry.plane_normal_in_rig = layouts[a].right_normal_in_rig;
-        geometry.focal_px = 0.5 * (frontend.projection(a).focal_px() + frontend.projection(b).focal_px());
-        for (const InterviewMatch& m : MatchViews(geometry, views[0], views[1], options.frontend_matching)) {
-          double error = 0;
-          const int verdict = verdict_of(m.index_a, m.index_b, &error);
-          if (verdict < 0) continue;
-          ++arm->chain_matches;
-          arm->chain_inliers += verdict;
-        }
-        for (const InterviewMatch& m : MatchViews(PairGeometry{}, views[0], views[1], nn_options)) {
-          const Eigen::Vector3d& da = views[0].bearings_in_rig[m.index_a];
-          const Eigen::Vector3d& db = views[1].bearings_in_rig[m.index_b];
-          const bool epipolar_ok =
-              EpipolarAngle(views[0].centre_in_rig, da, views[1].centre_in_rig, db) <= options.epipolar_deg * M_PI / 180;
-          const cv::Point2f pa = points[0][m.index_a].px, pb = points[1][m.index_b].px;
-          double error = 0;
-          const int verdict = verdict_of(m.index_a, m.index_b, &error);
-          if (verdict < 0) continue;
-          ++arm->raw_matches;
-          arm->raw_inliers += verdict;
-          if (!epipolar_ok) continue;
-          ++arm->matches;
-          arm->inliers += verdict;
-          ++arm->error_bins[ErrorBin(error)];
-          if (last && k == 0) arm->drawn.push_back({pa, pb, verdict == 1});
-        }
-      }
-    }
-
-    // The front-end's own accepted matches (all filters), same verification.
-    if (last) drawn_frontend.clear();
-    for (const Frontend::ViewMatch& m : frontend.last_matches()) {
-      double error = 0;
-      const int verdict = FrontendMatchVerdict(frontend, rig, m, depths, options.inlier_px, &error);
-      if (verdict < 0) continue;
-      const cv::Point2f pa = frontend.tracker(m.camera_a).points()[m.index_a].px;
-      const cv::Point2f pb = frontend.tracker(m.camera_b).points()[m.index_b].px;
-      ++result.matches_frontend;
-      result.inliers_frontend += verdict;
-      ++frontend_error_bins[ErrorBin(error)];
-      if (last && !pairs.empty() && m.camera_a == pairs[0].first && m.camera_b == pairs[0].second) {
-        drawn_frontend.push_back({pa, pb, verdict == 1});
-      }
-    }
-    if (last && !pairs.empty()) {
-      last_fisheye_a = images[pairs[0].first];
-      last_fisheye_b = images[pairs[0].second];
-    }
-    progress.Add(1);
+// Reads frame t, runs the front-end on it and tracks both arms (ids from one sequential source).
+StudyFrame TrackFrame(const StudySetup& setup, int t, Frontend& frontend, StudyTally& tally,
+                      const std::function<uint64_t()>& id_source) {
+  const int n = setup.n;
+  StudyFrame frame;
+  frame.images.resize(n);
+  frame.depths.resize(n);
+  frame.warped.resize(n);
+  tbb::parallel_for(0, n, [&](int i) {
+    frame.images[i] = ReadGray(ImagePath(setup.options.dataset_dir, setup.rig.cameras[i].name, t));
+    frame.depths[i] = ReadDepthImage(DepthPath(setup.options.dataset_dir, setup.rig.cameras[i].name, t));
+  });
+  frontend.Process(frame.images);
+  tbb::parallel_for(0, n, [&](int i) {
+    frame.warped[i] = frontend.warped_image(i);
+    tally.fisheye.trackers[i].Track(frame.images[i], setup.fisheye_masks[i]);
+    tally.hybrid.trackers[i].Track(frame.warped[i], frontend.projection(i).valid_mask());
+  });
+  for (Arm* arm : {&tally.fisheye, &tally.hybrid}) {
+    for (int i = 0; i < n; ++i) arm->trackers[i].DetectAndDescribe(id_source);
   }
-  progress.Finish();
+  return frame;
+}
 
+// Bearings (rig frame, rotation only) of every tracked point of an arm; zero where there is none.
+std::vector<std::vector<Eigen::Vector3d>> ArmBearingsInRig(const StudySetup& setup, const Frontend& frontend,
+                                                           const Arm& arm, bool hybrid) {
+  std::vector<std::vector<Eigen::Vector3d>> bearings_in_rig(setup.n);
+  for (int i = 0; i < setup.n; ++i) {
+    const Eigen::Matrix3d rig_from_cam = setup.rig.cameras[i].cam_from_rig.RotationMatrix().transpose();
+    for (const TrackedPoint& p : arm.trackers[i].points()) {
+      const Eigen::Vector2d px(p.px.x, p.px.y);
+      const auto bearing =
+          hybrid ? frontend.projection(i).BearingFromWarped(px) : setup.rig.cameras[i].camera.Unproject(px);
+      bearings_in_rig[i].push_back(bearing ? Eigen::Vector3d(rig_from_cam * *bearing) : Eigen::Vector3d::Zero());
+    }
+  }
+  return bearings_in_rig;
+}
+
+// The overlap features of a view pair (a, b) in one arm, as the two sides of MatchViews.
+struct OverlapViews {
+  std::vector<TrackedPoint> points[2];
+  MatchView views[2];
+};
+
+// Fills `out` (its views point into its own points).
+void BuildOverlapViews(const StudySetup& setup, const Frontend& frontend, const StudyFrame& frame, const Arm& arm,
+                       bool hybrid, const std::vector<std::vector<Eigen::Vector3d>>& bearings_in_rig, int a, int b,
+                       OverlapViews* out) {
+  for (int side = 0; side < 2; ++side) {
+    const int camera = side == 0 ? a : b;
+    const auto& all = arm.trackers[camera].points();
+    MatchView& view = out->views[side];
+    for (int q = 0; q < static_cast<int>(all.size()); ++q) {
+      const Eigen::Vector3d& d = bearings_in_rig[camera][q];
+      if (!all[q].has_descriptor || d.isZero() || !InHybridImage(frontend, setup.rig, a, d) ||
+          !InHybridImage(frontend, setup.rig, b, d))
+        continue;
+      out->points[side].push_back(all[q]);
+      view.bearings_in_rig.push_back(d);
+    }
+    view.points = &out->points[side];
+    view.centre_in_rig = setup.rig.cameras[camera].cam_from_rig.Inverse().translation;
+    view.image = hybrid ? &frame.warped[camera] : &frame.images[camera];
+    const Eigen::Matrix3d cam_from_rig = setup.rig.cameras[camera].cam_from_rig.RotationMatrix();
+    if (hybrid) {
+      const HybridProjection* projection = &frontend.projection(camera);
+      view.pixel_from_direction_in_rig = [projection, cam_from_rig](const Eigen::Vector3d& d) {
+        return projection->WarpedInImageFromBearing(cam_from_rig * d);
+      };
+    } else {
+      const Camera* lens = &setup.rig.cameras[camera].camera;
+      const cv::Mat* mask = &setup.fisheye_masks[camera];
+      view.pixel_from_direction_in_rig = [lens, mask, cam_from_rig](const Eigen::Vector3d& d) {
+        auto px = lens->Project(Eigen::Vector3d(cam_from_rig * d));
+        if (px && !MaskAt(*mask, *px)) px.reset();
+        return px;
+      };
+    }
+  }
+}
+
+// Part (b) on one view pair of one arm: the filter chain and the mutual-NN matches, verified with depth.
+void MatchOverlapPair(const StudySetup& setup, const Frontend& frontend, const StudyFrame& frame, Arm* arm, bool hybrid,
+                      const std::vector<std::vector<Eigen::Vector3d>>& bearings_in_rig, int a, int b, bool draw) {
+  const Rig& rig = setup.rig;
+  OverlapViews overlap;
+  BuildOverlapViews(setup, frontend, frame, *arm, hybrid, bearings_in_rig, a, b, &overlap);
+  const std::vector<TrackedPoint>(&points)[2] = overlap.points;
+  const MatchView(&views)[2] = overlap.views;
+  // The verdict of a match between views[0] point ia and views[1] point ib (-1: no depth).
+  const auto verdict_of = [&](int ia, int ib, double* error) {
+    const cv::Point2f pa = points[0][ia].px, pb = points[1][ib].px;
+    std::optional<Eigen::Vector2d> fa(Eigen::Vector2d(pa.x, pa.y)), fb(Eigen::Vector2d(pb.x, pb.y));
+    if (hybrid) {
+      fa = frontend.projection(a).FisheyeFromWarped(*fa);
+      fb = frontend.projection(b).FisheyeFromWarped(*fb);
+      if (!fa || !fb) return -1;
+    }
+    const Eigen::Vector3d bearing_a = rig.cameras[a].cam_from_rig.RotationMatrix() * views[0].bearings_in_rig[ia];
+    return GroundTruthMatchVerdict(rig, a, bearing_a, *fa, b, *fb, frame.depths[a], frame.depths[b],
+                                   setup.options.inlier_px, error);
+  };
+  PairGeometry geometry;
+  geometry.up_in_rig = setup.layouts[a].up_in_rig;
+  geometry.plane_normal_in_rig = setup.layouts[a].right_normal_in_rig;
+  geometry.focal_px = 0.5 * (frontend.projection(a).focal_px() + frontend.projection(b).focal_px());
+  for (const InterviewMatch& m : MatchViews(geometry, views[0], views[1], setup.options.frontend_matching)) {
+    double error = 0;
+    const int verdict = verdict_of(m.index_a, m.index_b, &error);
+    if (verdict < 0) continue;
+    ++arm->chain_matches;
+    arm->chain_inliers += verdict;
+  }
+  for (const InterviewMatch& m : MatchViews(PairGeometry{}, views[0], views[1], setup.nn_options)) {
+    const Eigen::Vector3d& da = views[0].bearings_in_rig[m.index_a];
+    const Eigen::Vector3d& db = views[1].bearings_in_rig[m.index_b];
+    const bool epipolar_ok = EpipolarAngle(views[0].centre_in_rig, da, views[1].centre_in_rig, db) <=
+                             setup.options.epipolar_deg * M_PI / 180;
+    const cv::Point2f pa = points[0][m.index_a].px, pb = points[1][m.index_b].px;
+    double error = 0;
+    const int verdict = verdict_of(m.index_a, m.index_b, &error);
+    if (verdict < 0) continue;
+    ++arm->raw_matches;
+    arm->raw_inliers += verdict;
+    if (!epipolar_ok) continue;
+    ++arm->matches;
+    arm->inliers += verdict;
+    ++arm->error_bins[ErrorBin(error)];
+    if (draw) arm->drawn.push_back({pa, pb, verdict == 1});
+  }
+}
+
+// The front-end's own accepted matches (all filters), verified with depth as the arms' matches are.
+void VerifyFrontendMatches(const StudySetup& setup, const Frontend& frontend, const StudyFrame& frame, bool last,
+                           StudyTally* tally, ProjectionStudyResult* result) {
+  if (last) tally->drawn_frontend.clear();
+  for (const Frontend::ViewMatch& m : frontend.last_matches()) {
+    double error = 0;
+    const int verdict = FrontendMatchVerdict(frontend, setup.rig, m, frame.depths, setup.options.inlier_px, &error);
+    if (verdict < 0) continue;
+    const cv::Point2f pa = frontend.tracker(m.camera_a).points()[m.index_a].px;
+    const cv::Point2f pb = frontend.tracker(m.camera_b).points()[m.index_b].px;
+    ++result->matches_frontend;
+    result->inliers_frontend += verdict;
+    ++tally->frontend_error_bins[ErrorBin(error)];
+    if (last && !setup.pairs.empty() && m.camera_a == setup.pairs[0].first && m.camera_b == setup.pairs[0].second) {
+      tally->drawn_frontend.push_back({pa, pb, verdict == 1});
+    }
+  }
+}
+
+// One frame of the study: tracking, part (a), part (b) in both arms, the front-end column.
+void StudyOneFrame(const StudySetup& setup, int t, int frames, Frontend& frontend, StudyTally* tally,
+                   const std::function<uint64_t()>& id_source, ProjectionStudyResult* result) {
+  const StudyFrame frame = TrackFrame(setup, t, frontend, *tally, id_source);
+  // (a) descriptor drift along the tracks.
+  for (Arm* arm : {&tally->fisheye, &tally->hybrid}) {
+    for (int i = 0; i < setup.n; ++i) AccumulateDescriptorDrift(arm, i, t);
+  }
+  // (b) inter-view matching in the overlaps, verified with depth.
+  const bool last = t + 1 == frames;
+  for (Arm* arm : {&tally->fisheye, &tally->hybrid}) {
+    const bool hybrid = arm == &tally->hybrid;
+    const std::vector<std::vector<Eigen::Vector3d>> bearings_in_rig = ArmBearingsInRig(setup, frontend, *arm, hybrid);
+    if (last) arm->drawn.clear();
+    for (size_t k = 0; k < setup.pairs.size(); ++k) {
+      MatchOverlapPair(setup, frontend, frame, arm, hybrid, bearings_in_rig, setup.pairs[k].first,
+                       setup.pairs[k].second, last && k == 0);
+    }
+  }
+  VerifyFrontendMatches(setup, frontend, frame, last, tally, result);
+  if (last && !setup.pairs.empty()) {
+    tally->last_fisheye_a = frame.images[setup.pairs[0].first];
+    tally->last_fisheye_b = frame.images[setup.pairs[0].second];
+  }
+}
+
+// The arms' sums as the result's means and counts.
+void SummarizeArms(const Arm& fisheye_arm, const Arm& hybrid_arm, ProjectionStudyResult* result) {
   const auto distinct = [](const Arm& arm) {
     int64_t count = 0;
     for (const auto& ids : arm.contributing) count += static_cast<int64_t>(ids.size());
     return count;
   };
   const auto ratio = [](double sum, int64_t count) { return count ? sum / static_cast<double>(count) : 0.0; };
-  result.hamming_fisheye = ratio(fisheye_arm.first_sum, fisheye_arm.first_pairs);
-  result.hamming_hybrid = ratio(hybrid_arm.first_sum, hybrid_arm.first_pairs);
-  result.hamming_step_fisheye = ratio(fisheye_arm.step_sum, fisheye_arm.step_pairs);
-  result.hamming_step_hybrid = ratio(hybrid_arm.step_sum, hybrid_arm.step_pairs);
-  result.mean_age_fisheye = ratio(fisheye_arm.age_sum, fisheye_arm.first_pairs);
-  result.mean_age_hybrid = ratio(hybrid_arm.age_sum, hybrid_arm.first_pairs);
-  result.tracked_pairs_fisheye = fisheye_arm.first_pairs;
-  result.tracked_pairs_hybrid = hybrid_arm.first_pairs;
-  result.features_fisheye = distinct(fisheye_arm);
-  result.features_hybrid = distinct(hybrid_arm);
-  result.raw_matches_fisheye = fisheye_arm.raw_matches;
-  result.raw_inliers_fisheye = fisheye_arm.raw_inliers;
-  result.raw_matches_hybrid = hybrid_arm.raw_matches;
-  result.raw_inliers_hybrid = hybrid_arm.raw_inliers;
-  result.chain_matches_fisheye = fisheye_arm.chain_matches;
-  result.chain_inliers_fisheye = fisheye_arm.chain_inliers;
-  result.chain_matches_hybrid = hybrid_arm.chain_matches;
-  result.chain_inliers_hybrid = hybrid_arm.chain_inliers;
-  result.matches_fisheye = fisheye_arm.matches;
-  result.inliers_fisheye = fisheye_arm.inliers;
-  result.matches_hybrid = hybrid_arm.matches;
-  result.inliers_hybrid = hybrid_arm.inliers;
+  result->hamming_fisheye = ratio(fisheye_arm.first_sum, fisheye_arm.first_pairs);
+  result->hamming_hybrid = ratio(hybrid_arm.first_sum, hybrid_arm.first_pairs);
+  result->hamming_step_fisheye = ratio(fisheye_arm.step_sum, fisheye_arm.step_pairs);
+  result->hamming_step_hybrid = ratio(hybrid_arm.step_sum, hybrid_arm.step_pairs);
+  result->mean_age_fisheye = ratio(fisheye_arm.age_sum, fisheye_arm.first_pairs);
+  result->mean_age_hybrid = ratio(hybrid_arm.age_sum, hybrid_arm.first_pairs);
+  result->tracked_pairs_fisheye = fisheye_arm.first_pairs;
+  result->tracked_pairs_hybrid = hybrid_arm.first_pairs;
+  result->features_fisheye = distinct(fisheye_arm);
+  result->features_hybrid = distinct(hybrid_arm);
+  result->raw_matches_fisheye = fisheye_arm.raw_matches;
+  result->raw_inliers_fisheye = fisheye_arm.raw_inliers;
+  result->raw_matches_hybrid = hybrid_arm.raw_matches;
+  result->raw_inliers_hybrid = hybrid_arm.raw_inliers;
+  result->chain_matches_fisheye = fisheye_arm.chain_matches;
+  result->chain_inliers_fisheye = fisheye_arm.chain_inliers;
+  result->chain_matches_hybrid = hybrid_arm.chain_matches;
+  result->chain_inliers_hybrid = hybrid_arm.chain_inliers;
+  result->matches_fisheye = fisheye_arm.matches;
+  result->inliers_fisheye = fisheye_arm.inliers;
+  result->matches_hybrid = hybrid_arm.matches;
+  result->inliers_hybrid = hybrid_arm.inliers;
+}
 
-  // Outputs.
+// table.md: the Table II rows, ratios, track counts, error bins and the method.
+void WriteStudyTable(const StudySetup& setup, const DatasetInfo& info, const FrontendOptions& frontend_options,
+                     const StudyTally& tally, const ProjectionStudyResult& result) {
+  const ProjectionStudyOptions& options = setup.options;
+  const Rig& rig = setup.rig;
+  const int frames = result.frames;
   char line[1024];
   std::ostringstream md;
   md << "# Hybrid projection vs raw fisheye (paper Table II)\n\n";
   md << "Dataset: `" << options.dataset_dir << "` (preset " << (info.preset.empty() ? "custom" : info.preset)
-     << ", seed " << info.seed << "), frames 0-" << frames - 1 << ", " << n << " cameras of "
+     << ", seed " << info.seed << "), frames 0-" << frames - 1 << ", " << setup.n << " cameras of "
      << rig.cameras[0].camera.width << "x" << rig.cameras[0].camera.height << ", " << options.features_per_view
      << " features per view. rovo " << ROVO_VERSION << ".\n\n";
   md << "| | Original fisheye | Hybrid projection (ours) | Paper: fisheye / hybrid |\n|---|---|---|---|\n";
@@ -501,8 +549,8 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
   };
   md << "Ground-truth reprojection distance of the counted matches (fisheye px):\n\n"
      << "| | < 0.5 | 0.5-1 | 1-2 | 2-4 | 4-8 | >= 8 |\n|---|---|---|---|---|---|---|\n"
-     << bins_row("fisheye, NN", fisheye_arm.error_bins) << bins_row("hybrid, NN", hybrid_arm.error_bins)
-     << bins_row("hybrid, front-end", frontend_error_bins) << "\n";
+     << bins_row("fisheye, NN", tally.fisheye.error_bins) << bins_row("hybrid, NN", tally.hybrid.error_bins)
+     << bins_row("hybrid, front-end", tally.frontend_error_bins) << "\n";
   md << "Method: the same tracker (FAST + " << frontend_options.min_feature_distance_px
      << " px minimum distance, pyramidal KLT with forward-backward check, re-detection to the target, ORB "
         "descriptors recomputed every frame, "
@@ -521,14 +569,19 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
      << " fisheye px of the second and is not occluded (depth agrees). Matches without depth (sky) are not "
         "counted.\n";
   WriteFileAtomic(options.out_dir + "/table.md", md.str());
+}
 
+// study.json: the settings and both arms' and the front-end's counts.
+void WriteStudyJson(const StudySetup& setup, const DatasetInfo& info, const StudyTally& tally,
+                    const ProjectionStudyResult& result) {
+  const ProjectionStudyOptions& options = setup.options;
   nlohmann::json json;
   json["generator"] = "rovo study projection";
   json["generator_version"] = ROVO_VERSION;
   json["dataset"] = options.dataset_dir;
   json["dataset_seed"] = info.seed;
   json["preset"] = info.preset;
-  json["frames"] = frames;
+  json["frames"] = result.frames;
   json["features_per_view"] = options.features_per_view;
   json["epipolar_deg"] = options.epipolar_deg;
   json["inlier_px"] = options.inlier_px;
@@ -549,27 +602,79 @@ ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) 
                           {"inlier_ratio", ratio_value},
                           {"error_bins", arm.error_bins}};
   };
-  json["fisheye"] = arm_json(fisheye_arm, result.hamming_fisheye, result.hamming_step_fisheye, result.mean_age_fisheye,
-                             result.features_fisheye, result.InlierRatioFisheye());
-  json["hybrid"] = arm_json(hybrid_arm, result.hamming_hybrid, result.hamming_step_hybrid, result.mean_age_hybrid,
+  json["fisheye"] = arm_json(tally.fisheye, result.hamming_fisheye, result.hamming_step_fisheye,
+                             result.mean_age_fisheye, result.features_fisheye, result.InlierRatioFisheye());
+  json["hybrid"] = arm_json(tally.hybrid, result.hamming_hybrid, result.hamming_step_hybrid, result.mean_age_hybrid,
                             result.features_hybrid, result.InlierRatioHybrid());
   json["frontend"] = {{"matches", result.matches_frontend},
                       {"inliers", result.inliers_frontend},
                       {"inlier_ratio", result.InlierRatioFrontend()},
-                      {"error_bins", frontend_error_bins}};
+                      {"error_bins", tally.frontend_error_bins}};
   WriteJsonFileAtomic(options.out_dir + "/study.json", json);
+}
 
-  if (!pairs.empty()) {
-    const auto [a, b] = pairs[0];
+// The match drawings of the first pair at the last frame.
+void WriteStudyDrawings(const StudySetup& setup, const Frontend& frontend, const StudyTally& tally,
+                        const ProjectionStudyResult& result) {
+  if (!setup.pairs.empty()) {
+    const auto [a, b] = setup.pairs[0];
     const std::string pair_name = "cam" + std::to_string(a) + "-cam" + std::to_string(b) + " frame " +
-                                  std::to_string(frames - 1) + " (green: inlier by depth GT, red: outlier)";
-    WriteMatchesPng(options.out_dir + "/matches_frontend.png", frontend.warped_image(a), frontend.warped_image(b),
-                    drawn_frontend, "hybrid, front-end matches " + pair_name);
-    WriteMatchesPng(options.out_dir + "/matches_hybrid.png", frontend.warped_image(a), frontend.warped_image(b),
-                    hybrid_arm.drawn, "hybrid, epipolar-consistent NN matches " + pair_name);
-    WriteMatchesPng(options.out_dir + "/matches_fisheye.png", last_fisheye_a, last_fisheye_b, fisheye_arm.drawn,
-                    "raw fisheye, epipolar-consistent NN matches " + pair_name);
+                                  std::to_string(result.frames - 1) + " (green: inlier by depth GT, red: outlier)";
+    WriteMatchesPng(setup.options.out_dir + "/matches_frontend.png", frontend.warped_image(a), frontend.warped_image(b),
+                    tally.drawn_frontend, "hybrid, front-end matches " + pair_name);
+    WriteMatchesPng(setup.options.out_dir + "/matches_hybrid.png", frontend.warped_image(a), frontend.warped_image(b),
+                    tally.hybrid.drawn, "hybrid, epipolar-consistent NN matches " + pair_name);
+    WriteMatchesPng(setup.options.out_dir + "/matches_fisheye.png", tally.last_fisheye_a, tally.last_fisheye_b,
+                    tally.fisheye.drawn, "raw fisheye, epipolar-consistent NN matches " + pair_name);
   }
+}
+
+}  // namespace
+
+ProjectionStudyResult RunProjectionStudy(const ProjectionStudyOptions& options) {
+  const DatasetInfo info = ReadDatasetInfo(options.dataset_dir);
+  if (!info.has_depth) {
+    throw std::runtime_error(DatasetJsonPath(options.dataset_dir) +
+                             ": has_depth is false; the study needs depth (render with --depth)");
+  }
+  const Rig& rig = info.rig;
+  const int n = rig.NumCameras();
+  const int frames = std::min(options.frames, info.frame_count);
+  if (frames < 2) throw std::runtime_error(DatasetJsonPath(options.dataset_dir) + ": frame_count < 2");
+  EnsureWritableDir(options.out_dir);
+
+  FrontendOptions frontend_options;
+  frontend_options.matching = options.frontend_matching;
+  frontend_options.upright_descriptors = options.upright_descriptors;
+  Frontend frontend(rig, frontend_options);
+  const std::vector<HybridLayout> layouts = ComputeHybridLayouts(rig);
+  const StudySetup setup{
+      options, rig, n, layouts, NeighbourPairs(layouts), FisheyeMasks(rig), NearestNeighbourMatchOptions()};
+
+  TrackerOptions tracker_options = TrackerOptionsFrom(frontend_options);
+  tracker_options.target_features = options.features_per_view;
+  StudyTally tally;
+  for (Arm* arm : {&tally.fisheye, &tally.hybrid}) {
+    arm->trackers.assign(n, ViewTracker(tracker_options));
+    arm->history.resize(n);
+    arm->contributing.resize(n);
+  }
+
+  ProjectionStudyResult result;
+  result.frames = frames;
+  uint64_t next_id = 0;
+  const std::function<uint64_t()> id_source = [&next_id] { return ++next_id; };
+  Progress progress("projection study", frames, "frames", options.quiet);
+  for (int t = 0; t < frames; ++t) {
+    StudyOneFrame(setup, t, frames, frontend, &tally, id_source, &result);
+    progress.Add(1);
+  }
+  progress.Finish();
+
+  SummarizeArms(tally.fisheye, tally.hybrid, &result);
+  WriteStudyTable(setup, info, frontend_options, tally, result);
+  WriteStudyJson(setup, info, tally, result);
+  WriteStudyDrawings(setup, frontend, tally, result);
   return result;
 }
 

@@ -195,5 +195,57 @@ TEST_F(RenderDatasetTest, RefusesToMixWithAnotherDataset) {
   }
 }
 
+// A scene folder's rig.json (as scenes/blender/export_scene.py writes it) is the default rig of
+// --scene; an explicit rig wins; without rig.json the scene's rig_preset, then rovo4.
+TEST_F(RenderDatasetTest, SceneFolderRigJsonIsTheDefaultRig) {
+  const Rig scene_rig = MakeRigPreset("rovo4").Scaled(0.04);  // 64x61 ocam; the box scene names omnimvs4
+  const std::string rig_json = (fs::path(scene_dir_) / "rig.json").string();
+  WriteRigJson(rig_json, scene_rig, "test");
+
+  RenderOptions options = Options("out_scene_rig");
+  options.rig = "";
+  options.scale = 0.0;
+  options.frame_end = 1;
+  const RenderSummary summary = RenderDataset(options);
+  EXPECT_NE(summary.rig.find(rig_json + " (the scene's rig.json)"), std::string::npos) << summary.rig;
+  EXPECT_NE(summary.rig.find("4 cameras, ocam 64x61"), std::string::npos) << summary.rig;
+  const Rig written = ReadDatasetInfo(options.out_dir).rig;
+  ASSERT_EQ(written.NumCameras(), scene_rig.NumCameras());
+  for (int c = 0; c < scene_rig.NumCameras(); ++c) {
+    EXPECT_EQ(written.cameras[c].camera.model, scene_rig.cameras[c].camera.model);
+    EXPECT_EQ(written.cameras[c].camera.width, scene_rig.cameras[c].camera.width);
+    EXPECT_EQ(written.cameras[c].camera.height, scene_rig.cameras[c].camera.height);
+    EXPECT_EQ(written.cameras[c].camera.params, scene_rig.cameras[c].camera.params);
+    EXPECT_TRUE(written.cameras[c].cam_from_rig.translation.isApprox(scene_rig.cameras[c].cam_from_rig.translation));
+  }
+
+  // An explicit rig wins over the scene's rig.json.
+  const Scene scene = LoadScene(scene_dir_);
+  const RigChoice explicit_rig = ChooseRig("omnimvs4", scene, scene_dir_, 0.1);
+  EXPECT_EQ(explicit_rig.source, "preset omnimvs4 (--rig)");
+  EXPECT_EQ(explicit_rig.rig.cameras[0].camera.width, 80);
+  const RigChoice explicit_json = ChooseRig(rig_json, scene, "", 0.0);
+  EXPECT_EQ(explicit_json.source, rig_json + " (--rig)");
+
+  // A broken rig.json in the scene folder is an error naming it, not a silent fallback.
+  WriteFileAtomic(rig_json, "{\"cameras\": 3}");
+  try {
+    ChooseRig("", scene, scene_dir_, 0.0);
+    ADD_FAILURE() << "expected an error";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("rig.json"), std::string::npos) << e.what();
+  }
+
+  // Without rig.json: the scene's rig_preset, then rovo4.
+  fs::remove(rig_json);
+  const RigChoice from_preset = ChooseRig("", scene, scene_dir_, 0.0);
+  EXPECT_EQ(from_preset.source, "preset omnimvs4 (the scene's rig_preset)");
+  Scene unnamed = scene;
+  unnamed.rig_preset = "";
+  const RigChoice fallback = ChooseRig("", unnamed, scene_dir_, 0.0);
+  EXPECT_EQ(fallback.source, "preset rovo4 (the default: the scene names no rig)");
+  EXPECT_EQ(fallback.rig.cameras[0].camera.width, MakeRigPreset("rovo4").cameras[0].camera.width);
+}
+
 }  // namespace
 }  // namespace rovo

@@ -1,5 +1,5 @@
 // `rovo render` as a process: SIGKILL mid-run then rerun equals an uninterrupted run; CLI errors;
-// the quick preset end to end; `rovo scene preview`.
+// the quick preset end to end; `rovo scene preview`; the scene folder's rig.json as the default rig.
 #include "datasets/dataset.h"
 #include "datasets/io.h"
 #include "render/render.h"
@@ -145,6 +145,26 @@ TEST_F(RenderCliTest, ScenePreviewWritesAContactSheet) {
   ASSERT_TRUE(in);
   EXPECT_EQ(in->spec().width, 4 * 80);
   EXPECT_EQ(in->spec().height, 2 * 77);
+}
+
+// `rovo render --scene DIR` renders with DIR/rig.json (the Blender exporter's rig) and says so.
+TEST_F(RenderCliTest, SceneFolderRigJsonIsUsedAndPrinted) {
+  SaveScene(testing::MakeBoxScene(2, false), Path("scene"));
+  const std::string rig_json = (fs::path(Path("scene")) / "rig.json").string();
+  WriteRigJson(rig_json, MakeRigPreset("rovo4").Scaled(0.04), "test");
+  ASSERT_EQ(RunRovo({"render", "--scene", Path("scene"), "--frames", "0:1", "--out", Path("out")}, Path("r.log")), 0)
+      << ReadFile(Path("r.log"));
+  const std::string log = ReadFile(Path("r.log"));
+  EXPECT_NE(log.find("rig: " + rig_json + " (the scene's rig.json): 4 cameras, ocam 64x61"), std::string::npos) << log;
+  EXPECT_EQ(ReadDatasetInfo(Path("out")).rig.cameras[0].camera.width, 64);
+
+  ASSERT_EQ(RunRovo({"render", "--scene", Path("scene"), "--frames", "0:1", "--rig", "omnimvs4", "--scale", "0.1",
+                     "--out", Path("out_explicit")},
+                    Path("e.log")),
+            0)
+      << ReadFile(Path("e.log"));
+  EXPECT_NE(ReadFile(Path("e.log")).find("rig: preset omnimvs4 (--rig)"), std::string::npos) << ReadFile(Path("e.log"));
+  EXPECT_EQ(ReadDatasetInfo(Path("out_explicit")).rig.cameras[0].camera.width, 80);
 }
 
 }  // namespace
