@@ -1,10 +1,8 @@
 #include "eval/batch.h"
 
 #include "datasets/io.h"
-#include "eval/format.h"
 #include "render/render.h"
 #include "rovo/version.h"
-#include "scenes/city.h"
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -26,18 +24,20 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Measured per-frame costs (docs/batch.md "Per-task figures"; 2-core Debian 12 machine, rovo 0.x):
-// render core-seconds per frame (4 views, default spp) and VO seconds per frame at one thread,
-// full size and quick form; peak resident memory of one task.
-constexpr double kRenderCoreSecondsFull = 1.4;
-constexpr double kRenderCoreSecondsQuick = 0.35;
-constexpr double kVoSecondsFull = 0.25;
-constexpr double kVoSecondsQuick = 0.08;
-constexpr const char* kRenderMemFull = "4G";
-constexpr const char* kRenderMemQuick = "2G";
+// Measured per-frame costs (docs/batch.md "Per-task figures"; 2-core Debian 12 machine under load,
+// Release build): render CPU-seconds per frame (4 views, default spp) and OnlineExt VO seconds per
+// frame at one thread, full size and quick form; memory requests about twice to six times the
+// measured peak resident memory of one task (render 1.1 GB full / 0.5 GB quick, VO 0.5 / 0.26 GB,
+// merge 0.14 GB).
+constexpr double kRenderCoreSecondsFull = 1.55;
+constexpr double kRenderCoreSecondsQuick = 0.45;
+constexpr double kVoSecondsFull = 0.45;
+constexpr double kVoSecondsQuick = 0.25;
+constexpr const char* kRenderMemFull = "3G";
+constexpr const char* kRenderMemQuick = "1G";
 constexpr const char* kVoMemFull = "3G";
-constexpr const char* kVoMemQuick = "2G";
-constexpr const char* kMergeMem = "2G";
+constexpr const char* kVoMemQuick = "1G";
+constexpr const char* kMergeMem = "1G";
 constexpr int kRenderCpus = 4;
 constexpr int kVoCpus = 2;
 
@@ -488,7 +488,7 @@ std::string FormatBatchStatus(const BatchLayout& layout, const BatchStatus& stat
     for (const auto& [state, n] : counts)
       line += (line.empty() ? "" : ", ") + std::to_string(n) + " " + TaskStateName(state);
     out += "  " + stage + std::string(8 - std::min<size_t>(7, stage.size()), ' ') +
-           std::to_string(layout.Tasks(stage)) + " tasks: " + line + "\n";
+           std::to_string(layout.Tasks(stage)) + (layout.Tasks(stage) == 1 ? " task: " : " tasks: ") + line + "\n";
   }
   out += problems;
   if (!status.squeue_ok) {

@@ -49,7 +49,7 @@ void AddPlanCommand(CLI::App* batch) {
     std::printf("Batch folder %s:\n", layout.options.dir.c_str());
     for (const std::string& stage : BatchStages()) {
       const BatchResources& r = layout.Resources(stage);
-      std::printf("  %-6s %4d tasks, each --cpus-per-task=%d --mem=%s --time=%s\n", stage.c_str(), layout.Tasks(stage),
+      std::printf("  %-6s %4d task(s), each --cpus-per-task=%d --mem=%s --time=%s\n", stage.c_str(), layout.Tasks(stage),
                   r.cpus, r.mem.c_str(), r.time.c_str());
     }
     std::printf("Submit with `rovo batch submit %s` (or %s/submit.sh)\n", layout.options.dir.c_str(),
