@@ -119,6 +119,8 @@ namespace {
 
 void PrintSuite(const std::vector<PresetSummary>& summaries, const SuiteOptions& options) {
   std::printf("%s\n", SuiteTableMarkdown(summaries, options.quick).c_str());
+  const std::string draws = DrawTableMarkdown(summaries, options.draw_sigma_deg);
+  if (!draws.empty()) std::printf("%s\n", draws.c_str());
   std::printf("Suite: %s (suite.json, table.md%s)\n", options.out_dir.c_str(), options.plots ? ", report.html" : "");
 }
 
