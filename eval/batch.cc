@@ -356,7 +356,8 @@ void RunBatchTask(const std::string& dir, const std::string& stage, int index) {
     throw std::invalid_argument("rovo batch task: " + stage + " has tasks 0.." +
                                 std::to_string(layout.Tasks(stage) - 1) + ", not " + std::to_string(index));
   }
-  const std::string job = EnvOr("SLURM_ARRAY_JOB_ID", EnvOr("SLURM_JOB_ID", "")) + "_" + std::to_string(index);
+  const std::string slurm_job = EnvOr("SLURM_ARRAY_JOB_ID", EnvOr("SLURM_JOB_ID", ""));
+  const std::string job = slurm_job.empty() ? "(not under Slurm)" : slurm_job + "_" + std::to_string(index);
   const std::string host = EnvOr("SLURMD_NODENAME", EnvOr("HOSTNAME", ""));
   std::fprintf(stderr, "rovo batch: %s task %d (%s), job %s on %s, started %s\n", stage.c_str(), index,
                TaskWhat(layout, stage, index).c_str(), job.c_str(), host.c_str(), UtcNow().c_str());
@@ -402,6 +403,8 @@ const char* TaskStateName(TaskState state) {
       return "pending";
     case TaskState::kLost:
       return "lost";
+    case TaskState::kUnknown:
+      return "unknown";
     case TaskState::kNotSubmitted:
       return "not submitted";
   }
@@ -457,6 +460,8 @@ BatchStatus ReadBatchStatus(const std::string& dir, const std::string* squeue_li
         t.detail =
             "not in squeue and no marker: cancelled, timed out, out of memory, its node was lost, or a stage "
             "before it failed";
+      } else if (!t.job.empty()) {
+        t.state = TaskState::kUnknown;
       } else {
         t.state = TaskState::kNotSubmitted;
       }

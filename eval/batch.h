@@ -75,7 +75,8 @@ std::string FormatIndices(const std::vector<int>& indices);
 std::vector<int> ParseIndices(const std::string& text);
 
 // State of one task.
-enum class TaskState { kDone, kFailed, kRunning, kPending, kLost, kNotSubmitted };
+// kUnknown: submitted, but squeue did not answer.
+enum class TaskState { kDone, kFailed, kRunning, kPending, kLost, kUnknown, kNotSubmitted };
 const char* TaskStateName(TaskState state);
 struct TaskStatus {
   std::string stage;
