@@ -14,6 +14,7 @@ PACKAGES=(
   python3 python3-matplotlib python3-numpy
   blender
   chromium
+  slurm-wlm munge
 )
 
 missing=()

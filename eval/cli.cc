@@ -4,6 +4,7 @@
 #include "eval/gate.h"
 #include "eval/report.h"
 #include "eval/suite.h"
+#include "eval/suite_cli.h"
 #include "scenes/city.h"
 
 #include <CLI/CLI.hpp>
@@ -66,25 +67,20 @@ std::vector<std::string> SplitCommaList(const std::string& list) {
   return out;
 }
 
-void PrintSuite(const std::vector<PresetSummary>& summaries, const SuiteOptions& options) {
-  std::printf("%s\n", SuiteTableMarkdown(summaries, options.quick).c_str());
-  std::printf("Suite: %s (suite.json, table.md%s)\n", options.out_dir.c_str(), options.plots ? ", report.html" : "");
+}  // namespace
+
+SuiteOptions SuiteCliArgs::Options() const {
+  SuiteOptions o = options;
+  o.presets = SplitCommaList(presets);
+  o.plots = !no_plots;
+  return o;
 }
 
-void AddSuiteCommand(CLI::App& root) {
-  auto options = std::make_shared<SuiteOptions>();
-  auto presets = std::make_shared<std::string>();
-  auto no_plots = std::make_shared<bool>(false);
+void AddSuiteOptions(CLI::App* cmd, SuiteCliArgs* args) {
+  SuiteOptions* options = &args->options;
   std::string preset_names;
   for (const ScenePreset& p : ScenePresets()) preset_names += (preset_names.empty() ? "" : ",") + p.name;
-  CLI::App* cmd = root.add_subcommand(
-      "suite",
-      "The paper's Table I suites: renders missing datasets, runs VO with ground-truth extrinsics (GTExt) once and "
-      "with each of K perturbed extrinsic sets fixed (NoisyExt) and calibrated online (OnlineExt), evaluates, and "
-      "writes suite.json, table.md (mean +- std over noise sets, the paper's figures beside ours) and report.html. "
-      "Resumes: complete runs made with the same settings (frames, seed, noise set, --max-new-features) and complete "
-      "datasets are not redone.");
-  cmd->add_option("--presets", *presets, "Comma-separated presets (default: all: " + preset_names + ")");
+  cmd->add_option("--presets", args->presets, "Comma-separated presets (default: all: " + preset_names + ")");
   cmd->add_flag("--quick", options->quick, "Use the presets' quick forms (fewer frames, smaller images)");
   cmd->add_option("--frames", options->frames,
                   "Only the first N frames of each preset: rendered, run and scored on that span (0: all; e.g. a "
@@ -94,10 +90,20 @@ void AddSuiteCommand(CLI::App& root) {
   cmd->add_option("--seeds", options->noise_sets, "Number K of extrinsic noise sets (noise_set 0..K-1)")
       ->default_val(1)
       ->check(CLI::Range(1, 1000));
-  cmd->add_option("--jobs", options->jobs, "VO runs in parallel; each gets cores/jobs threads")
-      ->default_val(1)
-      ->check(CLI::Range(1, 256));
-  cmd->add_option("--threads", options->threads, "Cores to use (0 = all)")->default_val(0);
+  cmd->add_option("--draws", options->draws,
+                  "D more OnlineExt runs per preset from fresh perturbation draws (seeds derived from --scene-seed, "
+                  "--vo-seed and the draw index, recorded in suite.json); reported as mean +- std and the rate of "
+                  "draws whose final extrinsic error is below 0.1 deg")
+      ->default_val(0)
+      ->check(CLI::Range(0, 100000));
+  cmd->add_option("--draw-sigma", options->draw_sigma_deg, "Sigma of the --draws perturbations in degrees")
+      ->default_val(5.0)
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--vo-threads", options->vo_threads,
+                  "Threads of each VO run (0: cores/jobs, or the task's CPUs in a batch); 1 makes OnlineExt runs "
+                  "reproducible, and a batch equal to a local suite byte for byte")
+      ->default_val(0)
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--data", options->data_dir, "Dataset cache folder (default: OUT/data)");
   cmd->add_option("--scene-seed", options->scene_seed, "Scene and render seed")->default_val(0);
   cmd->add_option("--vo-seed", options->vo_seed, "RANSAC seed of every run")->default_val(0);
@@ -105,12 +111,36 @@ void AddSuiteCommand(CLI::App& root) {
                   "New detections per view and frame at most, while the view has tracks, in every run (rovo vo "
                   "--max-new-features; 0: no limit; default: rovo vo's). Runs made with another value are redone")
       ->check(CLI::Range(0, 100000));
-  cmd->add_flag("--no-plots", *no_plots, "Skip plots and report.html");
+  cmd->add_flag("--no-plots", args->no_plots, "Skip plots and report.html");
   cmd->add_option("--out", options->out_dir, "Suite output folder")->required();
-  cmd->callback([options, presets, no_plots] {
-    options->presets = SplitCommaList(*presets);
-    options->plots = !*no_plots;
-    PrintSuite(RunSuite(*options), *options);
+}
+
+namespace {
+
+void PrintSuite(const std::vector<PresetSummary>& summaries, const SuiteOptions& options) {
+  std::printf("%s\n", SuiteTableMarkdown(summaries, options.quick).c_str());
+  const std::string draws = DrawTableMarkdown(summaries, options.draw_sigma_deg);
+  if (!draws.empty()) std::printf("%s\n", draws.c_str());
+  std::printf("Suite: %s (suite.json, table.md%s)\n", options.out_dir.c_str(), options.plots ? ", report.html" : "");
+}
+
+void AddSuiteCommand(CLI::App& root) {
+  auto args = std::make_shared<SuiteCliArgs>();
+  CLI::App* cmd = root.add_subcommand(
+      "suite",
+      "The paper's Table I suites: renders missing datasets, runs VO with ground-truth extrinsics (GTExt) once and "
+      "with each of K perturbed extrinsic sets fixed (NoisyExt) and calibrated online (OnlineExt), evaluates, and "
+      "writes suite.json, table.md (mean +- std over noise sets, the paper's figures beside ours) and report.html. "
+      "Resumes: complete runs made with the same settings (frames, seed, noise set, --max-new-features) and complete "
+      "datasets are not redone. `rovo batch plan` takes the same options and runs the suite as Slurm jobs.");
+  AddSuiteOptions(cmd, args.get());
+  cmd->add_option("--jobs", args->options.jobs, "VO runs in parallel; each gets cores/jobs threads")
+      ->default_val(1)
+      ->check(CLI::Range(1, 256));
+  cmd->add_option("--threads", args->options.threads, "Cores to use (0 = all)")->default_val(0);
+  cmd->callback([args] {
+    const SuiteOptions options = args->Options();
+    PrintSuite(RunSuite(options), options);
   });
 }
 
@@ -199,6 +229,7 @@ void AddGateCommand(CLI::App& root) {
 void AddEvalCommands(CliGroups& groups) {
   AddEvalCommand(*groups.root);
   AddSuiteCommand(*groups.root);
+  AddBatchCommand(*groups.root);
   AddDemoCommand(*groups.root);
   AddGateCommand(*groups.root);
 }

@@ -10,6 +10,7 @@
 #include "render/render.h"
 #include "rovo/version.h"
 #include "scenes/city.h"
+#include "scenes/rng.h"
 #include "vo/pipeline.h"
 
 #include <algorithm>
@@ -21,6 +22,7 @@
 #include <mutex>
 #include <stdexcept>
 #include <thread>
+#include <type_traits>
 
 namespace rovo {
 namespace fs = std::filesystem;
@@ -45,6 +47,8 @@ bool RunReusable(const std::string& run_dir, const RunSettings& want, std::strin
   const std::pair<const char*, std::pair<nlohmann::json, nlohmann::json>> checks[] = {
       {"mode", {info.value("mode", nlohmann::json()), ExtrinsicsModeName(want.mode)}},
       {"noise_set", {info.value("noise_set", nlohmann::json()), want.noise_set}},
+      // Runs from before draws were recorded started from a stored set.
+      {"draw_seed", {info.value("draw_seed", nlohmann::json(-1)), want.draw_seed}},
       {"seed", {info.value("seed", nlohmann::json()), want.seed}},
       {"max_new_features", {recorded_limit, want.max_new_features}},
   };
@@ -53,6 +57,11 @@ bool RunReusable(const std::string& run_dir, const RunSettings& want, std::strin
       *mismatch = std::string(field) + ": " + values.first.dump() + " vs " + values.second.dump();
       return false;
     }
+  }
+  if (want.draw_seed >= 0 && info.value("draw_sigma_deg", nlohmann::json()) != nlohmann::json(want.draw_sigma_deg)) {
+    *mismatch = "draw_sigma_deg: " + info.value("draw_sigma_deg", nlohmann::json()).dump() + " vs " +
+                nlohmann::json(want.draw_sigma_deg).dump();
+    return false;
   }
   return true;
 }
@@ -87,18 +96,11 @@ bool DatasetComplete(const std::string& dataset_dir, int max_frames) {
         if (!fs::is_regular_file(ImagePath(dataset_dir, cam.name, f), ec)) return false;
       }
     }
-    return info.frame_count > 0;
+    return info.frame_count > 0 && info.frame_count >= max_frames;
   } catch (const std::exception&) {
     return false;
   }
 }
-
-struct VoJob {
-  std::string preset;
-  std::string dataset_dir;
-  std::string run_dir;
-  RunSettings settings;
-};
 
 }  // namespace
 
@@ -156,27 +158,64 @@ const ModeSummary* PresetSummary::Find(const std::string& mode) const {
   return nullptr;
 }
 
+ModeSummary SummariseRuns(const std::string& mode, const std::vector<RunMetrics>& runs) {
+  ModeSummary summary;
+  summary.mode = mode;
+  summary.runs = runs;
+  for (const std::string& name : AggregatedMetricNames()) {
+    std::vector<double> values;
+    for (const RunMetrics& m : summary.runs) {
+      if (const auto v = MetricValue(m, name)) values.push_back(*v);
+    }
+    // A run without a value (e.g. no trajectory) makes the whole statistic undefined: n counts
+    // the runs that have it, and the table shows n when it is short.
+    summary.stats.emplace_back(name, ComputeStat(values));
+  }
+  return summary;
+}
+
 std::vector<ModeSummary> SummariseModes(const std::vector<RunMetrics>& runs) {
   std::vector<ModeSummary> out;
   for (const char* mode : {"gt", "noisy", "online"}) {
-    ModeSummary summary;
-    summary.mode = mode;
+    std::vector<RunMetrics> of_mode;
     for (const RunMetrics& m : runs) {
-      if (m.mode == mode) summary.runs.push_back(m);
+      if (m.mode == mode) of_mode.push_back(m);
     }
-    if (summary.runs.empty()) continue;
-    for (const std::string& name : AggregatedMetricNames()) {
-      std::vector<double> values;
-      for (const RunMetrics& m : summary.runs) {
-        if (const auto v = MetricValue(m, name)) values.push_back(*v);
-      }
-      // A run without a value (e.g. no trajectory) makes the whole statistic undefined: n counts
-      // the runs that have it, and the table shows n when it is short.
-      summary.stats.emplace_back(name, ComputeStat(values));
-    }
-    out.push_back(std::move(summary));
+    if (!of_mode.empty()) out.push_back(SummariseRuns(mode, of_mode));
   }
   return out;
+}
+
+DrawConvergence ComputeDrawConvergence(const ModeSummary& draws) {
+  DrawConvergence c;
+  c.draws = static_cast<int>(draws.runs.size());
+  for (size_t i = 0; i < draws.runs.size(); ++i) {
+    const RunMetrics& m = draws.runs[i];
+    if (!m.final_ext_rotation_deg.empty() && m.max_final_ext_rotation_deg < kDrawConvergedBelowDeg) {
+      ++c.converged;
+    } else if (i < draws.draw_seeds.size()) {
+      c.failed_seeds.push_back(draws.draw_seeds[i]);
+    }
+  }
+  return c;
+}
+
+uint64_t StoredNoiseSetSeed(uint64_t scene_seed, int k) {
+  return MixSeed(scene_seed * 1000003ull + 17 + static_cast<uint64_t>(k));  // as render/render.cc
+}
+
+int64_t SuiteDrawSeed(uint64_t scene_seed, uint64_t vo_seed, int draw) {
+  constexpr uint64_t kDrawDomain = 0x6472617773ull;  // "draws": a stream apart from the stored sets
+  uint64_t x = MixSeed(MixSeed(MixSeed(scene_seed ^ kDrawDomain) + vo_seed) + static_cast<uint64_t>(draw));
+  const auto stored = [&](uint64_t seed) {
+    for (int k = 0; k < kNumPerturbedSets; ++k) {
+      if (StoredNoiseSetSeed(scene_seed, k) == seed) return true;
+    }
+    return false;
+  };
+  // VoOptions::draw_seed is signed (-1 = no draw): keep 63 bits; step on in the rare clash.
+  while (stored(x >> 1)) x = MixSeed(x);
+  return static_cast<int64_t>(x >> 1);
 }
 
 std::optional<PaperRow> PaperRowForPreset(const std::string& preset) {
@@ -254,6 +293,10 @@ nlohmann::json SuiteToJson(const std::vector<PresetSummary>& presets, const Suit
   j["quick"] = options.quick;
   j["frames"] = options.frames;
   j["noise_sets"] = options.noise_sets;
+  if (options.draws > 0) {
+    j["draws"] = options.draws;
+    j["draw_sigma_deg"] = options.draw_sigma_deg;
+  }
   j["scene_seed"] = options.scene_seed;
   j["vo_seed"] = options.vo_seed;
   j["max_new_features"] = options.MaxNewFeatures();
@@ -271,192 +314,362 @@ nlohmann::json SuiteToJson(const std::vector<PresetSummary>& presets, const Suit
       for (const RunMetrics& r : m.runs) mj["runs"].push_back(MetricsToJson(r));
       pj["modes"][m.mode] = mj;
     }
+    if (const ModeSummary* draws = p.Find("draws")) {
+      const DrawConvergence c = ComputeDrawConvergence(*draws);
+      nlohmann::json& dj = pj["modes"]["draws"];
+      dj["draw_seeds"] = draws->draw_seeds;
+      dj["draw_sigma_deg"] = options.draw_sigma_deg;
+      dj["converged"] = {{"below_deg", kDrawConvergedBelowDeg},
+                         {"count", c.converged},
+                         {"draws", c.draws},
+                         {"rate", c.draws > 0 ? static_cast<double>(c.converged) / c.draws : 0.0},
+                         {"failed_seeds", c.failed_seeds}};
+    }
     j["presets"][p.preset] = pj;
   }
   return j;
 }
 
-std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
-  if (options.out_dir.empty()) throw std::invalid_argument("rovo suite: --out is required");
-  if (options.noise_sets < 1) throw std::invalid_argument("rovo suite: --seeds must be >= 1");
-  if (options.jobs < 1) throw std::invalid_argument("rovo suite: --jobs must be >= 1");
-  std::vector<std::string> presets = options.presets;
-  if (presets.empty()) {
-    for (const ScenePreset& p : ScenePresets()) presets.push_back(p.name);
+std::string DrawTableMarkdown(const std::vector<PresetSummary>& presets, double draw_sigma_deg) {
+  std::string md;
+  for (const PresetSummary& p : presets) {
+    const ModeSummary* draws = p.Find("draws");
+    if (!draws) continue;
+    const int n = static_cast<int>(draws->runs.size());
+    const DrawConvergence c = ComputeDrawConvergence(*draws);
+    std::string failed;
+    for (int64_t seed : c.failed_seeds) failed += (failed.empty() ? "" : ", ") + std::to_string(seed);
+    md += "| `" + p.preset + "` | " + std::to_string(n) + " | " + FmtStat(draws->Find("rmse_se3_m"), n, "%.3f") +
+          " | " + FmtStat(draws->Find("max_final_ext_rotation_deg"), n, "%.3f") + " | " +
+          Fmt("%.0f", 100.0 * c.converged / std::max(1, c.draws)) + " % (" + std::to_string(c.converged) + " of " +
+          std::to_string(c.draws) + ") | " + (failed.empty() ? "-" : failed) + " |\n";
   }
-  for (const std::string& p : presets) FindScenePreset(p);  // throws listing the valid names
-  const std::string data_dir = options.data_dir.empty() ? (fs::path(options.out_dir) / "data").string() : options.data_dir;
-  EnsureWritableDir(options.out_dir);
-  EnsureWritableDir(data_dir);
-  const int cores = options.threads > 0 ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  if (md.empty()) return "";
+  return "## OnlineExt from fresh perturbation draws (σ = " + Fmt("%.1f", draw_sigma_deg) +
+         "°)\n\n| sequence | draws | RMSE [m] | ext rot final [deg] | converged (< " +
+         Fmt("%.1f", kDrawConvergedBelowDeg) + "°) | seeds not converged |\n|---|---|---|---|---|---|\n" + md +
+         "\nmean ± std over the draws; ext rot = largest over cameras i ≥ 1 of the rotation angle of "
+         "est(cam_i_from_cam0) · true(cam_i_from_cam0)⁻¹ at the last frame; a draw has converged when it is below "
+         "the threshold. Draw seeds (suite.json \"draw_seeds\") are derived from the scene and VO seeds and never "
+         "equal a stored noise set's.\n";
+}
 
-  // 1. Datasets (rendering uses all cores, one dataset at a time).
-  std::vector<std::string> dataset_dirs;
-  for (const std::string& preset : presets) {
-    const std::string dir = (fs::path(data_dir) / (preset + (options.quick ? "_quick" : "") + "_s" +
-                                                   std::to_string(options.scene_seed)))
-                                .string();
-    dataset_dirs.push_back(dir);
-    if (DatasetComplete(dir, options.frames)) {
-      if (!options.quiet) std::fprintf(stderr, "rovo suite: dataset %s is complete, not rendering\n", dir.c_str());
-      continue;
-    }
-    if (!options.quiet) std::fprintf(stderr, "rovo suite: rendering %s%s -> %s\n", preset.c_str(),
-                                     options.quick ? " (quick)" : "", dir.c_str());
-    RenderOptions render;
-    render.preset = preset;
-    render.quick = options.quick;
-    render.out_dir = dir;
-    render.seed = options.scene_seed;
-    if (options.frames > 0) {
-      const ScenePreset& p = FindScenePreset(preset);
-      render.frame_end = std::min(options.frames, options.quick ? p.quick_frames : p.frames);
-    }
-    render.threads = cores;
-    render.depth = false;
-    render.quiet = options.quiet;
-    RenderDataset(render);
-  }
+nlohmann::json SuiteOptionsToJson(const SuiteOptions& o) {
+  return {{"presets", o.presets},
+          {"quick", o.quick},
+          {"frames", o.frames},
+          {"noise_sets", o.noise_sets},
+          {"draws", o.draws},
+          {"draw_sigma_deg", o.draw_sigma_deg},
+          {"jobs", o.jobs},
+          {"threads", o.threads},
+          {"vo_threads", o.vo_threads},
+          {"data_dir", o.data_dir},
+          {"out_dir", o.out_dir},
+          {"scene_seed", o.scene_seed},
+          {"vo_seed", o.vo_seed},
+          {"max_new_features", o.max_new_features},
+          {"plots", o.plots},
+          {"quiet", o.quiet}};
+}
 
-  // 2. VO runs.
-  std::vector<VoJob> jobs;
-  std::vector<int> frame_ends;      // per preset: runs cover frames [0, end)
-  std::vector<int> dataset_frames;  // per preset: frames of the dataset
-  for (size_t i = 0; i < presets.size(); ++i) {
-    const DatasetInfo info = ReadDatasetInfo(dataset_dirs[i]);
-    frame_ends.push_back(options.frames > 0 ? std::min(options.frames, info.frame_count) : info.frame_count);
-    dataset_frames.push_back(info.frame_count);
-    if (static_cast<int>(info.perturbed.size()) < options.noise_sets) {
-      throw std::runtime_error(DatasetJsonPath(dataset_dirs[i]) + ": field \"perturbed\" holds " +
-                               std::to_string(info.perturbed.size()) + " noise sets, --seeds asks for " +
-                               std::to_string(options.noise_sets));
-    }
-    const fs::path runs = fs::path(options.out_dir) / "runs" / presets[i];
-    const int end = frame_ends[i];
-    const auto settings = [&](ExtrinsicsMode mode, int noise_set) {
-      return RunSettings{mode, noise_set, end, options.vo_seed, options.MaxNewFeatures()};
+SuiteOptions SuiteOptionsFromJson(const nlohmann::json& j, const std::string& source) {
+  SuiteOptions o;
+  const char* field = "";
+  try {
+    auto get = [&](const char* name, auto* value) {
+      field = name;
+      *value = j.at(name).get<std::remove_pointer_t<decltype(value)>>();
     };
-    jobs.push_back({presets[i], dataset_dirs[i], (runs / "gt").string(), settings(ExtrinsicsMode::kGroundTruth, 0)});
-    for (int k = 0; k < options.noise_sets; ++k) {
-      jobs.push_back({presets[i], dataset_dirs[i], (runs / ("noisy_" + std::to_string(k))).string(),
-                      settings(ExtrinsicsMode::kNoisy, k)});
-      jobs.push_back({presets[i], dataset_dirs[i], (runs / ("online_" + std::to_string(k))).string(),
-                      settings(ExtrinsicsMode::kOnline, k)});
-    }
+    get("presets", &o.presets);
+    get("quick", &o.quick);
+    get("frames", &o.frames);
+    get("noise_sets", &o.noise_sets);
+    get("draws", &o.draws);
+    get("draw_sigma_deg", &o.draw_sigma_deg);
+    get("jobs", &o.jobs);
+    get("threads", &o.threads);
+    get("vo_threads", &o.vo_threads);
+    get("data_dir", &o.data_dir);
+    get("out_dir", &o.out_dir);
+    get("scene_seed", &o.scene_seed);
+    get("vo_seed", &o.vo_seed);
+    get("max_new_features", &o.max_new_features);
+    get("plots", &o.plots);
+    get("quiet", &o.quiet);
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(source + ": field \"" + field + "\": " + e.what());
   }
-  std::vector<const VoJob*> todo;
-  for (const VoJob& job : jobs) {
-    std::string mismatch;
-    if (RunReusable(job.run_dir, job.settings, &mismatch)) {
-      if (!options.quiet) std::fprintf(stderr, "rovo suite: run %s is complete, skipping\n", job.run_dir.c_str());
+  return o;
+}
+
+namespace {
+
+std::string DatasetDirFor(const std::string& data_dir, const std::string& preset, const SuiteOptions& options) {
+  return (fs::path(data_dir) / (preset + (options.quick ? "_quick" : "") + "_s" + std::to_string(options.scene_seed)))
+      .string();
+}
+
+// The runs of one preset, in the order of the table and suite.json.
+void PlanPresetRuns(const SuiteOptions& options, size_t preset_index, const std::string& runs_dir, int frame_end,
+                    std::vector<SuiteRun>* runs) {
+  const auto add = [&](const std::string& name, ExtrinsicsMode mode, int noise_set, int64_t draw_seed) {
+    SuiteRun run;
+    run.preset_index = preset_index;
+    run.name = name;
+    run.run_dir = (fs::path(runs_dir) / name).string();
+    run.settings = RunSettings{
+        mode, noise_set, draw_seed, options.draw_sigma_deg, frame_end, options.vo_seed, options.MaxNewFeatures()};
+    runs->push_back(run);
+  };
+  add("gt", ExtrinsicsMode::kGroundTruth, 0, -1);
+  for (int k = 0; k < options.noise_sets; ++k) {
+    add("noisy_" + std::to_string(k), ExtrinsicsMode::kNoisy, k, -1);
+    add("online_" + std::to_string(k), ExtrinsicsMode::kOnline, k, -1);
+  }
+  for (int d = 0; d < options.draws; ++d) {
+    add("draw_" + std::to_string(d), ExtrinsicsMode::kOnline, 0, SuiteDrawSeed(options.scene_seed, options.vo_seed, d));
+  }
+}
+
+// The dataset must cover the runs' frames and hold the noise sets they use.
+void CheckSuiteDataset(const SuitePlan& plan, size_t preset_index) {
+  const std::string& dir = plan.dataset_dirs[preset_index];
+  const DatasetInfo info = ReadDatasetInfo(dir);
+  if (info.frame_count < plan.frame_ends[preset_index]) {
+    throw std::runtime_error(DatasetJsonPath(dir) + ": field \"frame_count\" is " + std::to_string(info.frame_count) +
+                             ", the suite runs frames [0, " + std::to_string(plan.frame_ends[preset_index]) + ")");
+  }
+  if (static_cast<int>(info.perturbed.size()) < plan.options.noise_sets) {
+    throw std::runtime_error(DatasetJsonPath(dir) + ": field \"perturbed\" holds " +
+                             std::to_string(info.perturbed.size()) + " noise sets, --seeds asks for " +
+                             std::to_string(plan.options.noise_sets));
+  }
+}
+
+// The PNGs of a report folder's plots/, sorted.
+std::vector<std::string> ReportPngs(const std::string& report_dir) {
+  std::vector<std::string> pngs;
+  std::error_code ec;
+  const fs::path plots = fs::path(report_dir) / "plots";
+  if (!fs::is_directory(plots, ec)) return pngs;
+  for (const auto& entry : fs::directory_iterator(plots, ec)) {
+    if (entry.path().extension() == ".png") pngs.push_back(entry.path().string());
+  }
+  std::sort(pngs.begin(), pngs.end());
+  return pngs;
+}
+
+// Evaluates the runs of one preset (writes reports/<preset>/) and aggregates them.
+PresetSummary MergePreset(const SuitePlan& plan, size_t preset_index) {
+  const SuiteOptions& options = plan.options;
+  const std::string& preset = options.presets[preset_index];
+  std::vector<const SuiteRun*> runs;
+  std::vector<std::string> run_dirs;
+  for (const SuiteRun& run : plan.runs) {
+    if (run.preset_index != preset_index) continue;
+    runs.push_back(&run);
+    run_dirs.push_back(run.run_dir);
+  }
+  EvalReportOptions report;
+  report.plots = options.plots;
+  report.quiet = options.quiet;
+  const std::string report_dir = (fs::path(options.out_dir) / "reports" / preset).string();
+  const std::vector<RunEvaluation> evaluations =
+      EvaluateAndReport(plan.dataset_dirs[preset_index], run_dirs, report_dir, report);
+  PresetSummary summary;
+  summary.preset = preset;
+  summary.dataset_dir = fs::absolute(plan.dataset_dirs[preset_index]).lexically_normal().string();
+  summary.frames = plan.frame_ends[preset_index];
+  summary.dataset_frames = ReadDatasetInfo(plan.dataset_dirs[preset_index]).frame_count;
+  std::vector<RunMetrics> metrics, draws;
+  std::vector<int64_t> draw_seeds;
+  for (size_t r = 0; r < evaluations.size(); ++r) {
+    RunMetrics m = evaluations[r].metrics;
+    const RunSettings& settings = runs[r]->settings;
+    if (settings.draw_seed >= 0) m.noise_set = -1;
+    if (m.noise_set < 0 && settings.mode != ExtrinsicsMode::kGroundTruth && settings.draw_seed < 0) {
+      m.noise_set = settings.noise_set;
+    }
+    m.label = preset + "/" + m.label;
+    summary.path_length_m = m.path_length_m;
+    if (settings.draw_seed >= 0) {
+      draws.push_back(m);
+      draw_seeds.push_back(settings.draw_seed);
     } else {
-      if (!mismatch.empty()) {
-        std::fprintf(stderr, "rovo suite: run %s was made with other settings (%s), running it again\n",
-                     job.run_dir.c_str(), mismatch.c_str());
-      }
-      todo.push_back(&job);
-    }
-  }
-  const int parallel = std::min<int>(options.jobs, std::max<int>(1, static_cast<int>(todo.size())));
-  const int threads_per_job = options.vo_threads > 0 ? options.vo_threads : std::max(1, cores / parallel);
-  {
-    Progress progress("suite VO runs", static_cast<int64_t>(todo.size()), "runs", options.quiet);
-    std::atomic<size_t> next{0};
-    std::mutex error_mutex;
-    std::exception_ptr first_error;
-    auto worker = [&] {
-      while (true) {
-        const size_t index = next.fetch_add(1);
-        if (index >= todo.size()) return;
-        {
-          std::lock_guard<std::mutex> lock(error_mutex);
-          if (first_error) return;
-        }
-        const VoJob& job = *todo[index];
-        try {
-          VoOptions vo;
-          vo.dataset_dir = job.dataset_dir;
-          vo.out_dir = job.run_dir;
-          vo.mode = job.settings.mode;
-          vo.noise_set = job.settings.noise_set;
-          vo.max_new_features = job.settings.max_new_features;
-          vo.seed = options.vo_seed;
-          vo.threads = threads_per_job;
-          vo.quiet = options.quiet || parallel > 1;
-          vo.frame_end = job.settings.frame_end;
-          RunVo(vo);
-        } catch (...) {
-          std::lock_guard<std::mutex> lock(error_mutex);
-          if (!first_error) first_error = std::current_exception();
-        }
-        progress.Add(1);
-      }
-    };
-    std::vector<std::thread> pool;
-    for (int i = 1; i < parallel; ++i) pool.emplace_back(worker);
-    worker();
-    for (std::thread& t : pool) t.join();
-    progress.Finish();
-    if (first_error) std::rethrow_exception(first_error);
-  }
-
-  // 3. Evaluation per preset, aggregation, table, report.
-  std::vector<PresetSummary> summaries;
-  std::vector<std::string> all_pngs;
-  for (size_t i = 0; i < presets.size(); ++i) {
-    std::vector<std::string> run_dirs;
-    std::vector<int> noise_sets;
-    for (const VoJob& job : jobs) {
-      if (job.preset == presets[i]) {
-        run_dirs.push_back(job.run_dir);
-        noise_sets.push_back(job.settings.mode == ExtrinsicsMode::kGroundTruth ? -1 : job.settings.noise_set);
-      }
-    }
-    EvalReportOptions report;
-    report.plots = options.plots;
-    report.quiet = options.quiet;
-    const std::string report_dir = (fs::path(options.out_dir) / "reports" / presets[i]).string();
-    const std::vector<RunEvaluation> evaluations = EvaluateAndReport(dataset_dirs[i], run_dirs, report_dir, report);
-    PresetSummary summary;
-    summary.preset = presets[i];
-    summary.dataset_dir = fs::absolute(dataset_dirs[i]).lexically_normal().string();
-    summary.frames = frame_ends[i];
-    summary.dataset_frames = dataset_frames[i];
-    std::vector<RunMetrics> metrics;
-    for (size_t r = 0; r < evaluations.size(); ++r) {
-      RunMetrics m = evaluations[r].metrics;
-      if (m.noise_set < 0) m.noise_set = noise_sets[r];
-      m.label = presets[i] + "/" + m.label;
-      summary.path_length_m = m.path_length_m;
       metrics.push_back(m);
     }
-    summary.modes = SummariseModes(metrics);
-    summaries.push_back(std::move(summary));
-    std::error_code ec;
-    const fs::path plots = fs::path(report_dir) / "plots";
-    if (options.plots && fs::is_directory(plots, ec)) {
-      std::vector<std::string> pngs;
-      for (const auto& entry : fs::directory_iterator(plots, ec)) {
-        if (entry.path().extension() == ".png") pngs.push_back(entry.path().string());
-      }
-      std::sort(pngs.begin(), pngs.end());
-      all_pngs.insert(all_pngs.end(), pngs.begin(), pngs.end());
-    }
   }
-  const std::string table = SuiteTableMarkdown(summaries, options.quick);
+  summary.modes = SummariseModes(metrics);
+  if (!draws.empty()) {
+    summary.modes.push_back(SummariseRuns("draws", draws));
+    summary.modes.back().draw_seeds = draw_seeds;
+  }
+  return summary;
+}
+
+// table.md, suite.json and report.html of the merged presets.
+void WriteSuiteOutputs(const SuitePlan& plan, const std::vector<PresetSummary>& summaries) {
+  const SuiteOptions& options = plan.options;
+  std::string table = SuiteTableMarkdown(summaries, options.quick);
+  const std::string draw_table = DrawTableMarkdown(summaries, options.draw_sigma_deg);
+  if (!draw_table.empty()) table += "\n" + draw_table;
   WriteFileAtomic((fs::path(options.out_dir) / "table.md").string(), "# rovo suite (Table I layout)\n\n" + table);
   WriteJsonFileAtomic((fs::path(options.out_dir) / "suite.json").string(), SuiteToJson(summaries, options));
-  if (options.plots) {
-    std::vector<RunMetrics> all_runs;
-    for (const PresetSummary& p : summaries) {
-      for (const ModeSummary& m : p.modes) all_runs.insert(all_runs.end(), m.runs.begin(), m.runs.end());
-    }
-    // Captions name the preset through the report folder (reports/<preset>/plots/<plot>.png).
-    WriteHtmlReport((fs::path(options.out_dir) / "report.html").string(), "rovo suite (Table I layout)",
-                    table + "\n## All runs\n\n" + RunTableMarkdown(all_runs) + "\n" + MetricsLegendMarkdown(),
-                    all_pngs);
+  if (!options.plots) return;
+  std::vector<RunMetrics> all_runs;
+  std::vector<std::string> all_pngs;
+  for (const PresetSummary& p : summaries) {
+    for (const ModeSummary& m : p.modes) all_runs.insert(all_runs.end(), m.runs.begin(), m.runs.end());
+    const std::vector<std::string> pngs = ReportPngs((fs::path(options.out_dir) / "reports" / p.preset).string());
+    all_pngs.insert(all_pngs.end(), pngs.begin(), pngs.end());
   }
+  // Captions name the preset through the report folder (reports/<preset>/plots/<plot>.png).
+  WriteHtmlReport((fs::path(options.out_dir) / "report.html").string(), "rovo suite (Table I layout)",
+                  table + "\n## All runs\n\n" + RunTableMarkdown(all_runs) + "\n" + MetricsLegendMarkdown(), all_pngs);
+}
+
+// Runs `todo` with `parallel` runs at a time; rethrows the first error after the running ones end.
+void RunSuiteRunsInParallel(const SuitePlan& plan, const std::vector<const SuiteRun*>& todo, int parallel,
+                            int threads_per_run) {
+  Progress progress("suite VO runs", static_cast<int64_t>(todo.size()), "runs", plan.options.quiet);
+  std::atomic<size_t> next{0};
+  std::mutex error_mutex;
+  std::exception_ptr first_error;
+  auto worker = [&] {
+    while (true) {
+      const size_t index = next.fetch_add(1);
+      if (index >= todo.size()) return;
+      {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (first_error) return;
+      }
+      try {
+        RunSuiteRun(plan, *todo[index], threads_per_run, plan.options.quiet || parallel > 1);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!first_error) first_error = std::current_exception();
+      }
+      progress.Add(1);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int i = 1; i < parallel; ++i) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  progress.Finish();
+  if (first_error) std::rethrow_exception(first_error);
+}
+
+}  // namespace
+
+SuitePlan PlanSuite(const SuiteOptions& options) {
+  if (options.out_dir.empty()) throw std::invalid_argument("rovo suite: --out is required");
+  if (options.noise_sets < 1) throw std::invalid_argument("rovo suite: --seeds must be >= 1");
+  if (options.draws < 0) throw std::invalid_argument("rovo suite: --draws must be >= 0");
+  if (!(options.draw_sigma_deg >= 0.0)) throw std::invalid_argument("rovo suite: --draw-sigma must be >= 0");
+  if (options.jobs < 1) throw std::invalid_argument("rovo suite: --jobs must be >= 1");
+  if (options.frames < 0) throw std::invalid_argument("rovo suite: --frames must be >= 0");
+  SuitePlan plan;
+  plan.options = options;
+  if (plan.options.presets.empty()) {
+    for (const ScenePreset& p : ScenePresets()) plan.options.presets.push_back(p.name);
+  }
+  plan.data_dir = options.data_dir.empty() ? (fs::path(options.out_dir) / "data").string() : options.data_dir;
+  for (size_t i = 0; i < plan.options.presets.size(); ++i) {
+    const std::string& preset = plan.options.presets[i];
+    const ScenePreset& p = FindScenePreset(preset);  // throws listing the valid names
+    const int trajectory_frames = options.quick ? p.quick_frames : p.frames;
+    const int frame_end = options.frames > 0 ? std::min(options.frames, trajectory_frames) : trajectory_frames;
+    plan.dataset_dirs.push_back(DatasetDirFor(plan.data_dir, preset, options));
+    plan.frame_ends.push_back(frame_end);
+    PlanPresetRuns(options, i, (fs::path(options.out_dir) / "runs" / preset).string(), frame_end, &plan.runs);
+  }
+  return plan;
+}
+
+void RenderSuiteDataset(const SuitePlan& plan, size_t preset_index, int shard, int shards, int threads) {
+  const SuiteOptions& options = plan.options;
+  const std::string& dir = plan.dataset_dirs.at(preset_index);
+  const std::string& preset = options.presets[preset_index];
+  if (DatasetComplete(dir, plan.frame_ends[preset_index])) {
+    if (!options.quiet) std::fprintf(stderr, "rovo suite: dataset %s is complete, not rendering\n", dir.c_str());
+    return;
+  }
+  if (!options.quiet) {
+    std::fprintf(stderr, "rovo suite: rendering %s%s -> %s%s\n", preset.c_str(), options.quick ? " (quick)" : "",
+                 dir.c_str(),
+                 shards > 1 ? (" (shard " + std::to_string(shard) + "/" + std::to_string(shards) + ")").c_str() : "");
+  }
+  EnsureWritableDir(plan.data_dir);
+  RenderOptions render;
+  render.preset = preset;
+  render.quick = options.quick;
+  render.out_dir = dir;
+  render.seed = options.scene_seed;
+  if (options.frames > 0) render.frame_end = plan.frame_ends[preset_index];
+  render.shard_index = shard;
+  render.shard_count = shards;
+  render.threads = threads;
+  render.depth = false;
+  render.quiet = options.quiet;
+  RenderDataset(render);
+}
+
+bool RunSuiteRun(const SuitePlan& plan, const SuiteRun& run, int threads, bool quiet) {
+  std::string mismatch;
+  if (RunReusable(run.run_dir, run.settings, &mismatch)) {
+    if (!plan.options.quiet) std::fprintf(stderr, "rovo suite: run %s is complete, skipping\n", run.run_dir.c_str());
+    return false;
+  }
+  if (!mismatch.empty()) {
+    std::fprintf(stderr, "rovo suite: run %s was made with other settings (%s), running it again\n",
+                 run.run_dir.c_str(), mismatch.c_str());
+  }
+  CheckSuiteDataset(plan, run.preset_index);
+  VoOptions vo;
+  vo.dataset_dir = plan.dataset_dirs[run.preset_index];
+  vo.out_dir = run.run_dir;
+  vo.mode = run.settings.mode;
+  vo.noise_set = run.settings.noise_set;
+  vo.draw_seed = run.settings.draw_seed;
+  vo.draw_sigma_deg = run.settings.draw_sigma_deg;
+  vo.max_new_features = run.settings.max_new_features;
+  vo.seed = run.settings.seed;
+  vo.threads = threads;
+  vo.quiet = quiet;
+  vo.frame_end = run.settings.frame_end;
+  RunVo(vo);
+  return true;
+}
+
+std::vector<PresetSummary> MergeSuite(const SuitePlan& plan) {
+  std::vector<PresetSummary> summaries;
+  for (size_t i = 0; i < plan.options.presets.size(); ++i) summaries.push_back(MergePreset(plan, i));
+  WriteSuiteOutputs(plan, summaries);
   return summaries;
+}
+
+std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
+  const SuitePlan plan = PlanSuite(options);
+  EnsureWritableDir(options.out_dir);
+  EnsureWritableDir(plan.data_dir);
+  const int cores = options.threads > 0 ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  // Datasets: rendering uses all cores, one dataset at a time.
+  for (size_t i = 0; i < plan.dataset_dirs.size(); ++i) {
+    RenderSuiteDataset(plan, i, 0, 1, cores);
+    CheckSuiteDataset(plan, i);
+  }
+  // VO runs, --jobs at a time.
+  std::vector<const SuiteRun*> todo;
+  for (const SuiteRun& run : plan.runs) {
+    std::string mismatch;
+    if (!RunReusable(run.run_dir, run.settings, &mismatch)) todo.push_back(&run);
+  }
+  const int parallel = std::min<int>(options.jobs, std::max<int>(1, static_cast<int>(todo.size())));
+  const int threads_per_run = options.vo_threads > 0 ? options.vo_threads : std::max(1, cores / parallel);
+  RunSuiteRunsInParallel(plan, todo, parallel, threads_per_run);
+  return MergeSuite(plan);
 }
 
 }  // namespace rovo

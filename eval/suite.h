@@ -1,10 +1,17 @@
 #pragma once
 // The paper's comparison suites (Table I): for each preset, render the dataset if missing, run VO
 // with ground-truth extrinsics (GTExt) once and with each of K perturbed extrinsic sets held fixed
-// (NoisyExt) and calibrated online (OnlineExt), evaluate, aggregate mean +- std over the noise sets.
+// (NoisyExt) and calibrated online (OnlineExt), evaluate, aggregate mean +- std over the noise sets;
+// optionally D more OnlineExt runs per preset from fresh perturbation draws (--draws), reported as
+// mean +- std and a convergence rate.
+//
+// The suite is a plan of tasks (PlanSuite): per preset one dataset to render (in shards), then VO runs,
+// then one merge. `rovo suite` runs them in one process (RunSuite); `rovo batch` (eval/batch.h) runs the
+// same tasks as Slurm jobs. Both call RenderSuiteDataset, RunSuiteRun and MergeSuite, so their outputs
+// agree byte for byte apart from timing fields.
 //
 // Layout of --out:
-//   <out>/runs/<preset>/{gt, noisy_<k>, online_<k>}/   run folders (datasets/run.h)
+//   <out>/runs/<preset>/{gt, noisy_<k>, online_<k>, draw_<d>}/   run folders (datasets/run.h)
 //   <out>/reports/<preset>/                            `rovo eval` report of all runs of the preset
 //   <out>/suite.json                                   aggregated metrics per preset and mode
 //   <out>/table.md, <out>/report.html                  Table I layout with the paper's figures
@@ -29,6 +36,8 @@ struct SuiteOptions {
   bool quick = false;                // the presets' quick forms
   int frames = 0;                    // > 0: only the first N frames of each preset (rendered and run)
   int noise_sets = 1;                // K: NoisyExt/OnlineExt runs per preset (noise_set 0..K-1)
+  int draws = 0;                     // D: OnlineExt runs per preset from fresh draws (SuiteDrawSeed)
+  double draw_sigma_deg = 5.0;       // sigma of those draws (roll, pitch, yaw of every camera)
   int jobs = 1;                      // VO runs in parallel; each gets cores / jobs threads
   int threads = 0;                   // cores to use; 0 = all
   int vo_threads = 0;                // threads of each VO run; 0 = cores / jobs. 1 makes OnlineExt
@@ -43,11 +52,13 @@ struct SuiteOptions {
   bool quiet = false;
 };
 
-// What a suite run must have been made with to be reused: its frames, mode, noise set, RANSAC seed
-// and front-end detection limit, as recorded in its run.json.
+// What a suite run must have been made with to be reused: its frames, mode, noise set or draw seed,
+// RANSAC seed and front-end detection limit, as recorded in its run.json.
 struct RunSettings {
   ExtrinsicsMode mode = ExtrinsicsMode::kGroundTruth;
   int noise_set = 0;
+  int64_t draw_seed = -1;  // >= 0: started from PerturbExtrinsics(gt rig, draw_sigma_deg, 0, draw_seed)
+  double draw_sigma_deg = 5.0;
   int frame_end = 0;  // the run covers frames [0, frame_end)
   uint64_t seed = 0;
   int max_new_features = 0;
@@ -68,11 +79,29 @@ Stat ComputeStat(const std::vector<double>& values);
 
 // Aggregated metrics of one mode of one preset. Metric names as in MetricsToJson.
 struct ModeSummary {
-  std::string mode;  // gt | noisy | online
+  std::string mode;  // gt | noisy | online | draws (OnlineExt runs from fresh perturbation draws)
   std::vector<RunMetrics> runs;
   std::vector<std::pair<std::string, Stat>> stats;  // name -> stat, names in kAggregatedMetrics order
+  std::vector<int64_t> draw_seeds;                  // draws: the seed of each run, in runs order
   std::optional<Stat> Find(const std::string& name) const;
 };
+
+// A draw has converged when its final extrinsic error (largest over cameras i >= 1 of the rotation
+// angle of est(cam_i_from_cam0) * true(cam_i_from_cam0)^-1, RunMetrics::max_final_ext_rotation_deg)
+// is below this; a run without extrinsics has not.
+inline constexpr double kDrawConvergedBelowDeg = 0.1;
+struct DrawConvergence {
+  int converged = 0;
+  int draws = 0;
+  std::vector<int64_t> failed_seeds;  // seeds of the draws that did not converge
+};
+DrawConvergence ComputeDrawConvergence(const ModeSummary& draws);
+
+// Seed of perturbation draw `draw` (0-based) of a suite: derived from the scene and VO seeds and the
+// draw index, in [0, 2^63), and never equal to the seed of a noise set stored in dataset.json.
+int64_t SuiteDrawSeed(uint64_t scene_seed, uint64_t vo_seed, int draw);
+// The seed render/ uses for stored noise set k of a dataset rendered with `scene_seed`.
+uint64_t StoredNoiseSetSeed(uint64_t scene_seed, int k);
 
 struct PresetSummary {
   std::string preset;
@@ -91,6 +120,8 @@ std::optional<double> MetricValue(const RunMetrics& metrics, const std::string& 
 
 // Groups per-run metrics by mode and aggregates them.
 std::vector<ModeSummary> SummariseModes(const std::vector<RunMetrics>& runs);
+// Aggregates the given runs as one mode.
+ModeSummary SummariseRuns(const std::string& mode, const std::vector<RunMetrics>& runs);
 
 // The paper's Table I row for a preset, if it has one (path length in metres, RMSEs in metres,
 // inlier ratios in %, reprojection errors in degrees).
@@ -105,8 +136,47 @@ std::optional<PaperRow> PaperRowForPreset(const std::string& preset);
 // reprojection error Online/GT beside the paper's, final extrinsic error of OnlineExt.
 std::string SuiteTableMarkdown(const std::vector<PresetSummary>& presets, bool quick);
 
+// Per preset with draws: RMSE, final extrinsic error (mean +- std) and the convergence rate; "" when
+// no preset has draws.
+std::string DrawTableMarkdown(const std::vector<PresetSummary>& presets, double draw_sigma_deg);
+
 nlohmann::json SuiteToJson(const std::vector<PresetSummary>& presets, const SuiteOptions& options);
 
+// The suite's arguments as JSON and back (the batch folder's plan.json); FromJson names `source` and
+// the field on bad input.
+nlohmann::json SuiteOptionsToJson(const SuiteOptions& options);
+SuiteOptions SuiteOptionsFromJson(const nlohmann::json& j, const std::string& source);
+
+// One VO run of a suite.
+struct SuiteRun {
+  size_t preset_index = 0;
+  std::string name;  // gt | noisy_<k> | online_<k> | draw_<d>: the run folder's name
+  std::string run_dir;
+  RunSettings settings;
+};
+
+// Everything a suite does, decided from its options alone (no file is read).
+struct SuitePlan {
+  SuiteOptions options;                   // presets filled in (all when none were named)
+  std::string data_dir;                   // options.data_dir or <out>/data
+  std::vector<std::string> dataset_dirs;  // per preset
+  std::vector<int> frame_ends;            // per preset: runs cover frames [0, end)
+  std::vector<SuiteRun> runs;             // per preset: gt, noisy_k / online_k, draw_d
+};
+// Validates the options (throws std::invalid_argument naming the option).
+SuitePlan PlanSuite(const SuiteOptions& options);
+
+// Renders shard `shard` of `shards` of preset `preset_index`'s dataset with `threads` threads
+// (render/render.h: chunks of 8 frames); a complete dataset is not touched. Resumable.
+void RenderSuiteDataset(const SuitePlan& plan, size_t preset_index, int shard, int shards, int threads);
+// Runs one VO run with `threads` threads unless a reusable one exists (RunReusable); returns whether it
+// ran. `quiet` silences the run's progress.
+bool RunSuiteRun(const SuitePlan& plan, const SuiteRun& run, int threads, bool quiet);
+// Evaluates every run of the plan, writes reports/, suite.json, table.md and report.html.
+std::vector<PresetSummary> MergeSuite(const SuitePlan& plan);
+
+// The whole suite in this process: PlanSuite, RenderSuiteDataset, RunSuiteRun (--jobs at a time),
+// MergeSuite.
 std::vector<PresetSummary> RunSuite(const SuiteOptions& options);
 
 }  // namespace rovo
