@@ -16,8 +16,8 @@ std::string FindTrajectoryFile(const std::string& dir) {
     const std::string name = entry.path().filename().string();
     if (!entry.is_regular_file()) continue;
     if (name == "trajectory.tum" || name == "trajectory.txt" || name == "trajectory.csv" ||
-        name == "stamped_traj_estimate.txt" || name == "poses.txt" || name == "data.csv" ||
-        (name.rfind("f_", 0) == 0 && entry.path().extension() == ".txt")) {
+        name == "trajectory_kitti.txt" || name == "stamped_traj_estimate.txt" || name == "poses.txt" ||
+        name == "data.csv" || (name.rfind("f_", 0) == 0 && entry.path().extension() == ".txt")) {
       found.push_back(entry.path().string());
     }
   }

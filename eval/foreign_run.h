@@ -13,7 +13,7 @@ namespace rovo {
 
 // `format`: auto | tum | euroc | kitti. auto: a folder with run.json is a rovo run; otherwise the
 // trajectory file (the path itself, or in a folder the one file named trajectory.tum / .txt / .csv,
-// stamped_traj_estimate.txt, f_*.txt, poses.txt or data.csv) by its extension and first data line
+// trajectory_kitti.txt, stamped_traj_estimate.txt, f_*.txt, poses.txt or data.csv) by its extension and first data line
 // (commas: EuRoC; 12 numbers: KITTI; 8 numbers: TUM). Estimate timestamps that do not overlap the
 // ground truth's span at all (another start time) are shifted so that the first estimate falls on
 // the first ground-truth time; `note` (optional) says what was read and done.

@@ -1,13 +1,13 @@
 // Other systems' trajectories as runs: format detection, KITTI by line, start-time shift.
-#include "datasets/io.h"
 #include "eval/foreign_run.h"
-#include "eval/metrics.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 
-#include <unistd.h>
+#include "datasets/io.h"
+#include "eval/metrics.h"
 
 namespace rovo {
 namespace {
