@@ -75,6 +75,7 @@ ExchangeCamera ReadEurocSensorYaml(const std::string& path, const std::string& n
   }
   ExchangeCamera camera;
   camera.name = name;
+  if (!root.IsMap() || !root["T_BS"] || !root["T_BS"].IsMap()) throw std::runtime_error(path + ": T_BS: missing");
   const std::vector<double> data = ReadNumbers(root["T_BS"]["data"], path, "T_BS/data");
   if (data.size() != 16) throw std::runtime_error(path + ": T_BS/data: expected 16 numbers");
   Eigen::Matrix4d body_from_sensor;
@@ -88,14 +89,19 @@ ExchangeCamera ReadEurocSensorYaml(const std::string& path, const std::string& n
   camera.height = static_cast<int>(resolution[1]);
   KalibrLensFields lens;
   if (!root["camera_model"]) throw std::runtime_error(path + ": camera_model: missing");
-  lens.camera_model = root["camera_model"].as<std::string>();
+  try {
+    lens.camera_model = root["camera_model"].as<std::string>();
+    if (root["distortion_model"]) lens.distortion_model = root["distortion_model"].as<std::string>();
+    if (root["max_fov_deg"]) camera.max_fov_deg = root["max_fov_deg"].as<double>();
+  } catch (const YAML::Exception&) {
+    throw std::runtime_error(path + ": camera_model, distortion_model or max_fov_deg: wrong type");
+  }
   lens.intrinsics = ReadNumbers(root["intrinsics"], path, "intrinsics");
-  lens.distortion_model = root["distortion_model"] ? root["distortion_model"].as<std::string>() : "none";
+  if (!root["distortion_model"]) lens.distortion_model = "none";
   if (root["distortion_coefficients"]) {
     lens.distortion_coeffs = ReadNumbers(root["distortion_coefficients"], path, "distortion_coefficients");
   }
   FromKalibrFields(lens, path, &camera.model, &camera.params);
-  if (root["max_fov_deg"]) camera.max_fov_deg = root["max_fov_deg"].as<double>();
   return camera;
 }
 

@@ -113,8 +113,12 @@ std::vector<ExchangeCamera> ReadKalibrCamchain(const std::string& path) {
     ExchangeCamera camera;
     camera.name = key;
     KalibrLensFields lens;
-    if (!node["camera_model"]) throw std::runtime_error(what + "/camera_model: missing");
-    lens.camera_model = node["camera_model"].as<std::string>();
+    if (!node.IsMap() || !node["camera_model"]) throw std::runtime_error(what + "/camera_model: missing");
+    try {
+      lens.camera_model = node["camera_model"].as<std::string>();
+    } catch (const YAML::Exception&) {
+      throw std::runtime_error(what + "/camera_model: not a string");
+    }
     lens.intrinsics = Numbers(node["intrinsics"], what + "/intrinsics");
     lens.distortion_model = node["distortion_model"] ? node["distortion_model"].as<std::string>() : "none";
     if (node["distortion_coeffs"])
