@@ -3,7 +3,6 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -93,13 +92,16 @@ PerturbedExtrinsics PerturbationInfo(const std::string& path, ExchangeFormat for
     }
     return set;
   }
-  std::smatch m;
+  // "... sigma_rotation_deg S sigma_translation_m T seed N" (the header KalibrCamchainYaml gets).
   const std::string text = ReadFile(path);
-  static const std::regex header("sigma_rotation_deg (\\S+) sigma_translation_m (\\S+) seed (\\d+)");
-  if (std::regex_search(text, m, header)) {
-    set.sigma_rotation_deg = std::stod(m[1]);
-    set.sigma_translation_m = std::stod(m[2]);
-    set.seed = std::stoull(m[3]);
+  const size_t at = text.find("sigma_rotation_deg ");
+  if (at != std::string::npos) {
+    std::istringstream in(text.substr(at, text.find('\n', at) - at));
+    std::string key_rotation, key_translation, key_seed;
+    in >> key_rotation >> set.sigma_rotation_deg >> key_translation >> set.sigma_translation_m >> key_seed >> set.seed;
+    if (!in || key_translation != "sigma_translation_m" || key_seed != "seed") {
+      throw std::runtime_error(path + ": header: expected `sigma_rotation_deg S sigma_translation_m T seed N`");
+    }
   }
   return set;
 }
