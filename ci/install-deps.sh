@@ -11,7 +11,7 @@ PACKAGES=(
   libeigen3-dev libceres-dev libopengv-dev
   nlohmann-json3-dev libyaml-cpp-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3 python3-matplotlib python3-numpy
+  python3 python3-matplotlib python3-numpy python3-yaml
   blender
   chromium
   slurm-wlm munge

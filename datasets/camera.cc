@@ -131,6 +131,21 @@ void CheckDoubleSphere(const Camera& camera, const std::string& what) {
   }
 }
 
+void CheckExtendedUnified(const Camera& camera, const std::string& what) {
+  const double* p = camera.params.data();
+  if (!(p[0] > 0)) Fail(what, "params[0] (fx)", "must be positive, got " + Fmt(p[0]));
+  if (!(p[1] > 0)) Fail(what, "params[1] (fy)", "must be positive, got " + Fmt(p[1]));
+  if (!(p[4] >= 0 && p[4] <= 1)) Fail(what, "params[4] (alpha)", "must be in [0, 1], got " + Fmt(p[4]));
+  if (!(p[5] > 0)) Fail(what, "params[5] (beta)", "must be positive, got " + Fmt(p[5]));
+  // The FOV edge direction (sin a, 0, cos a) must satisfy cos a > -w sqrt(beta sin^2 a + cos^2 a).
+  const double half_fov = 0.5 * camera.max_fov_deg * kDegToRad;
+  const double s = std::sin(half_fov), c = std::cos(half_fov);
+  if (!(c > -ExtendedUnifiedModel::ValidW(p) * std::sqrt(p[5] * s * s + c * c))) {
+    Fail(what, "max_fov_deg",
+         Fmt(camera.max_fov_deg) + " deg exceeds the valid set of these extended-unified parameters");
+  }
+}
+
 void CheckOcam(const Camera& camera, const std::string& what) {
   const double* p = camera.params.data();
   if (!(p[2] > 0)) Fail(what, "params[2] (c)", "must be positive, got " + Fmt(p[2]));
@@ -155,7 +170,8 @@ CameraModelId CameraModelFromName(const std::string& name) {
   if (name == model_name) return CameraModelId::enum_id;
   ROVO_CAMERA_MODELS(ROVO_CAMERA_FROM_NAME)
 #undef ROVO_CAMERA_FROM_NAME
-  throw std::invalid_argument("unknown camera model \"" + name + "\" (known: equidistant, double_sphere, ocam)");
+  throw std::invalid_argument("unknown camera model \"" + name +
+                              "\" (known: equidistant, double_sphere, ocam, extended_unified)");
 }
 
 std::string CameraModelName(CameraModelId id) {
@@ -240,6 +256,7 @@ void Camera::Check(const std::string& what) const {
     if constexpr (std::is_same_v<Model, EquidistantModel>) CheckEquidistant(*this, what);
     if constexpr (std::is_same_v<Model, DoubleSphereModel>) CheckDoubleSphere(*this, what);
     if constexpr (std::is_same_v<Model, OcamModel>) CheckOcam(*this, what);
+    if constexpr (std::is_same_v<Model, ExtendedUnifiedModel>) CheckExtendedUnified(*this, what);
     return 0;
   });
 }

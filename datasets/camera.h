@@ -10,9 +10,9 @@
 
 namespace rovo {
 
-enum class CameraModelId { kEquidistant = 0, kDoubleSphere = 1, kOcam = 2 };
+enum class CameraModelId { kEquidistant = 0, kDoubleSphere = 1, kOcam = 2, kExtendedUnified = 3 };
 
-// "equidistant", "double_sphere", "ocam". Throws std::invalid_argument for an unknown name.
+// "equidistant", "double_sphere", "ocam", "extended_unified". Throws std::invalid_argument for an unknown name.
 CameraModelId CameraModelFromName(const std::string& name);
 std::string CameraModelName(CameraModelId id);
 

@@ -23,6 +23,8 @@ Camera MakeCamera(CameraModelId model) {
     }
     case CameraModelId::kDoubleSphere:
       return Camera{model, 1600, 1532, {350.0, 351.0, 799.5, 765.5, -0.2, 0.6}, 220.0};
+    case CameraModelId::kExtendedUnified:
+      return Camera{model, 1600, 1532, {420.0, 421.0, 799.5, 765.5, 0.62, 1.1}, 220.0};
     case CameraModelId::kOcam:
       return MakeOcamCamera(1600, 1532, 811.661, 756.215, 0.999876, -2.91382e-4, -1.66556e-4,
                             {-392.2, 0.0, 0.00127, -1.746e-6, 2.258e-9}, 220.0);
@@ -84,9 +86,9 @@ void BM_Unproject(benchmark::State& state) {
   state.SetLabel(CameraModelName(camera.model));
 }
 
-BENCHMARK(BM_Project)->DenseRange(0, 2);
-BENCHMARK(BM_ProjectWithJacobian)->DenseRange(0, 2);
-BENCHMARK(BM_Unproject)->DenseRange(0, 2);
+BENCHMARK(BM_Project)->DenseRange(0, 3);
+BENCHMARK(BM_ProjectWithJacobian)->DenseRange(0, 3);
+BENCHMARK(BM_Unproject)->DenseRange(0, 3);
 
 }  // namespace
 }  // namespace rovo

@@ -21,10 +21,11 @@
 namespace rovo {
 
 // The X-macro list of models: (enum id, struct, name on disk).
-#define ROVO_CAMERA_MODELS(X)                    \
-  X(kEquidistant, EquidistantModel, "equidistant") \
+#define ROVO_CAMERA_MODELS(X)                          \
+  X(kEquidistant, EquidistantModel, "equidistant")     \
   X(kDoubleSphere, DoubleSphereModel, "double_sphere") \
-  X(kOcam, OcamModel, "ocam")
+  X(kOcam, OcamModel, "ocam")                          \
+  X(kExtendedUnified, ExtendedUnifiedModel, "extended_unified")
 
 namespace camera_internal {
 using std::abs;
@@ -172,6 +173,70 @@ struct DoubleSphereModel {
     bearing_in_cam[1] = k * my;
     bearing_in_cam[2] = k * mz - xi;
     return bearing_in_cam[2] > -ValidW2(params);
+  }
+};
+
+// Extended unified camera model (Khomutenko, Garcia, Martinet: "An Enhanced Unified Camera Model",
+// RA-L 2016), as in Kalibr's `eucm` and Basalt's `eucm`.
+//   params = [fx, fy, cx, cy, alpha, beta]
+//   d = sqrt(beta (x^2 + y^2) + z^2),  s = alpha d + (1 - alpha) z
+//   u = fx x / s + cx,  v = fy y / s + cy
+// Valid set of the projection: z > -w d, w = alpha / (1 - alpha) if alpha <= 0.5 else
+// (1 - alpha) / alpha (for alpha > 0.5 and beta = 1: angles from the axis below acos(-w)).
+// Unprojection (closed form):
+//   mx = (u - cx) / fx, my = (v - cy) / fy, r2 = mx^2 + my^2, valid if alpha <= 0.5 or
+//   r2 <= 1 / (beta (2 alpha - 1));
+//   mz = (1 - beta alpha^2 r2) / (alpha sqrt(1 - (2 alpha - 1) beta r2) + 1 - alpha)
+//   bearing = (mx, my, mz) / |(mx, my, mz)|
+// CamFromImg also rejects bearings outside the valid set above (so it inverts ImgFromCam exactly).
+// Parameter ranges: fx, fy > 0, alpha in [0, 1], beta > 0.
+struct ExtendedUnifiedModel {
+  static constexpr int kNumParams = 6;
+  static constexpr const char* kParamNames = "fx, fy, cx, cy, alpha, beta";
+
+  // w of the valid set z > -w d.
+  template <typename T>
+  static T ValidW(const T* params) {
+    const T& alpha = params[4];
+    return alpha <= T(0.5) ? T(alpha / (T(1) - alpha)) : T((T(1) - alpha) / alpha);
+  }
+
+  template <typename T>
+  static bool ImgFromCam(const T* params, int num_params, const T* point_in_cam, T* uv) {
+    using namespace camera_internal;
+    const T& x = point_in_cam[0];
+    const T& y = point_in_cam[1];
+    const T& z = point_in_cam[2];
+    const T& alpha = params[4];
+    const T& beta = params[5];
+    const T d2 = beta * (x * x + y * y) + z * z;
+    if (!(d2 > T(0))) return false;
+    const T d = sqrt(d2);
+    if (!(z > -ValidW(params) * d)) return false;
+    const T s = alpha * d + (T(1) - alpha) * z;
+    if (!(s > T(0))) return false;
+    uv[0] = params[0] * x / s + params[2];
+    uv[1] = params[1] * y / s + params[3];
+    return true;
+  }
+
+  template <typename T>
+  static bool CamFromImg(const T* params, int num_params, const T* uv, T* bearing_in_cam) {
+    using namespace camera_internal;
+    const T& alpha = params[4];
+    const T& beta = params[5];
+    const T mx = (uv[0] - params[2]) / params[0];
+    const T my = (uv[1] - params[3]) / params[1];
+    const T r2 = mx * mx + my * my;
+    const T root_arg = T(1) - (T(2) * alpha - T(1)) * beta * r2;
+    if (!(root_arg >= T(0))) return false;  // outside the image disc of alpha > 0.5
+    const T mz = (T(1) - beta * alpha * alpha * r2) / (alpha * sqrt(root_arg) + T(1) - alpha);
+    const T norm = sqrt(r2 + mz * mz);
+    bearing_in_cam[0] = mx / norm;
+    bearing_in_cam[1] = my / norm;
+    bearing_in_cam[2] = mz / norm;
+    const T d = sqrt(beta * r2 + mz * mz) / norm;
+    return bearing_in_cam[2] > -ValidW(params) * d;
   }
 };
 

@@ -1,6 +1,7 @@
-// `rovo dataset ...` subcommands: validate, info, rig, import-omnimvs.
+// `rovo dataset ...` subcommands: validate, info, rig, import-omnimvs (export, import, lens-fit: exchange_cli.cc).
 #include "datasets/cli_groups.h"
 #include "datasets/dataset.h"
+#include "datasets/exchange.h"
 #include "datasets/omnimvs.h"
 
 #include <CLI/CLI.hpp>
@@ -151,6 +152,8 @@ void AddDatasetCommands(CliGroups& groups) {
     WriteRigJson(import_options->out, imported, "omnimvs " + import_options->yaml);
     std::printf("wrote %s (%d cameras)\n", import_options->out.c_str(), imported.NumCameras());
   });
+
+  AddExchangeCommands(dataset);
 }
 
 

@@ -305,7 +305,8 @@ Rig ParseRig(JsonChecker& check, const json& rig_json, const std::string& pointe
         rc.camera.model = CameraModelFromName(model);
         model_ok = true;
       } catch (const std::exception&) {
-        check.Issue(p + "/model", "unknown camera model `" + model + "` (known: equidistant, double_sphere, ocam)");
+        check.Issue(p + "/model",
+                    "unknown camera model `" + model + "` (known: equidistant, double_sphere, ocam, extended_unified)");
       }
     }
     rc.camera.width = static_cast<int>(check.Integer(cj, p, "width", 0, 1, 1 << 16));

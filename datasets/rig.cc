@@ -25,6 +25,7 @@ Camera ScaledCamera(const Camera& camera, double scale) {
   switch (camera.model) {
     case CameraModelId::kEquidistant:  // fx fy cx cy k1..k4
     case CameraModelId::kDoubleSphere:  // fx fy cx cy xi alpha
+    case CameraModelId::kExtendedUnified:  // fx fy cx cy alpha beta
       if (p.size() < 4) throw std::invalid_argument("Rig::Scaled: camera has too few parameters");
       p[0] *= scale;
       p[1] *= scale;

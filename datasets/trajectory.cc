@@ -157,4 +157,96 @@ double PathLength(const Trajectory& trajectory) {
   return length;
 }
 
+Trajectory ReadTumAnyUnit(const std::string& path, bool* nanoseconds) {
+  Trajectory trajectory = ReadTum(path);
+  std::vector<double> dt;
+  bool huge = false;
+  for (size_t i = 0; i < trajectory.size(); ++i) {
+    if (i > 0) dt.push_back(trajectory[i].timestamp - trajectory[i - 1].timestamp);
+    huge = huge || trajectory[i].timestamp > 1e12;
+  }
+  double median = 0.0;
+  if (!dt.empty()) {
+    std::nth_element(dt.begin(), dt.begin() + static_cast<long>(dt.size() / 2), dt.end());
+    median = dt[dt.size() / 2];
+  }
+  const bool ns = huge || median > 1000.0;
+  if (ns) {
+    for (StampedPose& pose : trajectory) pose.timestamp *= 1e-9;
+  }
+  if (nanoseconds) *nanoseconds = ns;
+  return trajectory;
+}
+
+namespace {
+
+// Numbers of a data line split at commas or white space; false on a non-number.
+bool SplitNumbers(const std::string& line, std::vector<double>* values) {
+  values->clear();
+  const char* p = line.c_str();
+  while (*p) {
+    while (*p == ' ' || *p == '\t' || *p == ',') ++p;
+    if (!*p) break;
+    char* end = nullptr;
+    const double v = std::strtod(p, &end);
+    if (end == p || !std::isfinite(v)) return false;
+    values->push_back(v);
+    p = end;
+  }
+  return true;
+}
+
+template <typename F>
+void ForEachDataLine(const std::string& path, F&& f) {
+  std::istringstream in(ReadFile(path));
+  std::string raw;
+  int line_number = 0;
+  std::vector<double> values;
+  while (std::getline(in, raw)) {
+    ++line_number;
+    const std::string line = Trim(raw);
+    if (line.empty() || line[0] == '#') continue;
+    if (!SplitNumbers(line, &values)) {
+      throw std::runtime_error(path + ": line " + std::to_string(line_number) + ": not a number in `" + line + "`");
+    }
+    f(line_number, values);
+  }
+}
+
+}  // namespace
+
+Trajectory ReadEurocCsv(const std::string& path) {
+  Trajectory trajectory;
+  ForEachDataLine(path, [&](int line_number, const std::vector<double>& v) {
+    const std::string where = path + ": line " + std::to_string(line_number) + ": ";
+    if (v.size() < 8) throw std::runtime_error(where + "expected timestamp [ns], p x y z, q w x y z");
+    const Eigen::Quaterniond q(v[4], v[5], v[6], v[7]);
+    if (std::abs(q.norm() - 1.0) > 1e-3) throw std::runtime_error(where + "quaternion norm is not 1");
+    const double t = v[0] * 1e-9;
+    if (!trajectory.empty() && !(t > trajectory.back().timestamp)) {
+      throw std::runtime_error(where + "timestamps not increasing");
+    }
+    trajectory.push_back({t, Rigid3(q, Eigen::Vector3d(v[1], v[2], v[3]))});
+  });
+  return trajectory;
+}
+
+Trajectory ReadKittiPoses(const std::string& path, const std::vector<double>& timestamps) {
+  Trajectory trajectory;
+  ForEachDataLine(path, [&](int line_number, const std::vector<double>& v) {
+    const std::string where = path + ": line " + std::to_string(line_number) + ": ";
+    if (v.size() != 12) throw std::runtime_error(where + "expected 12 numbers (row-major 3x4 pose)");
+    if (trajectory.size() >= timestamps.size()) {
+      throw std::runtime_error(where + "more poses than ground-truth frames (KITTI poses are matched by line)");
+    }
+    Eigen::Matrix3d rotation;
+    rotation << v[0], v[1], v[2], v[4], v[5], v[6], v[8], v[9], v[10];
+    if ((rotation * rotation.transpose() - Eigen::Matrix3d::Identity()).norm() > 1e-3) {
+      throw std::runtime_error(where + "the 3x3 block is not a rotation");
+    }
+    trajectory.push_back({timestamps[trajectory.size()], Rigid3(rotation, Eigen::Vector3d(v[3], v[7], v[11]))});
+  });
+  return trajectory;
+}
+
 }  // namespace rovo

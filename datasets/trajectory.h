@@ -24,6 +24,18 @@ void WriteTum(const std::string& path, const Trajectory& trajectory);
 // KITTI format: 12 numbers per line, row-major 3x4 world_from_rig.
 void WriteKitti(const std::string& path, const Trajectory& trajectory);
 
+// Trajectories written by other systems (timestamps converted to seconds):
+// TUM whose timestamps may be nanoseconds: taken as ns when the median interval exceeds 1000 or a
+// timestamp exceeds 1e12 (no sequence is sampled once in 17 minutes or lasts 30000 years);
+// `nanoseconds` (optional) says which.
+Trajectory ReadTumAnyUnit(const std::string& path, bool* nanoseconds = nullptr);
+// EuRoC csv (`#timestamp [ns], p x, p y, p z, q w, q x, q y, q z[, more columns]`, commas, the
+// state_groundtruth_estimate0/data.csv layout), holding world_from_body.
+Trajectory ReadEurocCsv(const std::string& path);
+// KITTI poses (12 numbers per line, row-major 3x4 world_from_rig), which carry no time: line i is
+// given timestamps[i]; more lines than timestamps throws.
+Trajectory ReadKittiPoses(const std::string& path, const std::vector<double>& timestamps);
+
 // One data line of a TUM file before any interpretation (for validators that report every fault).
 struct TumLine {
   int line_number = 0;  // 1-based line in the file

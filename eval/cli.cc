@@ -25,6 +25,7 @@ struct EvalArgs {
   bool kitti = false;
   bool no_plots = false;
   double tolerance_s = 0.0;
+  std::string format = "auto";
 };
 
 void AddEvalCommand(CLI::App& root) {
@@ -36,8 +37,15 @@ void AddEvalCommand(CLI::App& root) {
       "each camera relative to camera 0, time per frame. Writes metrics.json, summary.csv, table.md, per-run "
       "CSVs, plots and report.html to --out.");
   cmd->add_option("dataset", args->dataset, "Dataset folder (dataset.json, groundtruth.tum)")->required();
-  cmd->add_option("runs", args->runs, "One or more run folders (trajectory.tum, frames.csv, extrinsics.csv, run.json)")
+  cmd->add_option("runs", args->runs,
+                  "One or more run folders (trajectory.tum, frames.csv, extrinsics.csv, run.json), or other systems' "
+                  "trajectory files / folders holding one (TUM in s or ns, EuRoC csv, KITTI poses; see --format)")
       ->required();
+  cmd->add_option("--format", args->format,
+                  "Trajectory format of runs without run.json: auto | tum | euroc | kitti (KITTI poses are matched to "
+                  "ground-truth frames by line)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "tum", "euroc", "kitti"}));
   cmd->add_option("--out", args->out, "Report folder to write")->required();
   cmd->add_flag("--kitti", args->kitti, "Also write aligned estimate and ground truth in KITTI format per run");
   cmd->add_flag("--no-plots", args->no_plots, "Skip the matplotlib plots (report.html without figures)");
@@ -49,6 +57,7 @@ void AddEvalCommand(CLI::App& root) {
     options.kitti = args->kitti;
     options.plots = !args->no_plots;
     options.eval.time_tolerance_s = args->tolerance_s;
+    options.trajectory_format = args->format;
     const std::vector<RunEvaluation> evaluations = EvaluateAndReport(args->dataset, args->runs, args->out, options);
     std::vector<RunMetrics> metrics;
     for (const RunEvaluation& e : evaluations) metrics.push_back(e.metrics);

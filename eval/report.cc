@@ -1,8 +1,10 @@
 #include "eval/report.h"
+
 #include "eval/format.h"
 
 #include "datasets/dataset.h"
 #include "datasets/io.h"
+#include "eval/foreign_run.h"
 #include "eval/plots.h"
 #include "rovo/version.h"
 
@@ -124,7 +126,9 @@ std::string MetricsLegendMarkdown() {
          "**inliers** = mean inlier ratio of the multi-view P3P RANSAC over frames with status ok [%]; "
          "**reproj** = mean angular reprojection error of inliers after refinement over frames with status ok "
          "[deg]; **ext rot / ext trans** = largest error over cameras i >= 1 of cam_i_from_cam0 at the last frame "
-         "[deg / m]; **ms/frame** = mean wall time per frame. Frames = associated / ground-truth frames.\n";
+         "[deg / m]; **ms/frame** = mean wall time per frame. Frames = associated / ground-truth frames. Mode "
+         "external: a trajectory written by another system, without frames.csv/run.json/extrinsics.csv, so "
+         "inliers, reproj, ext rot, ext trans and ms/frame are n/a.\n";
 }
 
 std::string RunTableMarkdown(const std::vector<RunMetrics>& runs) {
@@ -137,9 +141,12 @@ std::string RunTableMarkdown(const std::vector<RunMetrics>& runs) {
           std::to_string(m.associated_frames) + "/" + std::to_string(m.gt_frames) + " | " +
           FmtOpt("%.4f", m.rmse_se3_m) + " | " + FmtOpt("%.4f", m.relative_rmse_pct) + " | " +
           FmtOpt("%.4f", m.rmse_origin_m) + " | " + Fmt("%.3f", m.drift.translation_pct) + " | " +
-          Fmt("%.3f", m.drift.rotation_deg_per_100m) + " | " + Fmt("%.1f", 100.0 * m.mean_inlier_ratio) + " | " +
-          Fmt("%.3f", m.mean_reproj_error_deg) + " | " + Fmt("%.3f", m.max_final_ext_rotation_deg) + " | " +
-          Fmt("%.4f", m.max_final_ext_translation_m) + " | " + Fmt("%.1f", m.mean_time_ms) + " |\n";
+          Fmt("%.3f", m.drift.rotation_deg_per_100m) + " | " +
+          (m.mode == "external"  // no frames.csv / extrinsics.csv
+               ? std::string("n/a | n/a | n/a | n/a | n/a |\n")
+               : Fmt("%.1f", 100.0 * m.mean_inlier_ratio) + " | " + Fmt("%.3f", m.mean_reproj_error_deg) + " | " +
+                     Fmt("%.3f", m.max_final_ext_rotation_deg) + " | " + Fmt("%.4f", m.max_final_ext_translation_m) +
+                     " | " + Fmt("%.1f", m.mean_time_ms) + " |\n");
   }
   return md;
 }
@@ -167,7 +174,9 @@ std::vector<RunEvaluation> EvaluateAndReport(const std::string& dataset_dir, con
            "drift_translation_pct", "drift_rotation_deg_per_100m", "mean_inlier_ratio", "mean_reproj_error_deg",
            "max_final_ext_rotation_deg", "max_final_ext_translation_m", "mean_time_ms"});
   for (const std::string& run_dir : run_dirs) {
-    const RunData run = ReadRun(run_dir);
+    std::string note;
+    const RunData run = ReadRunOrTrajectory(run_dir, gt, options.trajectory_format, &note);
+    if (!note.empty() && !options.quiet) std::printf("%s\n", note.c_str());
     std::string label = fs::path(run_dir).lexically_normal().filename().string();
     if (label.empty() || label == ".") label = fs::path(run_dir).lexically_normal().parent_path().filename().string();
     if (label.empty()) label = "run";

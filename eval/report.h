@@ -26,6 +26,7 @@ struct EvalReportOptions {
   bool plots = true;     // run eval/plots/plot_report.py and write report.html
   bool quiet = false;
   EvalOptions eval;
+  std::string trajectory_format = "auto";  // of runs from other systems (eval/foreign_run.h)
 };
 
 nlohmann::json MetricsToJson(const RunMetrics& metrics);

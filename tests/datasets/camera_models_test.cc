@@ -45,6 +45,12 @@ std::vector<ModelCase> Cases() {
        1e-6},
       {"double_sphere", CameraModelId::kDoubleSphere, {350.0, 351.0, 799.5, 765.5, -0.2, 0.6}, 110, 1e-6},
       {"double_sphere_small_alpha", CameraModelId::kDoubleSphere, {300.0, 300.0, 640.0, 480.0, 0.3, 0.4}, 110, 1e-6},
+      {"extended_unified", CameraModelId::kExtendedUnified, {420.0, 421.0, 799.5, 765.5, 0.62, 1.1}, 110, 1e-6},
+      {"extended_unified_small_alpha",
+       CameraModelId::kExtendedUnified,
+       {300.0, 300.0, 640.0, 480.0, 0.45, 0.9},
+       105,
+       1e-6},
       // The inverse polynomial is a fit (< 0.01 px): the round trip is only that good.
       {"ocam", CameraModelId::kOcam, ocam_identity.params, 110, 0.01},
       {"ocam_affine", CameraModelId::kOcam, ocam_affine.params, 110, 0.01},
@@ -58,6 +64,8 @@ bool ImgFromCam(CameraModelId model, const std::vector<T>& params, const T* poin
     case CameraModelId::kEquidistant: return EquidistantModel::ImgFromCam(params.data(), n, point, uv);
     case CameraModelId::kDoubleSphere: return DoubleSphereModel::ImgFromCam(params.data(), n, point, uv);
     case CameraModelId::kOcam: return OcamModel::ImgFromCam(params.data(), n, point, uv);
+    case CameraModelId::kExtendedUnified:
+      return ExtendedUnifiedModel::ImgFromCam(params.data(), n, point, uv);
   }
   return false;
 }
@@ -69,6 +77,8 @@ bool CamFromImg(CameraModelId model, const std::vector<T>& params, const T* uv, 
     case CameraModelId::kEquidistant: return EquidistantModel::CamFromImg(params.data(), n, uv, bearing);
     case CameraModelId::kDoubleSphere: return DoubleSphereModel::CamFromImg(params.data(), n, uv, bearing);
     case CameraModelId::kOcam: return OcamModel::CamFromImg(params.data(), n, uv, bearing);
+    case CameraModelId::kExtendedUnified:
+      return ExtendedUnifiedModel::CamFromImg(params.data(), n, uv, bearing);
   }
   return false;
 }
@@ -223,6 +233,45 @@ TEST(CameraModels, DoubleSphereValidSet) {
   const Eigen::Vector2d far_pixel(799.5 + 350.0 * r_max * 1.01, 765.5);
   Eigen::Vector3d bearing;
   EXPECT_FALSE(DoubleSphereModel::CamFromImg(params.data(), 6, far_pixel.data(), bearing.data()));
+}
+
+// Extended unified rejects directions outside its valid set z > -w d (alpha = 0.62, beta = 1.1:
+// w = 0.38 / 0.62, the limit angle a solves cos a = -w sqrt(beta sin^2 a + cos^2 a)).
+TEST(CameraModels, ExtendedUnifiedValidSet) {
+  const std::vector<double> params = {420.0, 421.0, 799.5, 765.5, 0.62, 1.1};
+  const double w = ExtendedUnifiedModel::ValidW(params.data());
+  EXPECT_NEAR(w, 0.38 / 0.62, 1e-12);
+  double limit_deg = 90.0;  // bisection on the boundary
+  for (double lo = 90.0, hi = 180.0; hi - lo > 1e-9; limit_deg = 0.5 * (lo + hi)) {
+    const double a = 0.5 * (lo + hi) * kDeg;
+    (std::cos(a) > -w * std::sqrt(1.1 * std::sin(a) * std::sin(a) + std::cos(a) * std::cos(a)) ? lo : hi) =
+        0.5 * (lo + hi);
+  }
+  Eigen::Vector2d uv;
+  const Eigen::Vector3d inside(std::sin((limit_deg - 0.5) * kDeg), 0, std::cos((limit_deg - 0.5) * kDeg));
+  const Eigen::Vector3d outside(std::sin((limit_deg + 0.5) * kDeg), 0, std::cos((limit_deg + 0.5) * kDeg));
+  EXPECT_TRUE(ExtendedUnifiedModel::ImgFromCam(params.data(), 6, inside.data(), uv.data()));
+  EXPECT_FALSE(ExtendedUnifiedModel::ImgFromCam(params.data(), 6, outside.data(), uv.data()));
+  // alpha > 0.5: pixels beyond the image disc r2 > 1 / (beta (2 alpha - 1)) have no bearing.
+  const double r_max = 1.0 / std::sqrt(1.1 * (2 * 0.62 - 1));
+  const Eigen::Vector2d far_pixel(799.5 + 420.0 * r_max * 1.01, 765.5);
+  Eigen::Vector3d bearing;
+  EXPECT_FALSE(ExtendedUnifiedModel::CamFromImg(params.data(), 6, far_pixel.data(), bearing.data()));
+}
+
+// Extended unified with beta = 1 is the unified model with xi = alpha / (1 - alpha) and focal
+// length f (1 - alpha): u = f x / (z + xi |p|) (Khomutenko et al., eq. 3).
+TEST(CameraModels, ExtendedUnifiedWithBetaOneIsTheUnifiedModel) {
+  const double alpha = 0.57, f = 400.0;
+  const std::vector<double> params = {f, f, 640.0, 480.0, alpha, 1.0};
+  const double xi = alpha / (1 - alpha), gamma = f / (1 - alpha);
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(0.3, -0.2, 1.0), Eigen::Vector3d(1.0, 0.5, -0.2)}) {
+    Eigen::Vector2d uv;
+    ASSERT_TRUE(ExtendedUnifiedModel::ImgFromCam(params.data(), 6, p.data(), uv.data()));
+    const double s = p.z() + xi * p.norm();
+    EXPECT_NEAR(uv.x(), gamma * (1 - alpha) * p.x() / ((1 - alpha) * s) + 640.0, 1e-9);
+    EXPECT_NEAR(uv.y(), gamma * (1 - alpha) * p.y() / ((1 - alpha) * s) + 480.0, 1e-9);
+  }
 }
 
 // Ocam against its definition, written out independently: the bearing of a pixel is

@@ -33,7 +33,11 @@ Camera Ocam220() {
                         {-392.2, 0.0, 0.00127, -1.746e-6, 2.258e-9}, 220.0);
 }
 
-std::vector<Camera> AllCameras() { return {Equidistant220(), DoubleSphere220(), Ocam220()}; }
+Camera ExtendedUnified220() {
+  return Camera{CameraModelId::kExtendedUnified, 1600, 1532, {420.0, 421.0, 799.5, 765.5, 0.62, 1.1}, 220.0};
+}
+
+std::vector<Camera> AllCameras() { return {Equidistant220(), DoubleSphere220(), Ocam220(), ExtendedUnified220()}; }
 
 Eigen::Vector3d Direction(double angle_deg, double azimuth_deg) {
   return Eigen::Vector3d(std::sin(angle_deg * kDeg) * std::cos(azimuth_deg * kDeg),
@@ -45,12 +49,14 @@ double AngleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 }
 
 TEST(Camera, ModelNamesRoundTrip) {
-  for (CameraModelId id : {CameraModelId::kEquidistant, CameraModelId::kDoubleSphere, CameraModelId::kOcam}) {
+  for (CameraModelId id : {CameraModelId::kEquidistant, CameraModelId::kDoubleSphere, CameraModelId::kOcam,
+                           CameraModelId::kExtendedUnified}) {
     EXPECT_EQ(CameraModelFromName(CameraModelName(id)), id);
   }
   EXPECT_EQ(CameraModelName(CameraModelId::kOcam), "ocam");
   EXPECT_EQ(CameraModelName(CameraModelId::kDoubleSphere), "double_sphere");
   EXPECT_EQ(CameraModelName(CameraModelId::kEquidistant), "equidistant");
+  EXPECT_EQ(CameraModelName(CameraModelId::kExtendedUnified), "extended_unified");
   EXPECT_THROW(CameraModelFromName("fisheye"), std::invalid_argument);
   EXPECT_THROW(CameraModelName(static_cast<CameraModelId>(7)), std::invalid_argument);
 }
@@ -246,6 +252,13 @@ TEST(Camera, CheckNamesTheBadField) {
   ExpectCheckFails(camera, "alpha");
   camera = DoubleSphere220();
   camera.params[4] = -0.6;  // valid set shrinks below 110 degrees
+  ExpectCheckFails(camera, "max_fov_deg");
+
+  camera = ExtendedUnified220();
+  camera.params[5] = 0.0;
+  ExpectCheckFails(camera, "beta");
+  camera = ExtendedUnified220();
+  camera.params[4] = 0.2;  // w = 0.25: valid set below 110 degrees
   ExpectCheckFails(camera, "max_fov_deg");
 
   camera = Ocam220();

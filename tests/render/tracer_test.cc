@@ -32,6 +32,16 @@ Camera TestCamera(CameraModelId model) {
       cam.Check("double sphere test camera");
       return cam;
     }
+    case CameraModelId::kExtendedUnified: {
+      Camera cam;
+      cam.model = CameraModelId::kExtendedUnified;
+      cam.width = 160;
+      cam.height = 150;
+      cam.params = {52.0, 52.0, 79.5, 74.5, 0.62, 1.1};
+      cam.max_fov_deg = 195.0;
+      cam.Check("extended unified test camera");
+      return cam;
+    }
   }
   return {};
 }
