@@ -226,6 +226,7 @@ ImportReport ImportDataset(const std::string& in_dir, const ImportOptions& optio
   const Trajectory gt = GroundTruthAt(in_dir, stamps);
   ImportReport report;
   if (!gt.empty()) WriteTum(GroundTruthPath(options.out_dir), gt);
+  info.has_ground_truth = !gt.empty();
   WriteDatasetInfo(options.out_dir, info);
   report.frames = info.frame_count;
   report.cameras = info.rig.NumCameras();
