@@ -68,7 +68,8 @@ CalibrationDraw RunDraw(const CalibrationStudyOptions& o, const DatasetInfo& inf
     StartupCalibrationOptions sopt;
     sopt.shots = 1;
     auto load = [&](int frame) { return LoadFrameImages(o.dataset_dir, info.rig, frame); };
-    const StartupCalibrationReport r = CalibrateAtStartup(info.rig, drawn, load, o.shot, o.shot + 1, {}, sopt, true);
+    const StartupCalibrationReport r = CalibrateAtStartup(info.rig, drawn, load, o.shot, o.shot + 1,
+                                                          LoadStaticMasks(o.dataset_dir, info.rig, info.has_static_masks), sopt, true);
     d.startup_deg = ExtrinsicErrorDeg(r.cam_from_rig, truth);
     d.startup_converged = r.converged;
     d.startup_status = r.status;

@@ -37,6 +37,23 @@ LoadedFrame LoadFrameImages(const std::string& dataset_dir, const Rig& rig, int 
   return loaded;
 }
 
+std::vector<cv::Mat> LoadStaticMasks(const std::string& dataset_dir, const Rig& rig, bool has_static_masks) {
+  std::vector<cv::Mat> masks;
+  if (!has_static_masks) return masks;
+  for (const RigCamera& cam : rig.cameras) {
+    const std::string path = StaticMaskPath(dataset_dir, cam.name);
+    cv::Mat mask = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    if (mask.empty()) throw std::runtime_error(path + ": static mask missing or unreadable (dataset.json has_static_masks)");
+    if (mask.cols != cam.camera.width || mask.rows != cam.camera.height) {
+      throw std::runtime_error(path + ": static mask is " + std::to_string(mask.cols) + "x" + std::to_string(mask.rows) +
+                               " but camera " + cam.name + " is " + std::to_string(cam.camera.width) + "x" +
+                               std::to_string(cam.camera.height));
+    }
+    masks.push_back(mask);
+  }
+  return masks;
+}
+
 ImagePrefetcher::ImagePrefetcher(const std::string& dataset_dir, const Rig& rig, int begin, int end)
     : dataset_dir_(dataset_dir), rig_(rig), end_(end) {
   Start(begin);

@@ -24,6 +24,11 @@ struct LoadedFrame {
 // `problems`; an image of the wrong size throws, naming the file and dataset.json's field.
 LoadedFrame LoadFrameImages(const std::string& dataset_dir, const Rig& rig, int frame);
 
+// The dataset's static masks (dataset.json has_static_masks), one 8-bit image per camera, 0 =
+// invalid; empty when the dataset has none. Throws naming the file when one is unreadable or of the
+// wrong size.
+std::vector<cv::Mat> LoadStaticMasks(const std::string& dataset_dir, const Rig& rig, bool has_static_masks);
+
 // Reads frame f+1's images on a second thread while frame f is processed (PNG decoding costs about
 // 30 CPU-ms per full-size view; it overlaps the front-end's and the BA's less parallel stretches).
 class ImagePrefetcher {

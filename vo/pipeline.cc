@@ -532,7 +532,9 @@ VoSummary RunVo(const VoOptions& options) {
     sopt.fallback_prior_deg = options.online_prior_deg;
     sopt.refine_rounds = options.online_bootstrap_rounds;
     auto load = [&](int frame) { return LoadFrameImages(options.dataset_dir, info.rig, frame); };
-    startup = CalibrateAtStartup(info.rig, cam_from_rig, load, begin, end, {}, sopt, options.quiet);
+    startup = CalibrateAtStartup(info.rig, cam_from_rig, load, begin, end,
+                                 LoadStaticMasks(options.dataset_dir, info.rig, info.has_static_masks), sopt,
+                                 options.quiet);
     if (!startup.converged) std::fprintf(stderr, "vo online: WARNING: start-up calibration not converged: %s\n", startup.status.c_str());
     cam_from_rig = startup.cam_from_rig;
   }
