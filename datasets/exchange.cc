@@ -334,4 +334,16 @@ ExportReport ExportDataset(const std::string& dataset_dir, const ExportOptions& 
   return report;
 }
 
+std::string YamlNumber(double value) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof(buffer), "%.17g", value);
+  return buffer;
+}
+
+std::string YamlList(const std::vector<double>& values) {
+  std::string out = "[";
+  for (size_t i = 0; i < values.size(); ++i) out += (i ? ", " : "") + YamlNumber(values[i]);
+  return out + "]";
+}
+
 }  // namespace rovo

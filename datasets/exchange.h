@@ -115,4 +115,8 @@ class App;
 namespace rovo {
 // `rovo dataset export`, `rovo dataset import`, `rovo dataset lens-fit` (datasets/exchange_cli.cc).
 void AddExchangeCommands(CLI::App* dataset);
+// Numbers for the YAML files of the exchange formats: full precision (%.17g), lists as [a, b, c].
+std::string YamlNumber(double value);
+std::string YamlList(const std::vector<double>& values);
+
 }  // namespace rovo

@@ -12,17 +12,6 @@
 namespace rovo {
 namespace {
 
-std::string Num(double value) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof(buffer), "%.17g", value);
-  return buffer;
-}
-
-std::string List(const std::vector<double>& values) {
-  std::string out = "[";
-  for (size_t i = 0; i < values.size(); ++i) out += (i ? ", " : "") + Num(values[i]);
-  return out + "]";
-}
 
 std::vector<double> ReadNumbers(const YAML::Node& node, const std::string& path, const std::string& field) {
   if (!node || !node.IsSequence()) throw std::runtime_error(path + ": " + field + ": missing or not a list");
@@ -53,16 +42,16 @@ std::string EurocSensorYaml(const ExchangeCamera& camera, double rate_hz, const 
   out << "# General sensor definitions.\nsensor_type: camera\ncomment: " << comment << "\n\n"
       << "# Sensor extrinsics wrt. the body-frame (body = rovo rig: x forward, y left, z up; camera: x right,\n"
       << "# y down, z along the optical axis). T_BS maps camera coordinates to body coordinates.\n"
-      << "T_BS:\n  cols: 4\n  rows: 4\n  data: " << List(data) << "\n\n"
+      << "T_BS:\n  cols: 4\n  rows: 4\n  data: " << YamlList(data) << "\n\n"
       << "# Camera specific definitions (Kalibr's names and parameter order; pixel centres at integers).\n"
-      << "rate_hz: " << Num(rate_hz) << "\n"
+      << "rate_hz: " << YamlNumber(rate_hz) << "\n"
       << "resolution: [" << camera.width << ", " << camera.height << "]\n"
       << "camera_model: " << lens.camera_model << "\n"
-      << "intrinsics: " << List(lens.intrinsics) << "\n"
+      << "intrinsics: " << YamlList(lens.intrinsics) << "\n"
       << "distortion_model: " << lens.distortion_model << "\n"
-      << "distortion_coefficients: " << List(lens.distortion_coeffs) << "\n"
+      << "distortion_coefficients: " << YamlList(lens.distortion_coeffs) << "\n"
       << "# Full field-of-view cone of the lens in degrees (rovo extension; other readers ignore it).\n"
-      << "max_fov_deg: " << Num(camera.max_fov_deg) << "\n";
+      << "max_fov_deg: " << YamlNumber(camera.max_fov_deg) << "\n";
   return out.str();
 }
 
@@ -124,7 +113,7 @@ std::string EurocGroundTruthCsv(const Trajectory& world_from_rig) {
     out << SecondsToNs(world_from_rig[i].timestamp);
     for (double v : {pose.translation.x(), pose.translation.y(), pose.translation.z(), q.w(), q.x(), q.y(), q.z(),
                      velocity.x(), velocity.y(), velocity.z()}) {
-      out << "," << Num(v);
+      out << "," << YamlNumber(v);
     }
     out << ",0,0,0,0,0,0\n";
   }

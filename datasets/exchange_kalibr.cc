@@ -14,22 +14,11 @@
 namespace rovo {
 namespace {
 
-std::string Num(double value) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof(buffer), "%.17g", value);
-  return buffer;
-}
-
-std::string List(const std::vector<double>& values) {
-  std::string out = "[";
-  for (size_t i = 0; i < values.size(); ++i) out += (i ? ", " : "") + Num(values[i]);
-  return out + "]";
-}
 
 void WriteMatrix(std::ostringstream& out, const std::string& key, const Rigid3& b_from_a) {
   const Eigen::Matrix4d m = b_from_a.Matrix4();
   out << "  " << key << ":\n";
-  for (int r = 0; r < 4; ++r) out << "  - " << List({m(r, 0), m(r, 1), m(r, 2), m(r, 3)}) << "\n";
+  for (int r = 0; r < 4; ++r) out << "  - " << YamlList({m(r, 0), m(r, 1), m(r, 2), m(r, 3)}) << "\n";
 }
 
 std::vector<double> Numbers(const YAML::Node& node, const std::string& what) {
@@ -88,9 +77,9 @@ std::string KalibrCamchainYaml(const std::vector<ExchangeCamera>& cameras, const
     for (int j : Overlaps(cameras, i)) overlaps += (overlaps.empty() ? "" : ", ") + std::to_string(j);
     out << "  cam_overlaps: [" << overlaps << "]\n"
         << "  camera_model: " << lens.camera_model << "\n"
-        << "  distortion_coeffs: " << List(lens.distortion_coeffs) << "\n"
+        << "  distortion_coeffs: " << YamlList(lens.distortion_coeffs) << "\n"
         << "  distortion_model: " << lens.distortion_model << "\n"
-        << "  intrinsics: " << List(lens.intrinsics) << "\n"
+        << "  intrinsics: " << YamlList(lens.intrinsics) << "\n"
         << "  resolution: [" << camera.width << ", " << camera.height << "]\n"
         << "  rostopic: /" << camera.name << "/image_raw\n";
   }

@@ -26,7 +26,9 @@ const std::vector<std::string> kFramesColumns = {"frame",        "timestamp",
                                                  "num_correspondences", "num_inliers",
                                                  "inlier_ratio", "mean_reproj_error_deg",
                                                  "keyframe",     "status",
-                                                 "time_ms"};
+                                                 "time_ms",      "missing_cameras"};
+// frames.csv as written before missing_cameras existed: still read (no camera missing).
+const std::vector<std::string> kFramesColumnsWithoutMissing(kFramesColumns.begin(), kFramesColumns.end() - 1);
 const std::vector<std::string> kExtrinsicsColumns = {"frame", "timestamp", "camera", "qx", "qy",
                                                      "qz",    "qw",        "tx",     "ty", "tz"};
 
@@ -147,7 +149,10 @@ bool IsKnownStatus(const std::string& status) {
 }
 
 std::vector<FrameRecord> ReadFramesCsv(const std::string& path) {
-  const CsvReader csv(path, kFramesColumns);
+  const std::string text = ReadFile(path);
+  const bool old_layout = text.rfind(Join(kFramesColumnsWithoutMissing) + "\n", 0) == 0 ||
+                          text.rfind(Join(kFramesColumnsWithoutMissing) + "\r\n", 0) == 0;
+  const CsvReader csv(path, old_layout ? kFramesColumnsWithoutMissing : kFramesColumns);
   std::vector<FrameRecord> frames(csv.NumRows());
   for (size_t r = 0; r < csv.NumRows(); ++r) {
     FrameRecord& f = frames[r];
@@ -169,6 +174,12 @@ std::vector<FrameRecord> ReadFramesCsv(const std::string& path) {
     if (!IsKnownStatus(f.status)) csv.Fail(r, 7, "unknown status \"" + f.status + "\" (ok|init|lost)");
     f.time_ms = csv.Double(r, 8);
     if (f.time_ms < 0.0) csv.Fail(r, 8, "negative time");
+    if (!old_layout) {
+      f.missing_cameras = csv.Text(r, 9);
+      if (f.missing_cameras.find_first_not_of("0123456789;") != std::string::npos) {
+        csv.Fail(r, 9, "expected camera indices separated by ';'");
+      }
+    }
     if (r > 0 && f.frame <= frames[r - 1].frame) csv.Fail(r, 0, "frame indices must increase");
   }
   return frames;
@@ -226,7 +237,7 @@ void WriteFramesCsv(const std::string& path, const std::vector<FrameRecord>& fra
     }
     text += Join({std::to_string(f.frame), FormatDouble(f.timestamp), std::to_string(f.num_correspondences),
                   std::to_string(f.num_inliers), FormatDouble(f.inlier_ratio), FormatDouble(f.mean_reproj_error_deg),
-                  f.keyframe ? "1" : "0", f.status, FormatDouble(f.time_ms)});
+                  f.keyframe ? "1" : "0", f.status, FormatDouble(f.time_ms), f.missing_cameras});
     text += '\n';
   }
   WriteFileAtomic(path, text);

@@ -28,6 +28,7 @@ struct FrameRecord {
   bool keyframe = false;
   std::string status = "ok";
   double time_ms = 0.0;             // wall time spent on this frame
+  std::string missing_cameras;      // cameras whose image was missing or unreadable, "1;3"; "" when none
 };
 
 struct ExtrinsicsRecord {

@@ -167,6 +167,11 @@ void AddVoCommands(CliGroups& groups) {
                 "reprojection error %.3f deg -> %s\n",
                 s.frames, s.frames_ok, s.frames_init, s.frames_lost, s.seconds, s.frames / std::max(s.seconds, 1e-9),
                 100.0 * s.mean_inlier_ratio, s.mean_reproj_error_deg, args->options.out_dir.c_str());
+    if (s.missing_images > 0) {
+      std::printf("warning: %d image%s missing or unreadable in %d frame%s (frames.csv missing_cameras)\n",
+                  s.missing_images, s.missing_images == 1 ? "" : "s", s.frames_with_missing_images,
+                  s.frames_with_missing_images == 1 ? "" : "s");
+    }
   });
 
   auto bench_args = std::make_shared<VoArgs>();

@@ -477,6 +477,13 @@ VoSummary RunVo(const VoOptions& options) {
                                 " is not a non-empty range within the dataset's " + std::to_string(info.frame_count) +
                                 " frames (" + DatasetJsonPath(options.dataset_dir) + ": frame_count)");
   }
+  // A camera folder missing entirely is an input error, not a run of lost frames.
+  for (const RigCamera& cam : info.rig.cameras) {
+    const std::string folder = (std::filesystem::path(options.dataset_dir) / cam.name).string();
+    if (!std::filesystem::is_directory(folder)) {
+      throw std::runtime_error(folder + ": image folder of camera " + cam.name + " (dataset.json rig.cameras) is missing");
+    }
+  }
   // Starting extrinsics.
   std::vector<Rigid3> cam_from_rig = info.rig.Extrinsics();
   if (options.mode != ExtrinsicsMode::kGroundTruth && options.draw_seed >= 0) {
@@ -600,6 +607,11 @@ VoSummary RunVo(const VoOptions& options) {
     total_hypotheses += result.ransac_hypotheses;
 
     FrameRecord rec = result.record;
+    for (int cam : loaded.missing_cameras) {
+      rec.missing_cameras += (rec.missing_cameras.empty() ? "" : ";") + std::to_string(cam);
+    }
+    summary.missing_images += static_cast<int>(loaded.missing_cameras.size());
+    summary.frames_with_missing_images += loaded.missing_cameras.empty() ? 0 : 1;
     rec.frame = frame;
     rec.timestamp = timestamp_of(frame);
     rec.time_ms = MsSince(frame_start);
@@ -672,6 +684,8 @@ VoSummary RunVo(const VoOptions& options) {
                   {"frames_ok", summary.frames_ok},
                   {"frames_init", summary.frames_init},
                   {"frames_lost", summary.frames_lost},
+                  {"frames_with_missing_images", summary.frames_with_missing_images},
+                  {"missing_images", summary.missing_images},
                   {"mean_inlier_ratio", summary.mean_inlier_ratio},
                   {"mean_reproj_error_deg", summary.mean_reproj_error_deg},
                   {"seconds", summary.seconds},

@@ -105,6 +105,8 @@ struct VoSummary {
   int frames_lost = 0;
   double seconds = 0.0;
   int frames_init = 0;
+  int frames_with_missing_images = 0;    // frames where some camera's image was missing or unreadable
+  int missing_images = 0;                // (frame, camera) images missing or unreadable
   double mean_inlier_ratio = 0.0;        // over "ok" frames
   double mean_reproj_error_deg = 0.0;    // over "ok" frames
   VoStageTimes stage_ms;

@@ -97,7 +97,8 @@ TEST_F(RunIoTest, RoundTripIsExact) {
   EXPECT_EQ(ext.substr(0, ext.find('\n')), "frame,timestamp,camera,qx,qy,qz,qw,tx,ty,tz");
   const std::string frames = ReadFile(RunFramesPath(dir_));
   EXPECT_EQ(frames.substr(0, frames.find('\n')),
-            "frame,timestamp,num_correspondences,num_inliers,inlier_ratio,mean_reproj_error_deg,keyframe,status,time_ms");
+            "frame,timestamp,num_correspondences,num_inliers,inlier_ratio,mean_reproj_error_deg,keyframe,status,time_ms,"
+            "missing_cameras");
   // No temporary files left behind.
   for (const auto& entry : fs::directory_iterator(dir_)) {
     EXPECT_EQ(entry.path().string().find(".tmp."), std::string::npos) << entry.path();
@@ -106,21 +107,41 @@ TEST_F(RunIoTest, RoundTripIsExact) {
 
 TEST_F(RunIoTest, BadNumberNamesFileLineAndColumn) {
   WriteRun(dir_, SampleRun());
-  ReplaceLine(RunFramesPath(dir_), 3, "1,0.1,301,150,abc,0.1,0,ok,12.5");
+  ReplaceLine(RunFramesPath(dir_), 3, "1,0.1,301,150,abc,0.1,0,ok,12.5,");
   const std::string error = ErrorOf(dir_);
   EXPECT_NE(error.find("frames.csv:3"), std::string::npos) << error;
   EXPECT_NE(error.find("column 5 (inlier_ratio)"), std::string::npos) << error;
 }
 
+TEST_F(RunIoTest, MissingCamerasRoundTripAndOldFilesStillRead) {
+  RunData run = SampleRun();
+  run.frames[1].missing_cameras = "1;3";
+  WriteRun(dir_, run);
+  EXPECT_EQ(ReadRun(dir_).frames[1].missing_cameras, "1;3");
+  EXPECT_EQ(ReadRun(dir_).frames[0].missing_cameras, "");
+  // A frames.csv without the column (as written before it existed) reads with no camera missing.
+  std::string text = ReadFile(RunFramesPath(dir_));
+  std::string old;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) old += line.substr(0, line.rfind(',')) + "\n";
+  WriteFileAtomic(RunFramesPath(dir_), old);
+  const RunData back = ReadRun(dir_);
+  ASSERT_EQ(back.frames.size(), run.frames.size());
+  EXPECT_EQ(back.frames[1].missing_cameras, "");
+  EXPECT_EQ(back.frames[1].status, run.frames[1].status);
+  ReplaceLine(RunFramesPath(dir_), 2, "0,0,300,150,0.5,0.1,0,ok,1,x");
+  EXPECT_NE(ErrorOf(dir_).find("expected 9 columns"), std::string::npos) << ErrorOf(dir_);
+}
+
 TEST_F(RunIoTest, BadRowsAreRejected) {
   WriteRun(dir_, SampleRun());
-  ReplaceLine(RunFramesPath(dir_), 2, "0,0,300,150,0.5,0.1,0,ok");  // one column short
-  EXPECT_NE(ErrorOf(dir_).find("frames.csv:2: expected 9 columns, got 8"), std::string::npos) << ErrorOf(dir_);
+  ReplaceLine(RunFramesPath(dir_), 2, "0,0,300,150,0.5,0.1,0,ok,1");  // one column short
+  EXPECT_NE(ErrorOf(dir_).find("frames.csv:2: expected 10 columns, got 9"), std::string::npos) << ErrorOf(dir_);
   WriteRun(dir_, SampleRun());
-  ReplaceLine(RunFramesPath(dir_), 2, "0,0,300,150,0.5,0.1,0,flying,1");
+  ReplaceLine(RunFramesPath(dir_), 2, "0,0,300,150,0.5,0.1,0,flying,1,");
   EXPECT_NE(ErrorOf(dir_).find("column 8 (status)"), std::string::npos) << ErrorOf(dir_);
   WriteRun(dir_, SampleRun());
-  ReplaceLine(RunFramesPath(dir_), 2, "0,0,300,400,0.5,0.1,0,ok,1");  // more inliers than correspondences
+  ReplaceLine(RunFramesPath(dir_), 2, "0,0,300,400,0.5,0.1,0,ok,1,");  // more inliers than correspondences
   EXPECT_NE(ErrorOf(dir_).find("column 4 (num_inliers)"), std::string::npos) << ErrorOf(dir_);
   WriteRun(dir_, SampleRun());
   ReplaceLine(RunExtrinsicsPath(dir_), 1, "frame,timestamp,camera,qw,qx,qy,qz,tx,ty,tz");

@@ -10,6 +10,8 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 namespace rovo {
@@ -55,6 +57,38 @@ TEST(PipelineIntegration, RecoversFromGapOfBlackFrames) {
     EXPECT_LT(error, 0.05 * length + 0.5) << "frame " << frame;
   }
   EXPECT_EQ(run.info["mode"], "gt");
+  EXPECT_EQ(run.info["summary"]["missing_images"], 0);
+
+  // An unreadable image of one camera is counted per frame and camera, in frames.csv and run.json.
+  const std::string broken = ImagePath(dataset, info.rig.cameras[2].name, 5);
+  { std::ofstream(broken, std::ios::trunc) << "not a png"; }
+  fs::remove(ImagePath(dataset, info.rig.cameras[1].name, 6));
+  const std::string run2 = (root / "run_missing").string();
+  ASSERT_EQ(RunCommand(std::string(ROVO_BINARY) + " vo " + dataset + " --extrinsics gt --frames 0:8 --quiet --out " + run2 +
+                       " > " + (root / "stdout.txt").string()),
+            0);
+  const RunData missing = ReadRun(run2);
+  EXPECT_EQ(missing.frames[5].missing_cameras, "2");
+  EXPECT_EQ(missing.frames[6].missing_cameras, "1");
+  EXPECT_EQ(missing.frames[4].missing_cameras, "");
+  EXPECT_EQ(missing.info["summary"]["missing_images"], 2);
+  EXPECT_EQ(missing.info["summary"]["frames_with_missing_images"], 2);
+  std::ifstream out((root / "stdout.txt").string());
+  const std::string printed((std::istreambuf_iterator<char>(out)), std::istreambuf_iterator<char>());
+  EXPECT_NE(printed.find("2 images missing or unreadable in 2 frames"), std::string::npos) << printed;
+
+  // A camera folder missing entirely is an error before any work, naming the folder.
+  fs::remove_all(fs::path(dataset) / info.rig.cameras[3].name);
+  const std::string err = (root / "stderr.txt").string();
+  EXPECT_NE(RunCommand(std::string(ROVO_BINARY) + " vo " + dataset + " --extrinsics gt --frames 0:8 --quiet --out " +
+                       (root / "run_nofolder").string() + " 2> " + err),
+            0);
+  std::ifstream in(err);
+  const std::string message((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(message.find((fs::path(dataset) / info.rig.cameras[3].name).string() + ": image folder of camera"),
+            std::string::npos)
+      << message;
+  EXPECT_FALSE(fs::exists((root / "run_nofolder" / "run.json")));
   fs::remove_all(root);
 }
 
