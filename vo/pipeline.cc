@@ -458,33 +458,23 @@ nlohmann::json PoseJson(const Rigid3& x) {
           {"rotation_xyzw", {x.rotation.x(), x.rotation.y(), x.rotation.z(), x.rotation.w()}}};
 }
 
-}  // namespace
-
-VoSummary RunVo(const VoOptions& options) {
-  const auto run_start = Clock::now();
-  if (options.dataset_dir.empty()) throw std::invalid_argument("vo: no dataset folder given");
-  if (options.out_dir.empty()) throw std::invalid_argument("vo: no output (run) folder given");
-  if (!(options.ransac_tau_deg > 0.0)) {
-    throw std::invalid_argument("vo: the RANSAC inlier threshold must be positive (--tau, degrees), got " +
-                                std::to_string(options.ransac_tau_deg));
-  }
-  const DatasetInfo info = ReadDatasetInfo(options.dataset_dir);
-  const int num_cams = info.rig.NumCameras();
-  const int begin = options.frame_begin;
-  const int end = options.frame_end < 0 ? info.frame_count : options.frame_end;
+// The frame range and the camera folders: a missing folder is an input error, not lost frames.
+void CheckRangeAndFolders(const VoOptions& options, const DatasetInfo& info, int begin, int end) {
   if (begin < 0 || end > info.frame_count || begin >= end) {
     throw std::invalid_argument("vo: --frames " + std::to_string(begin) + ":" + std::to_string(end) +
                                 " is not a non-empty range within the dataset's " + std::to_string(info.frame_count) +
                                 " frames (" + DatasetJsonPath(options.dataset_dir) + ": frame_count)");
   }
-  // A camera folder missing entirely is an input error, not a run of lost frames.
   for (const RigCamera& cam : info.rig.cameras) {
     const std::string folder = (std::filesystem::path(options.dataset_dir) / cam.name).string();
     if (!std::filesystem::is_directory(folder)) {
       throw std::runtime_error(folder + ": image folder of camera " + cam.name + " (dataset.json rig.cameras) is missing");
     }
   }
-  // Starting extrinsics.
+}
+
+// GTExt: the rig's; NoisyExt/OnlineExt: a fresh draw (--draw-seed) or a stored perturbed set.
+std::vector<Rigid3> StartingExtrinsics(const VoOptions& options, const DatasetInfo& info) {
   std::vector<Rigid3> cam_from_rig = info.rig.Extrinsics();
   if (options.mode != ExtrinsicsMode::kGroundTruth && options.draw_seed >= 0) {
     if (!(options.draw_sigma_deg >= 0.0)) {
@@ -500,11 +490,148 @@ VoSummary RunVo(const VoOptions& options) {
                                   std::to_string(info.perturbed.size()) + " perturbed extrinsic sets)");
     }
     cam_from_rig = info.perturbed[options.noise_set].cam_from_rig;
-    if (static_cast<int>(cam_from_rig.size()) != num_cams) {
+    if (static_cast<int>(cam_from_rig.size()) != info.rig.NumCameras()) {
       throw std::runtime_error(DatasetJsonPath(options.dataset_dir) + ": perturbed[" +
                                std::to_string(options.noise_set) + "].cam_from_rig has the wrong camera count");
     }
   }
+  return cam_from_rig;
+}
+
+BackendOptions MakeBackendOptions(const VoOptions& options) {
+  BackendOptions backend_options;
+  backend_options.ransac.seed = options.seed;
+  backend_options.ransac.sampling = ViewSamplingFromName(options.sampling);
+  backend_options.ransac.views = RansacViewsFromName(options.ransac);
+  backend_options.ba.optimize_extrinsics = options.mode == ExtrinsicsMode::kOnline;
+  backend_options.async_ba = options.async_ba;
+  backend_options.ransac.tau_rad = options.ransac_tau_deg * M_PI / 180.0;
+  if (options.keyframe_distance_m > 0.0) backend_options.keyframes.min_translation_m = options.keyframe_distance_m;
+  if (options.online_settle_frames >= 0) backend_options.online_settle_frames = options.online_settle_frames;
+  // Online: each keyframe BA may move an extrinsic by about this much (random-walk prior, local_ba.h):
+  // measured on cloudy_urban quick, it halves the wander of the estimate between windows.
+  backend_options.ba.extrinsic_prior_deg = 0.005;
+  return backend_options;
+}
+
+bool RunsStartupCalibration(const VoOptions& options) {
+  return options.mode == ExtrinsicsMode::kOnline && options.online_prior_deg > 0.0;
+}
+
+StartupCalibrationReport RunStartupCalibration(const VoOptions& options, const DatasetInfo& info, int begin, int end,
+                                               const std::vector<Rigid3>& cam_from_rig) {
+  StartupCalibrationOptions sopt;
+  sopt.shots = options.online_startup_shots;
+  sopt.fallback_prior_deg = options.online_prior_deg;
+  sopt.refine_rounds = options.online_bootstrap_rounds;
+  auto load = [&](int frame) { return LoadFrameImages(options.dataset_dir, info.rig, frame); };
+  StartupCalibrationReport startup =
+      CalibrateAtStartup(info.rig, cam_from_rig, load, begin, end,
+                         LoadStaticMasks(options.dataset_dir, info.rig, info.has_static_masks), sopt, options.quiet);
+  if (!startup.converged) {
+    std::fprintf(stderr, "vo online: WARNING: start-up calibration not converged: %s\n", startup.status.c_str());
+  }
+  return startup;
+}
+
+// Sums of per-frame stage times -> means per frame.
+void AverageStageTimes(int frames, int total_hypotheses, VoStageTimes* ms) {
+  const double n = std::max(1, frames);
+  for (double* v : {&ms->warp, &ms->detect, &ms->track, &ms->match, &ms->cpu_warp, &ms->cpu_detect, &ms->cpu_track,
+                    &ms->cpu_match, &ms->load, &ms->ransac, &ms->refine, &ms->triangulate, &ms->ba, &ms->ba_wait,
+                    &ms->backend_total, &ms->total}) {
+    *v /= n;
+  }
+  ms->ransac_us_per_hypothesis = total_hypotheses > 0 ? ms->ransac * n * 1000.0 / total_hypotheses : 0.0;
+}
+
+// Adds a frame's front-end and back-end stage times to the sums.
+void AddStageTimes(const FrontendFrame& features, const BackendFrameResult& result, VoStageTimes* ms) {
+  ms->warp += features.ms_warp;
+  ms->detect += features.ms_detect;
+  ms->track += features.ms_track;
+  ms->match += features.ms_match;
+  ms->cpu_warp += features.cpu_ms_warp;
+  ms->cpu_detect += features.cpu_ms_detect;
+  ms->cpu_track += features.cpu_ms_track;
+  ms->cpu_match += features.cpu_ms_match;
+  ms->ransac += result.ms_ransac;
+  ms->refine += result.ms_refine;
+  ms->triangulate += result.ms_triangulate;
+  ms->ba += result.ms_ba;  // synchronous BA; async BA is counted when it is joined
+}
+
+// run.json: every setting, seeds, the start-up calibration and the summary.
+nlohmann::json RunInfoJson(const VoOptions& options, const DatasetInfo& info, const BackendOptions& backend_options,
+                           const VoSummary& summary, const StartupCalibrationReport& startup, int begin, int end,
+                           const Rigid3& world_from_rig0) {
+  const std::string dataset_json = ReadFile(DatasetJsonPath(options.dataset_dir));
+  const VoStageTimes& ms = summary.stage_ms;
+  nlohmann::json j;
+  j["mode"] = ExtrinsicsModeName(options.mode);
+  j["dataset"] = std::filesystem::absolute(options.dataset_dir).lexically_normal().string();
+  j["dataset_json_hash"] = HashHex(dataset_json.data(), dataset_json.size());
+  j["scene_hash"] = info.scene_hash;
+  j["dataset_seed"] = info.seed;
+  j["seed"] = options.seed;
+  j["noise_set"] = options.noise_set;
+  j["draw_seed"] = options.draw_seed;
+  j["draw_sigma_deg"] = options.draw_sigma_deg;
+  j["frames"] = {begin, end};
+  j["threads"] = options.threads;
+  j["sampling"] = options.sampling;
+  j["ransac"] = options.ransac;
+  j["generator"] = "rovo vo";
+  j["version"] = ROVO_VERSION;
+  j["initial_world_from_rig"] = PoseJson(world_from_rig0);
+  j["online_prior_deg"] = options.online_prior_deg;
+  j["max_new_features"] = options.max_new_features;
+  j["warp_below_deg"] = options.warp_below_deg;
+  if (RunsStartupCalibration(options)) j["startup_calibration"] = startup.ToJson();
+  j["backend"] = {{"ransac_tau_deg", backend_options.ransac.tau_rad * 180.0 / M_PI},
+                  {"ransac_max_iterations", backend_options.ransac.max_iterations},
+                  {"ransac_confidence", backend_options.ransac.confidence},
+                  {"refine_cauchy_scale_deg", backend_options.refine.cauchy_scale_rad * 180.0 / M_PI},
+                  {"ba_cauchy_scale_deg", backend_options.ba.cauchy_scale_rad * 180.0 / M_PI},
+                  {"ba_max_iterations", backend_options.ba.max_iterations},
+                  {"ba_online_extrinsics", backend_options.ba.optimize_extrinsics},
+                  {"ba_extrinsic_prior_deg", backend_options.ba.extrinsic_prior_deg},
+                  {"window_keyframes", backend_options.window_keyframes},
+                  {"async_ba", backend_options.async_ba},
+                  {"keyframe_distance_m", backend_options.keyframes.min_translation_m},
+                  {"keyframe_max_frame_gap", backend_options.keyframes.max_frame_gap},
+                  {"online_max_error_deg", backend_options.online_max_error_deg},
+                  {"online_settle_frames", backend_options.online_settle_frames}};
+  j["summary"] = {{"frames", summary.frames},
+                  {"frames_ok", summary.frames_ok},
+                  {"frames_init", summary.frames_init},
+                  {"frames_lost", summary.frames_lost},
+                  {"frames_with_missing_images", summary.frames_with_missing_images},
+                  {"missing_images", summary.missing_images},
+                  {"mean_inlier_ratio", summary.mean_inlier_ratio},
+                  {"mean_reproj_error_deg", summary.mean_reproj_error_deg},
+                  {"seconds", summary.seconds},
+                  {"ms_per_frame", ms.total},
+                  {"ms_backend_per_frame", ms.backend_total}};
+  return j;
+}
+
+}  // namespace
+
+VoSummary RunVo(const VoOptions& options) {
+  const auto run_start = Clock::now();
+  if (options.dataset_dir.empty()) throw std::invalid_argument("vo: no dataset folder given");
+  if (options.out_dir.empty()) throw std::invalid_argument("vo: no output (run) folder given");
+  if (!(options.ransac_tau_deg > 0.0)) {
+    throw std::invalid_argument("vo: the RANSAC inlier threshold must be positive (--tau, degrees), got " +
+                                std::to_string(options.ransac_tau_deg));
+  }
+  const DatasetInfo info = ReadDatasetInfo(options.dataset_dir);
+  const int num_cams = info.rig.NumCameras();
+  const int begin = options.frame_begin;
+  const int end = options.frame_end < 0 ? info.frame_count : options.frame_end;
+  CheckRangeAndFolders(options, info, begin, end);
+  std::vector<Rigid3> cam_from_rig = StartingExtrinsics(options, info);
   // Ground truth: the first pose (metric start) and time stamps.
   Trajectory ground_truth;
   if (std::filesystem::exists(GroundTruthPath(options.dataset_dir))) ground_truth = ReadTum(GroundTruthPath(options.dataset_dir));
@@ -520,29 +647,10 @@ VoSummary RunVo(const VoOptions& options) {
   }
   EnsureWritableDir(options.out_dir);
 
-  BackendOptions backend_options;
-  backend_options.ransac.seed = options.seed;
-  backend_options.ransac.sampling = ViewSamplingFromName(options.sampling);
-  backend_options.ransac.views = RansacViewsFromName(options.ransac);
-  backend_options.ba.optimize_extrinsics = options.mode == ExtrinsicsMode::kOnline;
-  backend_options.async_ba = options.async_ba;
-  backend_options.ransac.tau_rad = options.ransac_tau_deg * M_PI / 180.0;
-  if (options.keyframe_distance_m > 0.0) backend_options.keyframes.min_translation_m = options.keyframe_distance_m;
-  if (options.online_settle_frames >= 0) backend_options.online_settle_frames = options.online_settle_frames;
-  // Online: each keyframe BA may move an extrinsic by about this much (random-walk prior, local_ba.h):
-  // measured on cloudy_urban quick, it halves the wander of the estimate between windows.
-  backend_options.ba.extrinsic_prior_deg = 0.005;
+  const BackendOptions backend_options = MakeBackendOptions(options);
   StartupCalibrationReport startup;
-  if (options.mode == ExtrinsicsMode::kOnline && options.online_prior_deg > 0.0) {
-    StartupCalibrationOptions sopt;
-    sopt.shots = options.online_startup_shots;
-    sopt.fallback_prior_deg = options.online_prior_deg;
-    sopt.refine_rounds = options.online_bootstrap_rounds;
-    auto load = [&](int frame) { return LoadFrameImages(options.dataset_dir, info.rig, frame); };
-    startup = CalibrateAtStartup(info.rig, cam_from_rig, load, begin, end,
-                                 LoadStaticMasks(options.dataset_dir, info.rig, info.has_static_masks), sopt,
-                                 options.quiet);
-    if (!startup.converged) std::fprintf(stderr, "vo online: WARNING: start-up calibration not converged: %s\n", startup.status.c_str());
+  if (RunsStartupCalibration(options)) {
+    startup = RunStartupCalibration(options, info, begin, end, cam_from_rig);
     cam_from_rig = startup.cam_from_rig;
   }
   FrontendOptions frontend_options;
@@ -592,18 +700,7 @@ VoSummary RunVo(const VoOptions& options) {
     BackendFrameResult result = backend.ProcessFrame(frame, features);
     ms.backend_total += MsSince(backend_start);
     if (options.mode == ExtrinsicsMode::kOnline) frontend.SetExtrinsics(backend.cam_from_rig());
-    ms.warp += features.ms_warp;
-    ms.detect += features.ms_detect;
-    ms.track += features.ms_track;
-    ms.match += features.ms_match;
-    ms.cpu_warp += features.cpu_ms_warp;
-    ms.cpu_detect += features.cpu_ms_detect;
-    ms.cpu_track += features.cpu_ms_track;
-    ms.cpu_match += features.cpu_ms_match;
-    ms.ransac += result.ms_ransac;
-    ms.refine += result.ms_refine;
-    ms.triangulate += result.ms_triangulate;
-    ms.ba += result.ms_ba;  // synchronous BA; async BA is counted in apply_ba_update
+    AddStageTimes(features, result, &ms);
     total_hypotheses += result.ransac_hypotheses;
 
     FrameRecord rec = result.record;
@@ -633,64 +730,11 @@ VoSummary RunVo(const VoOptions& options) {
   }
   if (auto update = backend.FinishPendingBa()) apply_ba_update(*update);
   progress.Finish();
-  const double n = std::max(1, summary.frames);
-  for (double* v : {&ms.warp, &ms.detect, &ms.track, &ms.match, &ms.cpu_warp, &ms.cpu_detect, &ms.cpu_track,
-                    &ms.cpu_match, &ms.load, &ms.ransac, &ms.refine, &ms.triangulate, &ms.ba, &ms.ba_wait,
-                    &ms.backend_total, &ms.total}) {
-    *v /= n;
-  }
-  ms.ransac_us_per_hypothesis = total_hypotheses > 0 ? ms.ransac * n * 1000.0 / total_hypotheses : 0.0;
+  AverageStageTimes(summary.frames, total_hypotheses, &ms);
   summary.mean_inlier_ratio = summary.frames_ok > 0 ? ok_ratio_sum / summary.frames_ok : 0.0;
   summary.mean_reproj_error_deg = summary.frames_ok > 0 ? ok_error_sum / summary.frames_ok : 0.0;
   summary.seconds = std::chrono::duration<double>(Clock::now() - run_start).count();
-
-  const std::string dataset_json = ReadFile(DatasetJsonPath(options.dataset_dir));
-  nlohmann::json& j = run.info;
-  j["mode"] = ExtrinsicsModeName(options.mode);
-  j["dataset"] = std::filesystem::absolute(options.dataset_dir).lexically_normal().string();
-  j["dataset_json_hash"] = HashHex(dataset_json.data(), dataset_json.size());
-  j["scene_hash"] = info.scene_hash;
-  j["dataset_seed"] = info.seed;
-  j["seed"] = options.seed;
-  j["noise_set"] = options.noise_set;
-  j["draw_seed"] = options.draw_seed;
-  j["draw_sigma_deg"] = options.draw_sigma_deg;
-  j["frames"] = {begin, end};
-  j["threads"] = options.threads;
-  j["sampling"] = options.sampling;
-  j["ransac"] = options.ransac;
-  j["generator"] = "rovo vo";
-  j["version"] = ROVO_VERSION;
-  j["initial_world_from_rig"] = PoseJson(world_from_rig0);
-  j["online_prior_deg"] = options.online_prior_deg;
-  j["max_new_features"] = options.max_new_features;
-  j["warp_below_deg"] = options.warp_below_deg;
-  if (options.mode == ExtrinsicsMode::kOnline && options.online_prior_deg > 0.0) j["startup_calibration"] = startup.ToJson();
-  j["backend"] = {{"ransac_tau_deg", backend_options.ransac.tau_rad * 180.0 / M_PI},
-                  {"ransac_max_iterations", backend_options.ransac.max_iterations},
-                  {"ransac_confidence", backend_options.ransac.confidence},
-                  {"refine_cauchy_scale_deg", backend_options.refine.cauchy_scale_rad * 180.0 / M_PI},
-                  {"ba_cauchy_scale_deg", backend_options.ba.cauchy_scale_rad * 180.0 / M_PI},
-                  {"ba_max_iterations", backend_options.ba.max_iterations},
-                  {"ba_online_extrinsics", backend_options.ba.optimize_extrinsics},
-                  {"ba_extrinsic_prior_deg", backend_options.ba.extrinsic_prior_deg},
-                  {"window_keyframes", backend_options.window_keyframes},
-                  {"async_ba", backend_options.async_ba},
-                  {"keyframe_distance_m", backend_options.keyframes.min_translation_m},
-                  {"keyframe_max_frame_gap", backend_options.keyframes.max_frame_gap},
-                  {"online_max_error_deg", backend_options.online_max_error_deg},
-                  {"online_settle_frames", backend_options.online_settle_frames}};
-  j["summary"] = {{"frames", summary.frames},
-                  {"frames_ok", summary.frames_ok},
-                  {"frames_init", summary.frames_init},
-                  {"frames_lost", summary.frames_lost},
-                  {"frames_with_missing_images", summary.frames_with_missing_images},
-                  {"missing_images", summary.missing_images},
-                  {"mean_inlier_ratio", summary.mean_inlier_ratio},
-                  {"mean_reproj_error_deg", summary.mean_reproj_error_deg},
-                  {"seconds", summary.seconds},
-                  {"ms_per_frame", ms.total},
-                  {"ms_backend_per_frame", ms.backend_total}};
+  run.info = RunInfoJson(options, info, backend_options, summary, startup, begin, end, world_from_rig0);
   WriteRun(options.out_dir, run);
   return summary;
 }
