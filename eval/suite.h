@@ -41,7 +41,7 @@ struct SuiteOptions {
   int jobs = 1;                      // VO runs in parallel; each gets cores / jobs threads
   int threads = 0;                   // cores to use; 0 = all
   int vo_threads = 0;                // threads of each VO run; 0 = cores / jobs. 1 makes OnlineExt
-                                     // runs reproducible (README: known limitations)
+                                     // runs reproducible (OnlineExt depends on the thread count)
   std::string data_dir;              // "" = <out>/data
   std::string out_dir;
   uint64_t scene_seed = 0;           // scene / render seed

@@ -49,7 +49,7 @@ double MachineReferenceWarpMs(int cores) {
   return ms[ms.size() / 2];
 }
 
-// --realtime: the two front-end settings that trade some accuracy for speed (README: speed). Measured
+// --realtime: the two front-end settings that trade some accuracy for speed (docs/design-notes.md: warp extents). Measured
 // 2026-11-24 on full-size cloudy_urban (150 frames, idle, images in memory): front-end 63 -> 45.5-47 ms
 // wall per frame, whole pipeline 14.8 -> 19.8-20.4 frames/s; first 300 frames relative RMSE GTExt
 // cloudy_urban 0.012 -> 0.025 %, sunset_urban 0.020 -> 0.018 %, OnlineExt 0.012 -> 0.025 % and
@@ -116,7 +116,7 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
       cmd->add_option("--max-new-features", args->options.max_new_features,
                       "New detections per view and frame at most, while the view has tracks (0: fill up to the target "
                       "count of 600). 150 makes the front-end about a fifth cheaper and the trajectories slightly less "
-                      "accurate (README: speed, whole sequences and quick forms)")
+                      "accurate (docs/design-notes.md, docs/results.md)")
           ->check(CLI::Range(0, 100000))
           ->capture_default_str();
   args->warp_below =
@@ -125,7 +125,7 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
              "Degrees below the rig plane that the hybrid warp reaches; features are tracked and detected only "
              "inside it (recorded in run.json). 25 makes the full-size front-end about 18 % cheaper (the road "
              "beside the vehicle, where fresh features die at once) at neutral full-size accuracy, but costs "
-             "accuracy at small image sizes (README: speed)")
+             "accuracy at small image sizes (docs/design-notes.md: warp extents)")
           ->check(CLI::Range(1.0, 85.0))
           ->capture_default_str();
   cmd->add_option("--keyframe-distance", args->options.keyframe_distance_m,
@@ -136,7 +136,7 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
                 "result, slower; OnlineExt's front-end then sees the calibration one frame earlier)");
   cmd->add_flag("--realtime", args->realtime,
                 "Real-time profile for full-size live rigs: --warp-below 25 --max-new-features 150 unless given "
-                "(front-end about 28 % cheaper, trajectories slightly less accurate; README: speed)");
+                "(front-end about 28 % cheaper, trajectories slightly less accurate; docs/design-notes.md)");
   cmd->add_flag("--quiet", args->options.quiet, "No progress output");
 }
 

@@ -74,7 +74,7 @@ struct FrontendOptions {
   // rotation invariance only adds the intensity-centroid angle's noise. `rovo study projection`, half-size
   // cloudy_urban, 100 frames: descriptor distance along tracks 76.6 -> 53.6 (frame to frame 41.7 -> 22.8),
   // correct matches of the front-end 10634 -> 14487 (precision 94.2 -> 92.9 %). Whole sequences in the
-  // README; canyon_multifov GTExt 0.050 -> 0.038 %. The start-up calibration keeps oriented descriptors
+  // docs/results.md; canyon_multifov GTExt 0.050 -> 0.038 %. The start-up calibration keeps oriented descriptors
   // (its views are rotated against each other by the extrinsic errors).
   bool upright_descriptors = true;
   HybridProjectionOptions projection;   // warp geometry (focal, extents, rebuild threshold)

@@ -64,7 +64,7 @@ struct VoOptions {
   // image centre: 0.29 deg on the full-size rovo4 lenses but 0.60 deg on canyon_multifov's, whose
   // drifted tracks then counted as inliers (reprojection error 0.18 deg). With 0.2 deg, whole
   // sequences: canyon_multifov reprojection 0.178 -> 0.086 deg (GTExt), relative RMSE within the
-  // run-to-run spread on all five presets (README), inlier ratios lower (canyon_multifov OnlineExt
+  // run-to-run spread on all five presets (docs/design-notes.md), inlier ratios lower (canyon_multifov OnlineExt
   // 82 -> 49 %, back to 78 % with BackendOptions::online_settle_frames).
   double ransac_tau_deg = 0.2;
   // Back-end settings exposed on the command line; <= 0 keeps BackendOptions' default.
@@ -77,7 +77,7 @@ struct VoOptions {
   int max_new_features = 0;
   // HybridProjectionOptions::vertical_fov_below_deg: how far below the rig plane the warp reaches
   // (the start-up calibration always uses the full default warp). 25 is a real-time setting, not the
-  // default (README, speed): fresh detections more than 25 deg below the rig plane (the road beside
+  // default (docs/design-notes.md): fresh detections more than 25 deg below the rig plane (the road beside
   // the vehicle) survived their first KLT step 3 % of the time at full size (cloudy_urban, 40 frames:
   // 18485 of 49772 fresh detections, against 12-41 % above), so cutting the warp there makes the
   // full-size front-end about 18 % cheaper with neutral accuracy over 300 frames, but at the quick

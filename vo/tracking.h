@@ -20,7 +20,7 @@ namespace rovo {
 struct TrackerOptions {
   int target_features = 600;         // per view; re-detect when fewer are tracked
   // At most this many new detections per frame while the view has tracks (0: no limit, fill to
-  // target_features). About four in five fresh detections die at their first KLT step (README), so a
+  // target_features). About four in five fresh detections die at their first KLT step (README, known limitations), so a
   // limit saves tracking work; a view without tracks (first frame, after a loss) still fills up.
   int max_new_per_frame = 0;
   float min_feature_distance_px = 12.0f;  // between any two features (detections and tracks)
