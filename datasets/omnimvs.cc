@@ -7,8 +7,10 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 
@@ -266,6 +268,41 @@ Rig MakeRovo4RealRig() {
 
 namespace rovo {
 
+namespace {
+
+// Why `format` is not a printf pattern of exactly two int arguments, or "" when it is.
+std::string ImageFormatProblem(const std::string& format) {
+  if (format.size() > 200) return "longer than 200 characters";
+  int fields = 0;
+  for (size_t i = 0; i < format.size(); ++i) {
+    if (format[i] != '%') continue;
+    if (++i < format.size() && format[i] == '%') continue;
+    while (i < format.size() && std::strchr("-+ 0#", format[i])) ++i;
+    size_t width_digits = 0;
+    while (i < format.size() && std::isdigit(static_cast<unsigned char>(format[i]))) ++i, ++width_digits;
+    if (i >= format.size() || width_digits > 2 || !std::strchr("diuxXo", format[i])) {
+      return "field " + std::to_string(fields + 1) +
+             " is not %d, %i, %u, %x, %X or %o with flags and a width below 100";
+    }
+    ++fields;
+  }
+  if (fields != 2) return std::to_string(fields) + " printf fields, expected 2 (camera id, frame index)";
+  return "";
+}
+
+}  // namespace
+
+std::string OmniMvsImageName(const OmniMvsCapture& capture, int cam_id, int index) {
+  const std::string problem = ImageFormatProblem(capture.img_fmt);
+  if (!problem.empty()) throw std::invalid_argument("img_fmt `" + capture.img_fmt + "`: " + problem);
+  char name[512];
+  const int n = std::snprintf(name, sizeof name, capture.img_fmt.c_str(), cam_id, index);
+  if (n < 0 || n >= static_cast<int>(sizeof name)) {
+    throw std::invalid_argument("img_fmt `" + capture.img_fmt + "`: the file name is too long");
+  }
+  return name;
+}
+
 OmniMvsCapture ReadOmniMvsCapture(const std::string& yaml_path) {
   YAML::Node root;
   try {
@@ -300,8 +337,15 @@ OmniMvsCapture ReadOmniMvsCapture(const std::string& yaml_path) {
                              std::to_string(capture.end) + ", step " + std::to_string(capture.step) +
                              " is not a non-empty range");
   }
-  if (capture.img_fmt.find("%") == std::string::npos) {
-    throw std::runtime_error(yaml_path + ": dataset.img_fmt: `" + capture.img_fmt + "` has no printf fields");
+  const int64_t frames = (static_cast<int64_t>(capture.end) - capture.start) / capture.step + 1;
+  if (frames > 100000000) {
+    throw std::runtime_error(yaml_path + ": dataset: start " + std::to_string(capture.start) + ", end " +
+                             std::to_string(capture.end) + ", step " + std::to_string(capture.step) + " gives " +
+                             std::to_string(frames) + " frames (at most 100000000)");
+  }
+  const std::string problem = ImageFormatProblem(capture.img_fmt);
+  if (!problem.empty()) {
+    throw std::runtime_error(yaml_path + ": dataset.img_fmt: `" + capture.img_fmt + "`: " + problem);
   }
   return capture;
 }
@@ -324,16 +368,14 @@ std::string ImportOmniMvsCapture(const std::string& yaml_path, const std::string
   info.has_ground_truth = false;
   info.has_static_masks = !masks_dir.empty();
   std::vector<int> indices;
-  for (int k = capture.start; k <= capture.end; k += capture.step) indices.push_back(k);
+  for (int64_t k = capture.start; k <= capture.end; k += capture.step) indices.push_back(static_cast<int>(k));
   info.frame_count = static_cast<int>(indices.size());
   fs::create_directories(out_dir);
   for (size_t c = 0; c < info.rig.cameras.size(); ++c) {
     const std::string& name = info.rig.cameras[c].name;
     fs::create_directories(fs::path(out_dir) / name);
     for (size_t f = 0; f < indices.size(); ++f) {
-      char relative[512];
-      std::snprintf(relative, sizeof relative, capture.img_fmt.c_str(), capture.cam_ids[c], indices[f]);
-      const fs::path source = fs::path(images_dir) / relative;
+      const fs::path source = fs::path(images_dir) / OmniMvsImageName(capture, capture.cam_ids[c], indices[f]);
       if (!fs::is_regular_file(source)) {
         throw std::runtime_error(source.string() + ": missing (camera " + std::to_string(capture.cam_ids[c]) +
                                  ", frame index " + std::to_string(indices[f]) + ", from " + yaml_path +

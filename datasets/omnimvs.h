@@ -60,7 +60,12 @@ struct OmniMvsCapture {
   int start = 1, end = 1, step = 1;  // frame indices start, start + step, ... <= end
   std::vector<int> cam_ids;          // per camera, in the file's order
 };
+// Throws std::runtime_error naming the file and field; img_fmt must hold exactly two integer fields
+// (%d, %i, %u, %x, %X or %o with optional flags and a width below 100; %% for a percent sign) in
+// at most 200 characters, and the range at most 100000000 frames.
 OmniMvsCapture ReadOmniMvsCapture(const std::string& yaml_path);
+// The image file of camera `cam_id` at frame index `index`: img_fmt with its two fields filled.
+std::string OmniMvsImageName(const OmniMvsCapture& capture, int cam_id, int index);
 
 // Imports a whole capture as a dataset without ground-truth poses (datasets/FORMAT.md): the rig from
 // the config (ReadOmniMvsConfig), images copied from `images_dir` (PNG, gray or RGB), frame k of the

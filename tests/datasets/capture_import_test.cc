@@ -91,5 +91,31 @@ TEST(CaptureImport, StaticMasksAreCopiedAndValidated) {
   fs::remove_all(masks);
 }
 
+// img_fmt is a printf pattern from the file: only two integer fields (camera id, frame index) are
+// accepted, and the frame range must stay countable (tests/fuzz/omnimvs_fuzz.cc fuzzes this path).
+TEST(CaptureImport, ImageFormatAndRangeFromTheFileAreChecked) {
+  const std::string dir = Scratch("fmt");
+  fs::create_directories(dir);
+  const std::string yaml = dir + "/config.yaml";
+  auto expect_error = [&](const std::string& dataset, const std::string& field) {
+    WriteFileAtomic(yaml, "dataset:\n" + dataset + "cameras:\n  - cam_id: 1\n");
+    try {
+      ReadOmniMvsCapture(yaml);
+      FAIL() << "no error for " << dataset;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(yaml + ": " + field), std::string::npos) << e.what();
+    }
+  };
+  expect_error("  img_fmt: cam%d/%s.png\n", "dataset.img_fmt");
+  expect_error("  img_fmt: cam%d/%05d_%d.png\n", "dataset.img_fmt");
+  expect_error("  img_fmt: cam%d/%0999999d.png\n", "dataset.img_fmt");
+  expect_error("  img_fmt: cam%ld/%d.png\n", "dataset.img_fmt");
+  expect_error("  start: -2147483648\n  end: 2147483647\n", "dataset");
+  WriteFileAtomic(yaml, "dataset:\n  img_fmt: cam%d/%%%05d.png\n  start: 2\n  end: 5\ncameras:\n  - cam_id: 1\n");
+  const OmniMvsCapture capture = ReadOmniMvsCapture(yaml);
+  EXPECT_EQ(OmniMvsImageName(capture, 1, 3), "cam1/%00003.png");
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace rovo
