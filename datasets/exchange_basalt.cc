@@ -1,6 +1,7 @@
 // Basalt calibration JSON: the cereal object under "value0" that Basalt's loader needs whole
 // (T_imu_cam per camera with the rig as the IMU, intrinsics with camera_type, integer
 // resolutions, IMU biases and noise, cam_time_offset_ns, vignette).
+#include <cmath>
 #include <stdexcept>
 
 #include "datasets/exchange.h"
@@ -39,7 +40,9 @@ double Number(const nlohmann::json& object, const std::string& key, const std::s
   if (!object.is_object() || !object.contains(key) || !object[key].is_number()) {
     throw std::runtime_error(what + "/" + key + ": missing or not a number");
   }
-  return object[key].get<double>();
+  const double value = object[key].get<double>();
+  if (!std::isfinite(value)) throw std::runtime_error(what + "/" + key + ": not finite");
+  return value;
 }
 
 }  // namespace
@@ -111,6 +114,11 @@ std::vector<ExchangeCamera> ReadBasaltCalibration(const std::string& path) {
     if (!resolution.is_array() || resolution.size() != 2 || !resolution[0].is_number_integer() ||
         !resolution[1].is_number_integer()) {
       throw std::runtime_error(where + "resolution" + index + ": expected [width, height] integers");
+    }
+    for (const nlohmann::json& v : resolution) {
+      if (v.get<int64_t>() < 1 || v.get<int64_t>() > 65536) {
+        throw std::runtime_error(where + "resolution" + index + ": expected [width, height] in [1, 65536]");
+      }
     }
     camera.width = resolution[0].get<int>();
     camera.height = resolution[1].get<int>();

@@ -69,11 +69,20 @@ ExchangeCamera ReadEurocSensorYaml(const std::string& path, const std::string& n
   if (data.size() != 16) throw std::runtime_error(path + ": T_BS/data: expected 16 numbers");
   Eigen::Matrix4d body_from_sensor;
   for (int i = 0; i < 16; ++i) body_from_sensor(i / 4, i % 4) = data[static_cast<size_t>(i)];
+  const Eigen::Matrix3d rotation = body_from_sensor.topLeftCorner<3, 3>();
+  if ((rotation * rotation.transpose() - Eigen::Matrix3d::Identity()).norm() > 1e-6 || rotation.determinant() < 0) {
+    throw std::runtime_error(path + ": T_BS/data: the 3x3 block is not a rotation");
+  }
   camera.cam_from_rig = Rigid3(Eigen::Matrix3d(body_from_sensor.topLeftCorner<3, 3>()),
                                Eigen::Vector3d(body_from_sensor.topRightCorner<3, 1>()))
                             .Inverse();
   const std::vector<double> resolution = ReadNumbers(root["resolution"], path, "resolution");
   if (resolution.size() != 2) throw std::runtime_error(path + ": resolution: expected [width, height]");
+  for (double v : resolution) {
+    if (!(v >= 1 && v <= 65536 && v == std::floor(v))) {
+      throw std::runtime_error(path + ": resolution: expected whole numbers in [1, 65536]");
+    }
+  }
   camera.width = static_cast<int>(resolution[0]);
   camera.height = static_cast<int>(resolution[1]);
   KalibrLensFields lens;

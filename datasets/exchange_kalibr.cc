@@ -29,7 +29,31 @@ std::vector<double> Numbers(const YAML::Node& node, const std::string& what) {
   } catch (const YAML::Exception&) {
     throw std::runtime_error(what + ": not a list of numbers");
   }
+  for (double v : out) {
+    if (!std::isfinite(v)) throw std::runtime_error(what + ": not finite");
+  }
   return out;
+}
+
+// [width, height]: whole numbers in [1, 65536] (the dataset format's bound).
+void ReadResolution(const YAML::Node& node, const std::string& what, int* width, int* height) {
+  const std::vector<double> resolution = Numbers(node, what);
+  if (resolution.size() != 2) throw std::runtime_error(what + ": expected [width, height]");
+  for (double v : resolution) {
+    if (!(v >= 1 && v <= 65536 && v == std::floor(v))) {
+      throw std::runtime_error(what + ": expected whole numbers in [1, 65536]");
+    }
+  }
+  *width = static_cast<int>(resolution[0]);
+  *height = static_cast<int>(resolution[1]);
+}
+
+std::string Text(const YAML::Node& node, const std::string& what) {
+  try {
+    return node.as<std::string>();
+  } catch (const YAML::Exception&) {
+    throw std::runtime_error(what + ": not a string");
+  }
 }
 
 Rigid3 ReadMatrix(const YAML::Node& node, const std::string& what) {
@@ -93,6 +117,7 @@ std::vector<ExchangeCamera> ReadKalibrCamchain(const std::string& path) {
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(path + ": " + e.what());
   }
+  if (!root.IsMap()) throw std::runtime_error(path + ": expected a map of cameras cam0, cam1, ...");
   std::vector<ExchangeCamera> cameras;
   bool all_have_imu = true;
   for (int i = 0; root["cam" + std::to_string(i)]; ++i) {
@@ -103,20 +128,13 @@ std::vector<ExchangeCamera> ReadKalibrCamchain(const std::string& path) {
     camera.name = key;
     KalibrLensFields lens;
     if (!node.IsMap() || !node["camera_model"]) throw std::runtime_error(what + "/camera_model: missing");
-    try {
-      lens.camera_model = node["camera_model"].as<std::string>();
-    } catch (const YAML::Exception&) {
-      throw std::runtime_error(what + "/camera_model: not a string");
-    }
+    lens.camera_model = Text(node["camera_model"], what + "/camera_model");
     lens.intrinsics = Numbers(node["intrinsics"], what + "/intrinsics");
-    lens.distortion_model = node["distortion_model"] ? node["distortion_model"].as<std::string>() : "none";
+    lens.distortion_model = node["distortion_model"] ? Text(node["distortion_model"], what + "/distortion_model") : "none";
     if (node["distortion_coeffs"])
       lens.distortion_coeffs = Numbers(node["distortion_coeffs"], what + "/distortion_coeffs");
     FromKalibrFields(lens, what, &camera.model, &camera.params);
-    const std::vector<double> resolution = Numbers(node["resolution"], what + "/resolution");
-    if (resolution.size() != 2) throw std::runtime_error(what + "/resolution: expected [width, height]");
-    camera.width = static_cast<int>(resolution[0]);
-    camera.height = static_cast<int>(resolution[1]);
+    ReadResolution(node["resolution"], what + "/resolution", &camera.width, &camera.height);
     if (node["T_cam_imu"]) {
       camera.cam_from_rig = ReadMatrix(node["T_cam_imu"], what + "/T_cam_imu");
     } else {

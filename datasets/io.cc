@@ -58,7 +58,8 @@ nlohmann::json ReadJsonFile(const std::string& path) {
   const std::string text = ReadFile(path);
   try {
     return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {
+    // parse_error, and out_of_range for a number that overflows (e.g. 1e99999999999).
     throw std::runtime_error(path + ": malformed JSON: " + e.what());
   }
 }

@@ -199,6 +199,7 @@ Rig ReadOmniMvsConfig(const std::string& yaml_path, std::string* report) {
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(yaml_path + ": cannot parse YAML: " + e.what());
   }
+  if (!root.IsMap()) throw std::runtime_error(yaml_path + ": expected a map with `cameras`");
   const YAML::Node cameras = root["cameras"];
   if (!cameras || !cameras.IsSequence() || cameras.size() == 0) {
     throw std::runtime_error(yaml_path + ": cameras: expected a non-empty list");
@@ -310,6 +311,7 @@ OmniMvsCapture ReadOmniMvsCapture(const std::string& yaml_path) {
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(yaml_path + ": cannot parse YAML: " + e.what());
   }
+  if (!root.IsMap()) throw std::runtime_error(yaml_path + ": expected a map with `dataset` and `cameras`");
   OmniMvsCapture capture;
   const YAML::Node dataset = root["dataset"];
   std::string field = "dataset";

@@ -16,6 +16,24 @@ std::string Fmt(double value) {
   return buffer;
 }
 
+// The suite's mean of a metric (suite.json /presets/<preset>/modes/<mode>/<metric>, with n > 0 runs),
+// or none when any part is missing or not of the expected type.
+std::optional<double> SuiteMean(const nlohmann::json& suite, const std::string& preset, const std::string& mode,
+                                const std::string& metric) {
+  const nlohmann::json* node = &suite;
+  for (const std::string& key : {std::string("presets"), preset, std::string("modes"), mode, metric}) {
+    if (!node->is_object()) return std::nullopt;
+    const auto it = node->find(key);
+    if (it == node->end()) return std::nullopt;
+    node = &*it;
+  }
+  if (!node->is_object()) return std::nullopt;
+  const auto n = node->find("n"), mean = node->find("mean");
+  if (n == node->end() || !n->is_number() || !(n->get<double>() > 0)) return std::nullopt;
+  if (mean == node->end() || !mean->is_number()) return std::nullopt;
+  return mean->get<double>();
+}
+
 }  // namespace
 
 std::vector<GateCheck> CheckGates(const nlohmann::json& gates, const std::string& gates_what,
@@ -48,12 +66,11 @@ std::vector<GateCheck> CheckGates(const nlohmann::json& gates, const std::string
     if (!bound.is_number()) throw std::runtime_error(where + ": field \"" + (has_max ? "max" : "min") + "\" must be a number");
     c.is_max = has_max;
     c.bound = bound.get<double>();
-    c.note = g.value("note", std::string());
-    const nlohmann::json::json_pointer pointer("/presets/" + c.preset + "/modes/" + c.mode + "/" + c.metric);
-    if (suite.contains(pointer)) {
-      const nlohmann::json& stat = suite[pointer];
-      if (stat.contains("n") && stat["n"].get<int>() > 0 && stat["mean"].is_number()) c.value = stat["mean"].get<double>();
+    if (g.contains("note")) {
+      if (!g["note"].is_string()) throw std::runtime_error(where + ": field \"note\" must be a string");
+      c.note = g["note"].get<std::string>();
     }
+    c.value = SuiteMean(suite, c.preset, c.mode, c.metric);
     c.pass = c.value && (c.is_max ? *c.value <= c.bound : *c.value >= c.bound);
     checks.push_back(c);
   }
