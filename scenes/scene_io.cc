@@ -446,6 +446,17 @@ Mesh ReadMesh(const Field& f, BufferCache& buffers, const std::string& file, int
   const std::string& buffer = buffers.Get(buffer_name, file, f.path() + ".buffer");
   const int64_t nv = f["vertex_count"].Int(0, INT32_MAX);
   const int64_t nt = f["triangle_count"].Int(0, INT32_MAX);
+  // Counts the buffer cannot hold fail before anything is allocated for them.
+  if (static_cast<size_t>(nv) * 3 * sizeof(float) > buffer.size()) {
+    Fail(file, f.path() + ".vertex_count",
+         std::to_string(nv) + " vertices do not fit in buffer '" + buffer_name + "' of " +
+             std::to_string(buffer.size()) + " bytes");
+  }
+  if (static_cast<size_t>(nt) * 3 * sizeof(int32_t) > buffer.size()) {
+    Fail(file, f.path() + ".triangle_count",
+         std::to_string(nt) + " triangles do not fit in buffer '" + buffer_name + "' of " +
+             std::to_string(buffer.size()) + " bytes");
+  }
   m.positions.resize(nv);
   CopyFromBuffer(buffer, f["positions_offset"].Int(0, INT64_MAX), nv, 3 * sizeof(float), m.positions.data(), file,
                  f.path() + ".positions_offset", buffer_name);

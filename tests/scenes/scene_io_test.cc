@@ -194,6 +194,13 @@ TEST(SceneIo, ErrorsNameFileAndField) {
     SaveScene(scene, dir);
     EditJson(dir, [](nlohmann::json& j) { j["meshes"][1]["triangle_count"] = 1000; });
     const std::string err = LoadError(dir);
+    EXPECT_NE(err.find("meshes[1].triangle_count"), std::string::npos) << err;  // checked before allocating
+  }
+  {
+    const std::string dir = FreshDir("short_buffer_offset");
+    SaveScene(scene, dir);
+    EditJson(dir, [](nlohmann::json& j) { j["meshes"][1]["triangles_offset"] = 1 << 20; });
+    const std::string err = LoadError(dir);
     EXPECT_NE(err.find("meshes[1].triangles_offset"), std::string::npos) << err;
   }
   {
