@@ -53,7 +53,8 @@ ViewGeometry MakeViewGeometry(const Rig& rig, int a, int b, const RingCalibratio
   g.rig_from_view.col(0) = m;
   g.rig_from_view.col(2) = Eigen::Vector3d::UnitZ();
   g.rig_from_view.col(1) = Eigen::Vector3d::UnitZ().cross(m);
-  g.focal = std::min(PixelsPerRadianAt90(rig.cameras[a].camera), PixelsPerRadianAt90(rig.cameras[b].camera));
+  g.focal = std::max(options.min_view_focal_px,
+                     std::min(PixelsPerRadianAt90(rig.cameras[a].camera), PixelsPerRadianAt90(rig.cameras[b].camera)));
   g.width = static_cast<int>(std::lround(2.0 * options.view_half_width_deg * kDeg * g.focal));
   g.height = static_cast<int>(std::lround(2.0 * options.view_half_height_deg * kDeg * g.focal));
   return g;
@@ -174,7 +175,7 @@ void RingCalibrationOptions::Check() const {
     throw std::invalid_argument("RingCalibrationOptions: view extents must be in (0, 90) deg");
   }
   if (!(max_ratio > 0.0 && max_ratio <= 1.0)) throw std::invalid_argument("RingCalibrationOptions: max_ratio in (0, 1]");
-  if (!(ransac_threshold_px > 0.0) || ransac_iterations < 1 || min_inliers < 5 || orb_features < 10) {
+  if (!(inlier_threshold_deg > 0.0) || ransac_iterations < 1 || min_inliers < 5 || orb_features < 10) {
     throw std::invalid_argument("RingCalibrationOptions: threshold, iterations, min_inliers or orb_features out of range");
   }
 }
@@ -282,6 +283,20 @@ struct FixedBaselineEpipolarError {
   Eigen::Vector3d normal_in_a, bearing_b;
 };
 
+// Whether the rays from camera a along `ray_a` and from camera b (at `baseline_in_a`, direction only)
+// along `ray_b` (both in a's frame) meet in front of both cameras. Nearly parallel rays (a far
+// point) pass: their depths are not determined.
+bool InFrontOfBoth(const Eigen::Vector3d& ray_a, const Eigen::Vector3d& ray_b, const Eigen::Vector3d& baseline_in_a) {
+  // depth_a ray_a - depth_b ray_b = baseline, in the least-squares sense.
+  const double aa = ray_a.dot(ray_a), ab = ray_a.dot(ray_b), bb = ray_b.dot(ray_b);
+  const double det = aa * bb - ab * ab;
+  if (det < 1e-6) return true;  // rays within about 0.06 deg of each other
+  const double ta = ray_a.dot(baseline_in_a), tb = ray_b.dot(baseline_in_a);
+  const double depth_a = (bb * ta - ab * tb) / det;
+  const double depth_b = (ab * ta - aa * tb) / det;
+  return depth_a > 0.0 && depth_b > 0.0;
+}
+
 // R_ab minimising the robust epipolar residuals of the matches `used` for the baseline direction
 // `baseline_in_a`, from `start`.
 Eigen::Quaterniond RefineWithBaseline(const opengv::bearingVectors_t& bearings_a, const opengv::bearingVectors_t& bearings_b,
@@ -324,22 +339,28 @@ RingPairEstimate EstimatePair(const PairState& p, const Rig& rig, const RingCali
   ransac.threshold_ = 1.0 - std::cos(o.max_parallax_deg * kDeg);
   ransac.max_iterations_ = o.ransac_iterations;
   if (!ransac.computeModel() || static_cast<int>(ransac.inliers_.size()) < o.min_inliers) return e;
+  const std::vector<int>& ransac_inliers = ransac.inliers_;
+  const Eigen::Matrix3d r12 = ransac.model_coefficients_;
   // OpenGV's R12 maps viewpoint 2 (b) into viewpoint 1 (a).
-  Eigen::Quaterniond a_from_b(Eigen::Matrix3d(ransac.model_coefficients_));
+  Eigen::Quaterniond a_from_b(r12);
   const Rigid3& cam_a = rig.cameras[p.a].cam_from_rig;
   const Eigen::Vector3d baseline_in_a =
       (cam_a.rotation * (CameraPositionInRig(rig.cameras[p.b].cam_from_rig) - CameraPositionInRig(cam_a))).normalized();
-  const double threshold = o.ransac_threshold_px / p.geometry.focal;
-  std::vector<int> used = ransac.inliers_;
+  const double threshold = o.inlier_threshold_deg * kDeg;
+  std::vector<int> used = ransac_inliers;
   for (int round = 0; round < 3; ++round) {
     a_from_b = RefineWithBaseline(p.bearings_a, p.bearings_b, used, baseline_in_a, a_from_b, threshold);
     std::vector<int> next;
-    for (int k : ransac.inliers_) {
+    const int candidates = o.reselect_all ? e.matches : static_cast<int>(ransac_inliers.size());
+    for (int c = 0; c < candidates; ++c) {
+      const int k = o.reselect_all ? c : ransac_inliers[c];
       const FixedBaselineEpipolarError f(p.bearings_a[k], p.bearings_b[k], baseline_in_a);
       double r = 0.0;
       const double q[4] = {a_from_b.x(), a_from_b.y(), a_from_b.z(), a_from_b.w()};
       f(q, &r);
-      if (std::abs(r) < threshold) next.push_back(k);
+      if (std::abs(r) < threshold && InFrontOfBoth(p.bearings_a[k], a_from_b * p.bearings_b[k], baseline_in_a)) {
+        next.push_back(k);
+      }
     }
     used.swap(next);
     if (static_cast<int>(used.size()) < o.min_inliers) return e;
@@ -418,6 +439,105 @@ std::vector<Eigen::Quaterniond> RefineRing(const std::vector<PairState>& pairs, 
   return rotations;
 }
 
+// One-sigma uncertainty (degrees) of the worst-determined camera's rotation relative to camera 0 at
+// the joint solution: the covariance of the epipolar least-squares problem on the inliers with
+// camera 0 held, scaled by the residuals' robust variance, largest eigenvalue over cameras 1..N-1.
+// A near-field overlap leaves the rotation about the epipolar planes' normal (roughly the yaw of a
+// pair) nearly free, because depth absorbs it: this is where that shows. -1: not computable.
+double RingUncertaintyDeg(const std::vector<PairState>& pairs, const std::vector<std::vector<int>>& inliers,
+                          const Rig& rig, std::vector<Eigen::Quaterniond> rotations) {
+  ceres::Problem problem;
+  for (auto& q : rotations) problem.AddParameterBlock(q.coeffs().data(), 4, new ceres::EigenQuaternionManifold);
+  problem.SetParameterBlockConstant(rotations[0].coeffs().data());
+  std::vector<double> residuals;
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const PairState& p = pairs[k];
+    const Eigen::Vector3d baseline = CameraPositionInRig(rig.cameras[p.b].cam_from_rig) -
+                                     CameraPositionInRig(rig.cameras[p.a].cam_from_rig);
+    for (int i : inliers[k]) {
+      const RingEpipolarError e(p.bearings_a[i], p.bearings_b[i], baseline);
+      double r = 0.0;
+      e(rotations[p.a].coeffs().data(), rotations[p.b].coeffs().data(), &r);
+      residuals.push_back(std::abs(r));
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<RingEpipolarError, 1, 4, 4>(new RingEpipolarError(e)),
+                               nullptr, rotations[p.a].coeffs().data(), rotations[p.b].coeffs().data());
+    }
+  }
+  if (residuals.size() < 10) return -1.0;
+  std::nth_element(residuals.begin(), residuals.begin() + residuals.size() / 2, residuals.end());
+  const double sigma = 1.4826 * residuals[residuals.size() / 2];
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::DENSE_SVD;
+  options.null_space_rank = -1;
+  ceres::Covariance covariance(options);
+  std::vector<std::pair<const double*, const double*>> blocks;
+  for (size_t j = 1; j < rotations.size(); ++j) blocks.emplace_back(rotations[j].coeffs().data(), rotations[j].coeffs().data());
+  if (!covariance.Compute(blocks, &problem)) return -1.0;
+  double worst = 0.0;
+  for (size_t j = 1; j < rotations.size(); ++j) {
+    Eigen::Matrix3d c;
+    covariance.GetCovarianceMatrixInTangentSpace({rotations[j].coeffs().data()}, c.data());
+    const double largest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(c).eigenvalues().maxCoeff();
+    // Ceres' quaternion tangent is half the rotation vector.
+    worst = std::max(worst, 2.0 * std::sqrt(std::max(0.0, largest)) * sigma / kDeg);
+  }
+  return worst;
+}
+
+// Per pair, the indices of the matches that the joint rotations (cam_j_from_rig) explain: epipolar
+// residual (RingEpipolarError) below `threshold_rad` and the rays meeting in front of both cameras.
+std::vector<std::vector<int>> ReselectInliers(const std::vector<PairState>& pairs, const Rig& rig,
+                                              const std::vector<Eigen::Quaterniond>& rotations, double threshold_rad) {
+  std::vector<std::vector<int>> out(pairs.size());
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const PairState& p = pairs[k];
+    const Eigen::Quaterniond& qa = rotations[p.a];
+    const Eigen::Quaterniond a_from_b = qa * rotations[p.b].conjugate();
+    const Eigen::Vector3d baseline_in_rig =
+        CameraPositionInRig(rig.cameras[p.b].cam_from_rig) - CameraPositionInRig(rig.cameras[p.a].cam_from_rig);
+    const Eigen::Vector3d baseline_in_a = (qa * baseline_in_rig).normalized();
+    for (size_t i = 0; i < p.bearings_a.size(); ++i) {
+      const RingEpipolarError e(p.bearings_a[i], p.bearings_b[i], baseline_in_rig);
+      double r = 0.0;
+      e(qa.coeffs().data(), rotations[p.b].coeffs().data(), &r);
+      if (std::abs(r) < threshold_rad && InFrontOfBoth(p.bearings_a[i], a_from_b * p.bearings_b[i], baseline_in_a)) {
+        out[k].push_back(static_cast<int>(i));
+      }
+    }
+  }
+  return out;
+}
+
+// Median |RingEpipolarError| over `indices` of pair `p` under the cam_j_from_rig `rotations`, degrees.
+double MedianResidualDeg(const PairState& p, const std::vector<int>& indices, const Rig& rig,
+                         const std::vector<Eigen::Quaterniond>& rotations) {
+  if (indices.empty()) return -1.0;
+  const Eigen::Vector3d baseline_in_rig =
+      CameraPositionInRig(rig.cameras[p.b].cam_from_rig) - CameraPositionInRig(rig.cameras[p.a].cam_from_rig);
+  std::vector<double> residuals;
+  for (int i : indices) {
+    double r = 0.0;
+    RingEpipolarError(p.bearings_a[i], p.bearings_b[i], baseline_in_rig)(rotations[p.a].coeffs().data(),
+                                                                           rotations[p.b].coeffs().data(), &r);
+    residuals.push_back(std::abs(r));
+  }
+  std::nth_element(residuals.begin(), residuals.begin() + residuals.size() / 2, residuals.end());
+  return std::asin(std::min(1.0, residuals[residuals.size() / 2])) / kDeg;
+}
+
+// Angle between the joint rotation of a pair and the pair's own rotation refined on its inliers alone
+// with the joint baseline direction: how far the pair's matches pull away from the ring solution.
+double PairDisagreementDeg(const PairState& p, const std::vector<int>& inliers, const Rig& rig,
+                           const std::vector<Eigen::Quaterniond>& rotations, double scale_rad) {
+  const Eigen::Quaterniond& qa = rotations[p.a];
+  const Eigen::Quaterniond joint_a_from_b = qa * rotations[p.b].conjugate();
+  const Eigen::Vector3d baseline_in_a =
+      (qa * (CameraPositionInRig(rig.cameras[p.b].cam_from_rig) - CameraPositionInRig(rig.cameras[p.a].cam_from_rig)))
+          .normalized();
+  const Eigen::Quaterniond own = RefineWithBaseline(p.bearings_a, p.bearings_b, inliers, baseline_in_a, joint_a_from_b, scale_rad);
+  return RotationDistanceDeg(own, joint_a_from_b);
+}
+
 // cam_j_from_cam0 rotations by chaining usable pairs outward from camera 0 (breadth first); false
 // when some camera is not reached.
 bool ChainFromCameraZero(const std::vector<RingPairEstimate>& pairs, int num_cams,
@@ -457,6 +577,47 @@ double LoopClosureErrorDeg(const std::vector<RingPairEstimate>& pairs, int num_c
   return worst;
 }
 
+struct JointSolution {
+  std::vector<Eigen::Quaterniond> rotations;  // cam_j_from_rig
+  std::vector<std::vector<int>> inliers;      // per pair
+  int total_inliers = -1;
+};
+
+// The joint refinement (RefineRing) from `start` (cam_j_from_rig) on the pairs' own inliers, then
+// `joint_rounds` times: inliers re-selected from every match by the joint solution, refined again.
+JointSolution SolveJoint(const std::vector<PairState>& pairs, const std::vector<std::vector<int>>& pair_inliers,
+                         const Rig& rig, const std::vector<Eigen::Quaterniond>& start, const RingCalibrationOptions& o) {
+  const double scale = o.inlier_threshold_deg * kDeg;
+  JointSolution s;
+  s.inliers = pair_inliers;
+  s.rotations = RefineRing(pairs, s.inliers, rig, start, scale, o.prior_sigma_deg);
+  for (int round = 0; round < o.joint_rounds; ++round) {
+    s.inliers = ReselectInliers(pairs, rig, s.rotations, scale);
+    s.rotations = RefineRing(pairs, s.inliers, rig, s.rotations, scale, o.prior_sigma_deg);
+  }
+  s.inliers = ReselectInliers(pairs, rig, s.rotations, scale);
+  s.total_inliers = 0;
+  for (const auto& v : s.inliers) s.total_inliers += static_cast<int>(v.size());
+  return s;
+}
+
+// Starting points (cam_j_from_cam0) of the joint refinement: the pairs averaged around the ring
+// (AverageRing from the chain `chained`) and, for a closed ring, the chain that leaves out each pair
+// in turn. The pairs' own rotations are biased by the given baseline directions (off by the draw), so
+// one start can fall into another minimum of the joint problem on near-field scenes.
+std::vector<std::vector<Eigen::Quaterniond>> JointStarts(const std::vector<RingPairEstimate>& pairs, int num_cams,
+                                                         const std::vector<Eigen::Quaterniond>& chained) {
+  std::vector<std::vector<Eigen::Quaterniond>> starts = {AverageRing(pairs, num_cams, chained)};
+  for (size_t left_out = 0; left_out < pairs.size(); ++left_out) {
+    if (!pairs[left_out].usable) continue;
+    std::vector<RingPairEstimate> others = pairs;
+    others[left_out].usable = false;
+    std::vector<Eigen::Quaterniond> chain;
+    if (ChainFromCameraZero(others, num_cams, &chain)) starts.push_back(chain);
+  }
+  return starts;
+}
+
 }  // namespace
 
 RingCalibrationReport RingCalibrator::Solve() const {
@@ -479,20 +640,47 @@ RingCalibrationReport RingCalibrator::Solve() const {
     return report;
   }
   report.loop_error_deg = LoopClosureErrorDeg(report.pairs, n);
+  if (o.require_closed_ring && report.loop_error_deg < 0.0 && n >= 3 && static_cast<int>(report.pairs.size()) == n) {
+    report.reason = "the ring is open (a pair has too few overlap matches), so nothing checks the chained pairs (pairs:";
+    for (const RingPairEstimate& p : report.pairs) {
+      report.reason += " " + std::to_string(p.camera_a) + "-" + std::to_string(p.camera_b) + " " +
+                       std::to_string(p.inliers) + "/" + std::to_string(p.matches);
+    }
+    report.reason += " inliers/matches)";
+    return report;
+  }
   if (report.loop_error_deg > o.max_loop_error_deg) {
     report.reason = "the pair rotations do not close the ring (loop error " + std::to_string(report.loop_error_deg) +
                     " deg > " + std::to_string(o.max_loop_error_deg) + ")";
     return report;
   }
-  rotations = AverageRing(report.pairs, n, rotations);  // cam_j_from_cam0
   const Eigen::Quaterniond cam0_from_rig = rig.cameras[0].cam_from_rig.rotation;
-  for (auto& q : rotations) q = (q * cam0_from_rig).normalized();  // cam_j_from_rig
-  const double scale = o.ransac_threshold_px / impl_->pairs.front().geometry.focal;
-  rotations = RefineRing(impl_->pairs, inliers, rig, rotations, scale, o.prior_sigma_deg);
-  for (RingPairEstimate& p : report.pairs) {
+  JointSolution best;
+  for (const std::vector<Eigen::Quaterniond>& start : JointStarts(report.pairs, n, rotations)) {
+    std::vector<Eigen::Quaterniond> start_from_rig = start;
+    for (auto& q : start_from_rig) q = (q * cam0_from_rig).normalized();  // cam_j_from_rig
+    JointSolution candidate = SolveJoint(impl_->pairs, inliers, rig, start_from_rig, o);
+    if (candidate.total_inliers > best.total_inliers) best = std::move(candidate);
+  }
+  rotations = best.rotations;
+  inliers = best.inliers;
+  const double scale = o.inlier_threshold_deg * kDeg;
+  std::vector<Eigen::Quaterniond> given;
+  for (const RigCamera& c : rig.cameras) given.push_back(c.cam_from_rig.rotation);
+  report.uncertainty_deg = RingUncertaintyDeg(impl_->pairs, inliers, rig, rotations);
+  for (size_t k = 0; k < impl_->pairs.size(); ++k) {
+    RingPairEstimate& p = report.pairs[k];
     if (!p.usable) continue;
-    const Eigen::Quaterniond joint = rotations[p.camera_b] * rotations[p.camera_a].inverse();
-    report.max_pair_disagreement_deg = std::max(report.max_pair_disagreement_deg, RotationDistanceDeg(joint, p.camb_from_cama));
+    p.inliers = static_cast<int>(inliers[k].size());
+    p.median_residual_deg_given = MedianResidualDeg(impl_->pairs[k], inliers[k], rig, given);
+    p.median_residual_deg_result = MedianResidualDeg(impl_->pairs[k], inliers[k], rig, rotations);
+    report.max_pair_disagreement_deg =
+        std::max(report.max_pair_disagreement_deg, PairDisagreementDeg(impl_->pairs[k], inliers[k], rig, rotations, scale));
+  }
+  if (report.uncertainty_deg < 0.0 || report.uncertainty_deg > o.max_uncertainty_deg) {
+    report.reason = "the overlaps leave a camera's rotation uncertain (one sigma " + std::to_string(report.uncertainty_deg) +
+                    " deg > " + std::to_string(o.max_uncertainty_deg) + ")";
+    return report;
   }
   if (report.max_pair_disagreement_deg > o.max_pair_disagreement_deg) {
     report.reason = "a pair's own rotation is " + std::to_string(report.max_pair_disagreement_deg) +

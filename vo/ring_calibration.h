@@ -39,17 +39,22 @@ namespace rovo {
 struct RingCalibrationOptions {
   double view_half_width_deg = 65.0;   // longitude extent of an overlap view (each side of m)
   double view_half_height_deg = 60.0;  // latitude extent (each side of the horizon)
+  double min_view_focal_px = 300.0;    // overlap views sample at least this density (pixels per radian)
   int orb_features = 3000;             // per overlap view
   int orb_fast_threshold = 10;
   double max_ratio = 0.8;              // best / second-best Hamming distance
   int max_descriptor_distance = 80;
   double max_prior_angle_deg = 40.0;   // gross-outlier bound on the nominal rig-frame bearings
   double max_parallax_deg = 5.0;       // rotation-only RANSAC threshold (parallax of near points)
-  double ransac_threshold_px = 1.0;    // epipolar threshold, in overlap-view pixels
+  bool reselect_all = true;            // final inliers from every match, not only the RANSAC's
+  double inlier_threshold_deg = 0.4;   // epipolar residual of an inlier (and the Cauchy scale)
   int ransac_iterations = 2000;
   int min_inliers = 25;                // fewer: the pair is not estimated
-  double max_loop_error_deg = 5.0;     // larger loop-closure error of the pairs: not converged
-  double max_pair_disagreement_deg = 3.0;  // a pair further from the joint ring solution: not converged
+  double max_loop_error_deg = 12.0;    // larger loop-closure error of the pairs: not converged
+  double max_pair_disagreement_deg = 1.0;  // a pair further from the joint ring solution: not converged
+  bool require_closed_ring = true;     // every ring pair estimated (the loop checks them), else not converged
+  double max_uncertainty_deg = 0.25;   // one sigma of the worst camera (RingUncertaintyDeg) above: not converged
+  int joint_rounds = 2;                // inliers re-selected by the joint solution, then refined again
   double prior_sigma_deg = 5.0;        // joint refinement: camera 0's prior (the common rotation)
   void Check() const;
 };
@@ -61,6 +66,9 @@ struct RingPairEstimate {
   bool usable = false;
   Eigen::Quaterniond camb_from_cama = Eigen::Quaterniond::Identity();  // R_ba
   double change_deg = 0.0;             // angle between R_ba and the nominal one
+  // Median |epipolar residual| of the final inliers under the given extrinsics and under the result
+  // (degrees; -1 when the ring did not converge): how much better the result explains the overlaps.
+  double median_residual_deg_given = -1.0, median_residual_deg_result = -1.0;
 };
 
 struct RingCalibrationReport {
@@ -70,6 +78,7 @@ struct RingCalibrationReport {
   std::vector<RingPairEstimate> pairs;
   double loop_error_deg = -1.0;        // < 0: the ring is not closed (a pair missing, or N < 3)
   double max_pair_disagreement_deg = 0.0;  // largest angle between a pair's own and the joint rotation
+  double uncertainty_deg = -1.0;       // one sigma of the worst-determined camera (RingUncertaintyDeg)
   std::vector<Rigid3> cam_from_rig;    // calibrated (camera 0 and every centre unchanged)
 };
 

@@ -71,6 +71,38 @@ void PrintRing(const RingCalibrationReport& ring) {
                ring.reason.c_str());
 }
 
+RingCalibrationReport RunRingPass(const Rig& rig, const std::vector<Rigid3>& cam_from_rig,
+                                  const std::vector<std::vector<cv::Mat>>& shots, const std::vector<cv::Mat>& static_masks,
+                                  const RingCalibrationOptions& options) {
+  RingCalibrator ring(rig.WithExtrinsics(cam_from_rig), static_masks, options);
+  for (const auto& images : shots) ring.AddFrame(images);
+  return ring.Solve();
+}
+
+// The ring stage, then again with the overlap views placed by its result: where the given
+// extrinsics were far off, the first pass saw the overlaps off-centre and rotated. The second pass
+// must confirm the first (max_pass_change_deg), else the result depends on where the views were
+// placed and is not trusted.
+RingCalibrationReport RunRingPasses(const Rig& rig, const std::vector<Rigid3>& cam_from_rig,
+                                    const std::vector<std::vector<cv::Mat>>& shots,
+                                    const std::vector<cv::Mat>& static_masks, const StartupCalibrationOptions& options,
+                                    bool quiet) {
+  RingCalibrationReport first = RunRingPass(rig, cam_from_rig, shots, static_masks, options.ring);
+  if (!quiet) PrintRing(first);
+  if (!first.converged || options.ring_passes < 2) return first;
+  RingCalibrationReport second = RunRingPass(rig, first.cam_from_rig, shots, static_masks, options.ring);
+  if (!quiet) PrintRing(second);
+  if (!second.converged) return second;
+  const double change = LargestChangeDeg(first.cam_from_rig, second.cam_from_rig);
+  if (change > options.max_pass_change_deg) {
+    second.converged = false;
+    second.reason = "the second pass, with the overlap views placed by the first, moved a camera " +
+                    std::to_string(change) + " deg (> " + std::to_string(options.max_pass_change_deg) +
+                    "): the overlaps do not determine the extrinsics";
+  }
+  return second;
+}
+
 }  // namespace
 
 nlohmann::json StartupCalibrationReport::ToJson() const {
@@ -80,7 +112,9 @@ nlohmann::json StartupCalibrationReport::ToJson() const {
                      {"matches", p.matches},
                      {"inliers", p.inliers},
                      {"usable", p.usable},
-                     {"change_deg", p.change_deg}});
+                     {"change_deg", p.change_deg},
+                     {"median_residual_deg_given", p.median_residual_deg_given},
+                     {"median_residual_deg_result", p.median_residual_deg_result}});
   }
   nlohmann::json round_list = nlohmann::json::array();
   for (const StartupRound& r : rounds) {
@@ -111,8 +145,7 @@ StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Ri
                                             const StartupCalibrationOptions& options, bool quiet) {
   StartupCalibrationReport report;
   report.cam_from_rig = cam_from_rig;
-  RingCalibrator ring(rig.WithExtrinsics(cam_from_rig), static_masks, options.ring);
-  std::vector<cv::Mat> first_images;
+  std::vector<std::vector<cv::Mat>> shots;
   for (int k = 0; k < std::max(1, options.shots); ++k) {
     const int frame = first_frame + k * std::max(1, options.shot_spacing);
     if (frame >= end_frame) break;
@@ -121,16 +154,15 @@ StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Ri
       if (!quiet) std::fprintf(stderr, "vo online: start-up calibration skips frame %d: %s\n", frame, loaded.problems.c_str());
       continue;
     }
-    ring.AddFrame(loaded.images);
+    shots.push_back(std::move(loaded.images));
     report.shots.push_back(frame);
-    if (first_images.empty()) first_images = std::move(loaded.images);
   }
   if (report.shots.empty()) {
     report.status = "no shot with every camera's image";
     return report;
   }
-  report.ring = ring.Solve();
-  if (!quiet) PrintRing(report.ring);
+  report.ring = RunRingPasses(rig, cam_from_rig, shots, static_masks, options, quiet);
+  const std::vector<cv::Mat>& first_images = shots.front();
   const std::vector<Rigid3> start = report.ring.converged ? report.ring.cam_from_rig : cam_from_rig;
   const double uncertainty = report.ring.converged ? options.refine_start_deg : options.fallback_prior_deg;
   std::vector<Rigid3> refined = start;

@@ -30,6 +30,8 @@ struct StartupCalibrationOptions {
   int shots = 1;                      // synchronous shots pooled by the ring stage
   int shot_spacing = 10;              // frames between two shots
   RingCalibrationOptions ring;
+  int ring_passes = 2;                // 2: the ring stage again with views placed by its first result
+  double max_pass_change_deg = 0.5;   // the second pass moving a camera further: not converged
   bool refine = false;                // stage 2 (off: measured worse than the ring stage alone)
   double refine_start_deg = 2.0;      // stage 2's first uncertainty after a converged ring stage
   double fallback_prior_deg = 15.0;   // stage 2's first uncertainty when the ring stage fails
