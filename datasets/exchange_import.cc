@@ -86,9 +86,14 @@ PerturbedExtrinsics PerturbationInfo(const std::string& path, ExchangeFormat for
     const nlohmann::json json = ReadJsonFile(path);
     if (json.contains("rovo_perturbation")) {
       const nlohmann::json& p = json["rovo_perturbation"];
-      set.sigma_rotation_deg = p.value("sigma_rotation_deg", 0.0);
-      set.sigma_translation_m = p.value("sigma_translation_m", 0.0);
-      set.seed = p.value("seed", uint64_t{0});
+      try {
+        set.sigma_rotation_deg = p.value("sigma_rotation_deg", 0.0);
+        set.sigma_translation_m = p.value("sigma_translation_m", 0.0);
+        set.seed = p.value("seed", uint64_t{0});
+      } catch (const nlohmann::json::exception&) {  // not an object, or a field of another type
+        throw std::runtime_error(path + ": /rovo_perturbation: expected {sigma_rotation_deg, sigma_translation_m, seed} "
+                                 "numbers");
+      }
     }
     return set;
   }
