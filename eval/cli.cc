@@ -199,22 +199,7 @@ void AddGateCommand(CLI::App& root) {
   cmd->callback([args] {
     const nlohmann::json gates = ReadJsonFile(args->gates);
     if (args->run) {
-      if (!gates.contains("suite") || !gates["suite"].is_object()) {
-        throw std::runtime_error(args->gates + ": missing object field \"suite\" (needed by --run)");
-      }
-      const nlohmann::json& s = gates["suite"];
-      SuiteOptions options;
-      try {
-        options.presets = s.at("presets").get<std::vector<std::string>>();
-        options.quick = s.value("quick", true);
-        options.noise_sets = s.value("noise_sets", 1);
-        options.scene_seed = s.value("scene_seed", uint64_t{0});
-        options.vo_seed = s.value("vo_seed", uint64_t{0});
-        options.vo_threads = s.value("vo_threads", 0);
-        options.max_new_features = s.value("max_new_features", -1);
-      } catch (const nlohmann::json::exception& e) {
-        throw std::runtime_error(args->gates + ": field \"suite\": " + e.what());
-      }
+      SuiteOptions options = GateSuiteOptions(gates, args->gates);
       options.out_dir = args->suite;
       options.data_dir = args->data;
       options.jobs = args->jobs;

@@ -31,6 +31,12 @@ struct GateCheck {
 // Throws std::runtime_error naming `gates_what` and the gate index/field on a malformed gate file.
 std::vector<GateCheck> CheckGates(const nlohmann::json& gates, const std::string& gates_what,
                                   const nlohmann::json& suite);
+struct SuiteOptions;
+// The "suite" object of a gates file (`rovo gate --run`): presets (strings), quick (bool), noise_sets
+// (1..1000), scene_seed and vo_seed (non-negative integers), vo_threads (0..1024), max_new_features
+// (-1..1000000); omitted fields keep quick true, noise_sets 1, seeds 0, vo_threads 0,
+// max_new_features -1. Throws std::runtime_error "<gates_what>: suite.<field>: ..." otherwise.
+SuiteOptions GateSuiteOptions(const nlohmann::json& gates, const std::string& gates_what);
 bool AllGatesPass(const std::vector<GateCheck>& checks);
 std::string GateTableMarkdown(const std::vector<GateCheck>& checks);
 

@@ -1,7 +1,9 @@
-// Fuzz target: gates.json checked against a suite.json (CheckGates, as `rovo gate` reads them). The
+// Fuzz target: gates.json checked against a suite.json (CheckGates, as `rovo gate` reads them) and
+// its "suite" object (GateSuiteOptions, `rovo gate --run`). The
 // input holds gates.json and suite.json separated by a marker line (fuzz_util.h PartMarker).
 #include "datasets/io.h"
 #include "eval/gate.h"
+#include "eval/suite.h"
 #include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -16,5 +18,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const nlohmann::json suite = rovo::ReadJsonFile(suite_path);
     rovo::GateTableMarkdown(rovo::CheckGates(gates, gates_path, suite));
   });
+  rovo::fuzz::ExpectClearError({gates_path},
+                               [&] { rovo::GateSuiteOptions(rovo::ReadJsonFile(gates_path), gates_path); });
   return 0;
 }
