@@ -106,6 +106,8 @@ struct Frontend::Impl {
   std::vector<HybridProjection> projections;  // maps (rebuilt only past the threshold)
   std::vector<ViewTracker> trackers;
   std::vector<cv::Mat> warped, fisheye_gray;
+  std::vector<cv::Mat> static_masks;          // fisheye, per camera; empty: none
+  std::vector<cv::Mat> view_masks;            // warped: the lens' valid area and the static mask
   std::vector<std::pair<int, int>> pairs;     // (camera, its right neighbour), each overlap once
   std::vector<ViewMatch> last_matches;
   uint64_t last_id = 0;
@@ -119,6 +121,19 @@ struct Frontend::Impl {
   std::vector<MatchView> MakeMatchViews(const ViewBearings& bearings_in_cam) const;
   void UnifyIds(const std::vector<std::vector<InterviewMatch>>& pair_matches, FrontendFrame* frame);
   void CollectFeatures(const ViewBearings& bearings_in_cam, FrontendFrame* frame) const;
+
+  // The detection and tracking mask of view i for its current projection.
+  void UpdateViewMask(int i) {
+    if (static_masks.empty()) {
+      view_masks[i] = projections[i].valid_mask();
+      return;
+    }
+    cv::Mat warped_mask, allowed;
+    projections[i].Warp(static_masks[i], &warped_mask);
+    cv::compare(warped_mask, 254, allowed, cv::CMP_GT);
+    cv::erode(allowed, allowed, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(15, 15)));
+    cv::bitwise_and(allowed, projections[i].valid_mask(), view_masks[i]);
+  }
 
   void UpdatePairs() {
     pairs.clear();
@@ -143,7 +158,26 @@ Frontend::Frontend(const Rig& rig, const FrontendOptions& options) : impl_(std::
   s.trackers.assign(rig.NumCameras(), ViewTracker(TrackerOptionsFrom(s.options)));
   s.warped.resize(rig.NumCameras());
   s.fisheye_gray.resize(rig.NumCameras());
+  s.view_masks.resize(rig.NumCameras());
+  for (int i = 0; i < rig.NumCameras(); ++i) s.UpdateViewMask(i);
   s.UpdatePairs();
+}
+
+void Frontend::SetStaticMasks(const std::vector<cv::Mat>& fisheye_masks) {
+  Impl& s = *impl_;
+  if (!fisheye_masks.empty() && static_cast<int>(fisheye_masks.size()) != s.rig.NumCameras()) {
+    throw std::invalid_argument("Frontend::SetStaticMasks: " + std::to_string(fisheye_masks.size()) + " masks for " +
+                                std::to_string(s.rig.NumCameras()) + " cameras");
+  }
+  for (size_t i = 0; i < fisheye_masks.size(); ++i) {
+    const Camera& camera = s.rig.cameras[i].camera;
+    if (fisheye_masks[i].type() != CV_8UC1 || fisheye_masks[i].cols != camera.width || fisheye_masks[i].rows != camera.height) {
+      throw std::invalid_argument("Frontend::SetStaticMasks: the mask of camera " + std::to_string(i) +
+                                  " is not 8-bit single-channel of the camera's size");
+    }
+  }
+  s.static_masks = fisheye_masks;
+  for (int i = 0; i < s.rig.NumCameras(); ++i) s.UpdateViewMask(i);
 }
 
 Frontend::~Frontend() = default;
@@ -186,9 +220,10 @@ void Frontend::SetExtrinsics(const std::vector<Rigid3>& cam_from_rig) {
       carried.push_back(std::move(q));
     }
     s.projections[i] = std::move(rebuilt);
+    s.UpdateViewMask(i);
     if (!s.fisheye_gray[i].empty()) {
       s.projections[i].Warp(s.fisheye_gray[i], &s.warped[i]);
-      s.trackers[i].ResetImage(s.warped[i], s.projections[i].valid_mask(), std::move(carried));
+      s.trackers[i].ResetImage(s.warped[i], s.view_masks[i], std::move(carried));
     } else {
       s.trackers[i].Clear();
     }
@@ -280,7 +315,7 @@ void Frontend::Impl::RunViewStages(const std::vector<cv::Mat>& fisheye_images, V
     projections[i].Warp(fisheye_gray[i], &warped_image);
     warped[i] = warped_image;
     lap(kWarp);
-    trackers[i].Track(warped[i], projections[i].valid_mask());
+    trackers[i].Track(warped[i], view_masks[i]);
     lap(kTrack);
     trackers[i].DetectAndDescribe([] { return uint64_t{0}; });  // ids below
     lap(kDetect);

@@ -110,6 +110,10 @@ class Frontend {
   // on a wrong count, size or type.
   FrontendFrame Process(const std::vector<cv::Mat>& fisheye_images);
   void SetExtrinsics(const std::vector<Rigid3>& cam_from_rig);
+  // Per-camera static masks of the fisheye images (8-bit, the camera's size, 0 = invalid: rig body,
+  // vehicle, operator), or none. No feature is detected or tracked where a mask is 0: they are
+  // warped with each view and eroded by half an ORB patch.
+  void SetStaticMasks(const std::vector<cv::Mat>& fisheye_masks);
   // Inter-view filter thresholds from the next Process call on (the back-end loosens the epipolar
   // and y filters while online calibration has not converged).
   void SetMatchingOptions(const InterviewMatchOptions& matching);

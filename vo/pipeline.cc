@@ -657,6 +657,7 @@ VoSummary RunVo(const VoOptions& options) {
   frontend_options.max_new_features_per_view = options.max_new_features;
   frontend_options.projection.vertical_fov_below_deg = options.warp_below_deg;
   Frontend frontend(info.rig.WithExtrinsics(cam_from_rig), frontend_options);
+  frontend.SetStaticMasks(LoadStaticMasks(options.dataset_dir, info.rig, info.has_static_masks));
   VoBackend backend(cam_from_rig, world_from_rig0, backend_options);
 
   RunData run;
