@@ -415,6 +415,11 @@ json CameraJson(const RigCamera& rc) {
 // Image header check (OpenImageIO reads the header only).
 void CheckImage(const std::string& path, const std::string& field, int width, int height, int max_channels,
                 std::vector<ValidationIssue>* issues) {
+  const std::string png_problem = PngChunkProblem(path);
+  if (!png_problem.empty()) {
+    issues->push_back({path, field, "unreadable image: " + png_problem});
+    return;
+  }
   auto input = OIIO::ImageInput::open(path);
   if (!input) {
     std::string error = OIIO::geterror();

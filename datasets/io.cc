@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -73,6 +74,33 @@ void EnsureWritableDir(const std::string& dir) {
   fs::create_directories(dir, ec);
   if (ec) throw std::runtime_error(dir + ": cannot create folder: " + ec.message());
   if (::access(dir.c_str(), W_OK) != 0) throw std::runtime_error(dir + ": folder is not writable");
+}
+
+std::string PngChunkProblem(const std::string& path) {
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  std::ifstream in(path, std::ios::binary);
+  unsigned char header[8];
+  if (!in.read(reinterpret_cast<char*>(header), 8) || std::memcmp(header, kSignature, 8) != 0) return "";
+  std::error_code ec;
+  const uint64_t size = fs::file_size(path, ec);
+  if (ec) return "cannot read the file size";
+  uint64_t offset = 8;
+  for (int index = 0; offset < size; ++index) {
+    unsigned char chunk[8];  // length (big-endian), type
+    if (!in.read(reinterpret_cast<char*>(chunk), 8)) return "truncated chunk header at byte " + std::to_string(offset);
+    const uint64_t length =
+        (uint64_t{chunk[0]} << 24) | (uint64_t{chunk[1]} << 16) | (uint64_t{chunk[2]} << 8) | chunk[3];
+    const std::string type(reinterpret_cast<const char*>(chunk + 4), 4);
+    if (index == 0 && type != "IHDR") return "the first chunk is not IHDR";
+    if (offset + 12 + length > size) {
+      return "chunk " + std::to_string(index) + " claims " + std::to_string(length) +
+             " bytes, beyond the end of the file";
+    }
+    if (type == "IEND") return "";
+    offset += 12 + length;
+    in.seekg(static_cast<std::streamoff>(offset));
+  }
+  return "";
 }
 
 std::string HashHex(const void* data, size_t size, uint64_t seed) {

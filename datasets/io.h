@@ -23,6 +23,10 @@ nlohmann::json ReadJsonFile(const std::string& path);
 void WriteJsonFileAtomic(const std::string& path, const nlohmann::json& json);
 // Creates a folder and its parents; throws naming the folder when it cannot be created or written.
 void EnsureWritableDir(const std::string& dir);
+// For a file that starts with the PNG signature: why its chunk list is broken (a chunk longer than the
+// rest of the file, no IHDR first), or "" when it is sound or not a PNG. Checked before OpenImageIO
+// opens a PNG: libpng allocates a chunk's stated length before reading it (1.7 GB for a corrupt tEXt).
+std::string PngChunkProblem(const std::string& path);
 // FNV-1a 64-bit hash of bytes, as 16 hex digits (content hashes for caching and provenance).
 std::string HashHex(const void* data, size_t size, uint64_t seed = 0);
 

@@ -233,8 +233,9 @@ Rig ReadOmniMvsConfig(const std::string& yaml_path, std::string* report) {
       for (int k = 0; k < 3; ++k) cam.affine[k] = affine[k];
       field = "image_size";
       const std::vector<double> size = FixedList(node["image_size"], 2, where + ".image_size");
-      if (!(size[0] >= 1 && size[1] >= 1 && size[0] == std::floor(size[0]) && size[1] == std::floor(size[1]))) {
-        throw std::runtime_error(where + ".image_size: expected positive integers [height, width]");
+      if (!(size[0] >= 1 && size[1] >= 1 && size[0] <= 65536 && size[1] <= 65536 && size[0] == std::floor(size[0]) &&
+            size[1] == std::floor(size[1]))) {
+        throw std::runtime_error(where + ".image_size: expected whole numbers [height, width] in [1, 65536]");
       }
       cam.height = static_cast<int>(size[0]);
       cam.width = static_cast<int>(size[1]);

@@ -203,6 +203,8 @@ void WritePng(const std::string& path, const Texture& texture) {
 }
 
 void ReadPng(const std::string& path, Texture& texture, const std::string& json_file, const std::string& field) {
+  const std::string png_problem = PngChunkProblem(path);
+  if (!png_problem.empty()) Fail(json_file, field, "cannot read texture '" + path + "': " + png_problem);
   auto in = OIIO::ImageInput::open(path);
   if (!in) Fail(json_file, field, "cannot read texture '" + path + "': " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
