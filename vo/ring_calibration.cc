@@ -577,6 +577,16 @@ double LoopClosureErrorDeg(const std::vector<RingPairEstimate>& pairs, int num_c
   return worst;
 }
 
+// " (pairs: a-b inliers/matches ...)" for a failure message.
+std::string PairCounts(const std::vector<RingPairEstimate>& pairs) {
+  std::string out = " (pairs:";
+  for (const RingPairEstimate& p : pairs) {
+    out += " " + std::to_string(p.camera_a) + "-" + std::to_string(p.camera_b) + " " + std::to_string(p.inliers) + "/" +
+           std::to_string(p.matches);
+  }
+  return out + " inliers/matches)";
+}
+
 struct JointSolution {
   std::vector<Eigen::Quaterniond> rotations;  // cam_j_from_rig
   std::vector<std::vector<int>> inliers;      // per pair
@@ -631,22 +641,13 @@ RingCalibrationReport RingCalibrator::Solve() const {
   for (size_t k = 0; k < impl_->pairs.size(); ++k) report.pairs.push_back(EstimatePair(impl_->pairs[k], rig, o, &inliers[k]));
   std::vector<Eigen::Quaterniond> rotations;
   if (!ChainFromCameraZero(report.pairs, n, &rotations)) {
-    report.reason = "too few overlap matches to connect every camera to camera 0 (pairs:";
-    for (const RingPairEstimate& p : report.pairs) {
-      report.reason += " " + std::to_string(p.camera_a) + "-" + std::to_string(p.camera_b) + " " +
-                       std::to_string(p.inliers) + "/" + std::to_string(p.matches);
-    }
-    report.reason += " inliers/matches)";
+    report.reason = "too few overlap matches to connect every camera to camera 0" + PairCounts(report.pairs);
     return report;
   }
   report.loop_error_deg = LoopClosureErrorDeg(report.pairs, n);
   if (o.require_closed_ring && report.loop_error_deg < 0.0 && n >= 3 && static_cast<int>(report.pairs.size()) == n) {
-    report.reason = "the ring is open (a pair has too few overlap matches), so nothing checks the chained pairs (pairs:";
-    for (const RingPairEstimate& p : report.pairs) {
-      report.reason += " " + std::to_string(p.camera_a) + "-" + std::to_string(p.camera_b) + " " +
-                       std::to_string(p.inliers) + "/" + std::to_string(p.matches);
-    }
-    report.reason += " inliers/matches)";
+    report.reason = "the ring is open (a pair has too few overlap matches), so nothing checks the chained pairs" +
+                    PairCounts(report.pairs);
     return report;
   }
   if (report.loop_error_deg > o.max_loop_error_deg) {
