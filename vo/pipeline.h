@@ -2,31 +2,15 @@
 // The whole ROVO pipeline over a dataset, writing a run folder (datasets/run.h). Entry point of
 // `rovo vo`.
 //
-// Per frame (paper Sec. IV): front-end features -> 2D-3D correspondences of tracked landmarks ->
-// multi-view P3P RANSAC (ransac.h) -> Cauchy pose refinement (pose_refinement.h) -> new landmarks by
-// inter-view and multi-frame triangulation (triangulation.h) -> on keyframes, local BA over a
-// sliding window, with online extrinsic calibration in OnlineExt mode (local_ba.h).
-// Start: the ground-truth first pose; metric scale from inter-view triangulation (rig baselines).
-// Failure handling: a frame with too few correspondences, no RANSAC consensus, or a black/missing
-// image gets status "lost" and the pose of a constant-velocity prediction; the map is then rebuilt
-// from inter-view triangulation at the predicted pose (status "init").
+// RunVo: the starting extrinsics (ground truth, a stored perturbed set or a fresh draw), in OnlineExt
+// the start-up calibration (startup_calibration.h), then per frame the images (image_loader.h, read
+// ahead on a second thread) -> Frontend (frontend.h) -> VoBackend (backend.h), starting at the
+// ground-truth first pose (identity without ground truth); the run folder is written at the end.
 
-#include "datasets/rigid3.h"
-#include "datasets/run.h"
-#include "vo/extrinsic_bootstrap.h"
-#include "vo/frontend.h"
-#include "vo/local_ba.h"
-#include "vo/map.h"
-#include "vo/pose_refinement.h"
-#include "vo/ransac.h"
-#include "vo/triangulation.h"
+#include "vo/backend.h"
 
 #include <cstdint>
-#include <map>
-#include <memory>
-#include <optional>
 #include <string>
-#include <vector>
 
 namespace rovo {
 
@@ -113,105 +97,5 @@ struct VoSummary {
 };
 
 VoSummary RunVo(const VoOptions& options);
-
-// ---------------------------------------------------------------------------------------------
-// The back-end alone (everything after the front-end), usable on synthetic FrontendFrames.
-
-struct BackendOptions {
-  MultiViewRansacOptions ransac;
-  PoseRefinementOptions refine;
-  TriangulationOptions interview_triangulation;   // same frame, >= 2 cameras
-  TriangulationOptions multiframe_triangulation;  // several frames
-  LocalBaOptions ba;                              // ba.optimize_extrinsics = OnlineExt
-  KeyframeOptions keyframes;
-  bool local_ba = true;
-  int window_keyframes = 6;          // sliding window size
-  int max_ba_landmarks = 800;        // bound on BA size (landmarks with most observations)
-  int min_features = 20;             // fewer features in all views: frame lost (e.g. black image)
-  int min_correspondences = 15;      // fewer 2D-3D correspondences: frame lost
-  double min_inlier_ratio = 0.15;    // below: no consensus
-  int min_init_landmarks = 15;       // inter-view points needed to (re)initialise
-  int max_unseen_frames = 2;         // landmarks unseen for longer are dropped
-  // Keyframe BA on a second thread, beside the caller's work on the next frame (its front-end): the
-  // solve starts at the end of ProcessFrame(k) and is joined and applied by FinishPendingBa, which
-  // ProcessFrame(k + 1) calls first. Results equal the synchronous order exactly; the caller sees the
-  // BA-refined pose and extrinsics of frame k only after FinishPendingBa.
-  bool async_ba = false;
-  double max_landmark_error_deg = 2.0;  // BA observations above are dropped
-  // Online calibration settles over the first `online_settle_frames` frames after the first one: in
-  // them, an observation off its landmark by less than online_max_error_deg is kept (BA sees it), as
-  // the extrinsics are still moving; afterwards one off by more than the RANSAC threshold is
-  // rejected, as in GTExt. Keeping the 0.2-2 deg observations for the whole run (as before
-  // 2026-11-21) let them into the map: canyon_multifov OnlineExt counted 1730 correspondences per
-  // frame against GTExt's 1480, and 49 % inliers against 79 %, even when started at the true
-  // extrinsics. The start-up calibration (extrinsic_bootstrap.h) leaves ~0.1 deg. Without it
-  // (--online-prior 0) the BA alone does not correct degree-sized errors at all, whatever these two
-  // are: its random-walk prior (LocalBaOptions::extrinsic_prior_deg, 0.005 deg per solve) holds them
-  // (quick cloudy_urban: 14 deg at the end, with a 2 or a 12 deg bound).
-  double online_max_error_deg = 2.0;
-  int online_settle_frames = 50;
-  void Check() const;
-};
-
-struct BackendFrameResult {
-  Rigid3 world_from_rig;     // with async_ba on a keyframe: before its BA (FinishPendingBa gives the refined one)
-  FrameRecord record;        // status, counts, errors (frame and timestamp filled by the caller)
-  double ms_ransac = 0, ms_refine = 0, ms_triangulate = 0, ms_ba = 0;  // ms_ba: synchronous BA only
-  int ransac_hypotheses = 0;
-  int num_landmarks = 0;
-};
-
-class VoBackend {
- public:
-  VoBackend(const std::vector<Rigid3>& initial_cam_from_rig, const Rigid3& initial_world_from_rig,
-            const BackendOptions& options);
-
-  // `frame` must increase between calls (gaps allowed). `frontend` may be empty (unreadable image).
-  BackendFrameResult ProcessFrame(int frame, const FrontendFrame& frontend);
-
-  // Joins a keyframe BA still running (async_ba) and applies it. Returns the frame it belonged to with
-  // that frame's BA-refined world_from_rig (the caller's record of the frame should be updated), or
-  // nothing when no BA was pending. Call before reading cam_from_rig() or map() in async mode.
-  struct BaUpdate {
-    int frame = 0;
-    Rigid3 world_from_rig;
-    double ms_solve = 0;  // BA time on its thread
-    double ms_wait = 0;   // time this call waited for it
-  };
-  std::optional<BaUpdate> FinishPendingBa();
-
-  const std::vector<Rigid3>& cam_from_rig() const { return cam_from_rig_; }
-  const LandmarkMap& map() const { return map_; }
-
-  ~VoBackend();
-  VoBackend(const VoBackend&) = delete;
-  VoBackend& operator=(const VoBackend&) = delete;
-
- private:
-  struct PendingBa;
-  bool Initialise(int frame, const Rigid3& rig_from_world, BackendFrameResult* result);
-  void AddObservations(int frame, const FrontendFrame& frontend, const std::vector<std::vector<char>>* rejected);
-  int TriangulateNew(int frame);
-  // Local BA in three steps: the problem from the map (window keyframes, best-observed landmarks),
-  // the solve (touches only the PendingBa), the write-back plus the frame's culling.
-  std::unique_ptr<PendingBa> PrepareLocalBa(int frame) const;
-  void ApplyLocalBa(PendingBa& pending);
-  void Cull(int frame);
-  Rigid3 PredictRigFromWorld(int frame) const;
-  std::vector<Rigid3> WorldFromCam(const Rigid3& rig_from_world) const;
-
-  BackendOptions options_;
-  std::vector<Rigid3> cam_from_rig_;
-  std::vector<double> baseline_lengths_;
-  Rigid3 initial_rig_from_world_;
-  LandmarkMap map_;
-  std::map<int, Rigid3> rig_from_world_;  // estimated poses of recent frames
-  std::vector<int> keyframes_;            // window, oldest first
-  bool initialised_ = false;
-  int first_frame_ = -1;  // of the run (online_settle_frames)
-  int last_good_frame_ = -1;
-  int previous_good_frame_ = -1;
-  std::unique_ptr<PendingBa> pending_ba_;
-};
 
 }  // namespace rovo
