@@ -4,6 +4,7 @@
 #include <ceres/rotation.h>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
 #include <opengv/relative_pose/CentralRelativeAdapter.hpp>
 #include <opengv/relative_pose/methods.hpp>
 #include <opengv/sac/Ransac.hpp>
@@ -131,6 +132,32 @@ std::vector<std::pair<int, int>> MutualRatioMatches(const cv::Mat& desc_a, const
   return out;
 }
 
+// Sub-pixel positions in view b of matches found by descriptors: pyramidal KLT from each point of
+// view a, started at its ORB match, kept when tracking back lands within 0.3 px of the start and the
+// refined point stays within 3 px of the ORB one. KLT's translation model holds only when the two
+// views are aligned (a second ring pass, whose views are placed by the first pass's result).
+void RefineMatchesKlt(const cv::Mat& view_a, const cv::Mat& view_b, std::vector<cv::Point2f>* points_a,
+                      std::vector<cv::Point2f>* points_b) {
+  if (points_a->empty()) return;
+  std::vector<cv::Point2f> forward = *points_b, backward = *points_a;
+  std::vector<uint8_t> status_fw, status_bw;
+  std::vector<float> error;
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
+  cv::calcOpticalFlowPyrLK(view_a, view_b, *points_a, forward, status_fw, error, cv::Size(15, 15), 2, criteria,
+                           cv::OPTFLOW_USE_INITIAL_FLOW);
+  cv::calcOpticalFlowPyrLK(view_b, view_a, forward, backward, status_bw, error, cv::Size(15, 15), 2, criteria,
+                           cv::OPTFLOW_USE_INITIAL_FLOW);
+  std::vector<cv::Point2f> kept_a, kept_b;
+  for (size_t k = 0; k < points_a->size(); ++k) {
+    if (!status_fw[k] || !status_bw[k]) continue;
+    if (cv::norm(backward[k] - (*points_a)[k]) > 0.3 || cv::norm(forward[k] - (*points_b)[k]) > 3.0) continue;
+    kept_a.push_back((*points_a)[k]);
+    kept_b.push_back(forward[k]);
+  }
+  points_a->swap(kept_a);
+  points_b->swap(kept_b);
+}
+
 // Averages the pair rotations into cam_j_from_cam0 (see the header); `rotations[0]` stays fixed.
 struct PairRotationError {
   explicit PairRotationError(const Eigen::Quaterniond& camb_from_cama) : measured_inverse(camb_from_cama.inverse()) {}
@@ -255,9 +282,15 @@ void RingCalibrator::AddFrame(const std::vector<cv::Mat>& images) {
       orb->detectAndCompute(p.last_view[s], p.side[s].valid, keypoints[s], descriptors[s]);
     }
     const double max_prior = std::cos(o.max_prior_angle_deg * kDeg);
+    std::vector<cv::Point2f> points_a, points_b;
     for (const auto& [i, j] : MutualRatioMatches(descriptors[0], descriptors[1], o)) {
-      const Eigen::Vector3d d_a = p.geometry.DirectionInRig(keypoints[0][i].pt.x, keypoints[0][i].pt.y);
-      const Eigen::Vector3d d_b = p.geometry.DirectionInRig(keypoints[1][j].pt.x, keypoints[1][j].pt.y);
+      points_a.push_back(keypoints[0][i].pt);
+      points_b.push_back(keypoints[1][j].pt);
+    }
+    if (o.refine_matches) RefineMatchesKlt(p.last_view[0], p.last_view[1], &points_a, &points_b);
+    for (size_t k = 0; k < points_a.size(); ++k) {
+      const Eigen::Vector3d d_a = p.geometry.DirectionInRig(points_a[k].x, points_a[k].y);
+      const Eigen::Vector3d d_b = p.geometry.DirectionInRig(points_b[k].x, points_b[k].y);
       if (d_a.dot(d_b) < max_prior) continue;
       p.bearings_a.push_back((p.side[0].cam_from_rig_nominal * d_a).normalized());
       p.bearings_b.push_back((p.side[1].cam_from_rig_nominal * d_b).normalized());

@@ -90,7 +90,9 @@ RingCalibrationReport RunRingPasses(const Rig& rig, const std::vector<Rigid3>& c
   RingCalibrationReport first = RunRingPass(rig, cam_from_rig, shots, static_masks, options.ring);
   if (!quiet) PrintRing(first);
   if (!first.converged || options.ring_passes < 2) return first;
-  RingCalibrationReport second = RunRingPass(rig, first.cam_from_rig, shots, static_masks, options.ring);
+  RingCalibrationOptions aligned = options.ring;
+  aligned.refine_matches = options.refine_second_pass;
+  RingCalibrationReport second = RunRingPass(rig, first.cam_from_rig, shots, static_masks, aligned);
   if (!quiet) PrintRing(second);
   if (!second.converged) return second;
   const double change = LargestChangeDeg(first.cam_from_rig, second.cam_from_rig);

@@ -31,6 +31,7 @@ struct StartupCalibrationOptions {
   int shot_spacing = 10;              // frames between two shots
   RingCalibrationOptions ring;
   int ring_passes = 2;                // 2: the ring stage again with views placed by its first result
+  bool refine_second_pass = true;     // KLT sub-pixel matches in the second pass (its views are aligned)
   double max_pass_change_deg = 0.5;   // the second pass moving a camera further: not converged
   bool refine = false;                // stage 2 (off: measured worse than the ring stage alone)
   double refine_start_deg = 2.0;      // stage 2's first uncertainty after a converged ring stage
