@@ -564,6 +564,18 @@ void WriteDatasetInfo(const std::string& dir, const DatasetInfo& info) {
 
 // ---- validator ----------------------------------------------------------------------------------
 
+// static_masks/<cam>.png of a dataset that declares them: present, one channel, the camera's size.
+static void CheckStaticMasks(const std::string& dir, const DatasetInfo& info, std::vector<ValidationIssue>* issues) {
+  for (const RigCamera& rc : info.rig.cameras) {
+    const std::string path = StaticMaskPath(dir, rc.name);
+    if (!fs::exists(path)) {
+      issues->push_back({path, "file", "missing static mask of camera " + rc.name + " (dataset.json has_static_masks)"});
+    } else {
+      CheckImage(path, "header", rc.camera.width, rc.camera.height, 1, issues);
+    }
+  }
+}
+
 std::vector<ValidationIssue> ValidateDataset(const std::string& dir) {
   std::vector<ValidationIssue> issues;
   if (!fs::is_directory(dir)) {
@@ -630,16 +642,7 @@ std::vector<ValidationIssue> ValidateDataset(const std::string& dir) {
                                             std::to_string(info.frame_count)});
   }
 
-  if (json_ok && info.has_static_masks) {
-    for (const RigCamera& rc : info.rig.cameras) {
-      const std::string path = StaticMaskPath(dir, rc.name);
-      if (!fs::exists(path)) {
-        issues.push_back({path, "file", "missing static mask of camera " + rc.name + " (dataset.json has_static_masks)"});
-      } else {
-        CheckImage(path, "header", rc.camera.width, rc.camera.height, 1, &issues);
-      }
-    }
-  }
+  if (json_ok && info.has_static_masks) CheckStaticMasks(dir, info, &issues);
 
   // Images (and depth/masks when declared): present, readable, the rig camera's size; no extras.
   struct Layer {

@@ -151,6 +151,16 @@ std::string RunTableMarkdown(const std::vector<RunMetrics>& runs) {
   return md;
 }
 
+// groundtruth.csv of a report: timestamp and world position of the rig per frame (for the plots).
+static void WriteGroundTruthCsv(const std::string& path, const std::vector<StampedPose>& gt) {
+  std::string csv = Csv({"timestamp", "x", "y", "z"});
+  for (const StampedPose& p : gt) {
+    csv += Csv({Num(p.timestamp), Num(p.world_from_rig.translation.x()), Num(p.world_from_rig.translation.y()),
+                Num(p.world_from_rig.translation.z())});
+  }
+  WriteFileAtomic(path, csv);
+}
+
 std::vector<RunEvaluation> EvaluateAndReport(const std::string& dataset_dir, const std::vector<std::string>& run_dirs,
                                              const std::string& out_dir, const EvalReportOptions& options) {
   if (run_dirs.empty()) throw std::invalid_argument("rovo eval: no run folders given");
@@ -242,12 +252,7 @@ std::vector<RunEvaluation> EvaluateAndReport(const std::string& dataset_dir, con
     evaluations.push_back(std::move(evaluation));
   }
 
-  std::string gt_csv = Csv({"timestamp", "x", "y", "z"});
-  for (const StampedPose& p : gt) {
-    gt_csv += Csv({Num(p.timestamp), Num(p.world_from_rig.translation.x()), Num(p.world_from_rig.translation.y()),
-                   Num(p.world_from_rig.translation.z())});
-  }
-  WriteFileAtomic((fs::path(out_dir) / "groundtruth.csv").string(), gt_csv);
+  WriteGroundTruthCsv((fs::path(out_dir) / "groundtruth.csv").string(), gt);
   WriteFileAtomic((fs::path(out_dir) / "summary.csv").string(), summary);
 
   std::vector<RunMetrics> metrics;
