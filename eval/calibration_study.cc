@@ -38,13 +38,14 @@ std::string RunDir(const CalibrationStudyOptions& o, uint64_t seed) {
 }
 
 // Whether the run folder holds a finished OnlineExt run of this draw with these settings.
-bool RunReusable(const std::string& dir, uint64_t seed, int frame_end, int startup_shots) {
+bool RunReusable(const std::string& dir, uint64_t seed, int frame_end, int startup_shots, int spacing) {
   std::error_code ec;
   if (!fs::exists(RunInfoPath(dir), ec) || !fs::exists(RunExtrinsicsPath(dir), ec)) return false;
   try {
     const nlohmann::json j = nlohmann::json::parse(ReadFile(RunInfoPath(dir)));
     return j.value("draw_seed", int64_t{-1}) == static_cast<int64_t>(seed) && j.at("frames")[1] == frame_end &&
-           j.value("online_startup_shots", 1) == startup_shots && j.contains("startup_calibration");
+           j.value("online_startup_shots", -1) == startup_shots && j.value("online_startup_spacing", -1) == spacing &&
+           j.contains("startup_calibration");
   } catch (const std::exception&) {
     return false;
   }
@@ -58,6 +59,12 @@ double ErrorAtFrame(const std::map<int, std::vector<Rigid3>>& by_frame, int fram
   return ExtrinsicErrorDeg(it->second, truth);
 }
 
+// The error below which a draw counts as converged.
+double Bound(const CalibrationStudyOptions& o) {
+  if (o.bound_deg > 0.0) return o.bound_deg;
+  return o.shot_only ? o.shot_converged_deg : o.converged_deg;
+}
+
 CalibrationDraw RunDraw(const CalibrationStudyOptions& o, const DatasetInfo& info, uint64_t seed) {
   CalibrationDraw d;
   d.seed = seed;
@@ -66,19 +73,22 @@ CalibrationDraw RunDraw(const CalibrationStudyOptions& o, const DatasetInfo& inf
   d.before_deg = ExtrinsicErrorDeg(drawn, truth);
   if (o.shot_only) {
     StartupCalibrationOptions sopt;
-    sopt.shots = 1;
+    sopt.shots = o.startup_shots;
+    sopt.shot_spacing = o.shot_spacing;
     auto load = [&](int frame) { return LoadFrameImages(o.dataset_dir, info.rig, frame); };
-    const StartupCalibrationReport r = CalibrateAtStartup(info.rig, drawn, load, o.shot, o.shot + 1,
-                                                          LoadStaticMasks(o.dataset_dir, info.rig, info.has_static_masks), sopt, true);
+    const StartupCalibrationReport r =
+        CalibrateAtStartup(info.rig, drawn, load, o.shot, o.shot + (o.startup_shots - 1) * o.shot_spacing + 1,
+                           LoadStaticMasks(o.dataset_dir, info.rig, info.has_static_masks), sopt, true);
+    d.startup_cam_from_rig = r.cam_from_rig;
     d.startup_deg = ExtrinsicErrorDeg(r.cam_from_rig, truth);
     d.startup_converged = r.converged;
     d.startup_status = r.status;
-    d.converged = d.startup_deg < o.shot_converged_deg;
+    d.converged = d.startup_deg < Bound(o);
     return d;
   }
   const int frame_end = o.frames > 0 ? std::min(o.frames, info.frame_count) : info.frame_count;
   const std::string dir = RunDir(o, seed);
-  if (!RunReusable(dir, seed, frame_end, o.startup_shots)) {
+  if (!RunReusable(dir, seed, frame_end, o.startup_shots, o.shot_spacing)) {
     VoOptions v;
     v.dataset_dir = o.dataset_dir;
     v.out_dir = dir;
@@ -88,6 +98,7 @@ CalibrationDraw RunDraw(const CalibrationStudyOptions& o, const DatasetInfo& inf
     v.frame_end = frame_end;
     v.threads = o.threads;
     v.online_startup_shots = o.startup_shots;
+    v.online_startup_spacing = o.shot_spacing;
     v.quiet = true;
     RunVo(v);
   }
@@ -95,6 +106,7 @@ CalibrationDraw RunDraw(const CalibrationStudyOptions& o, const DatasetInfo& inf
   const nlohmann::json& startup = run.info.at("startup_calibration");
   std::vector<Rigid3> after;
   for (const auto& x : startup.at("cam_from_rig")) after.push_back(Rigid3FromRunJson(x));
+  d.startup_cam_from_rig = after;
   d.startup_deg = ExtrinsicErrorDeg(after, truth);
   d.startup_converged = startup.at("converged").get<bool>();
   d.startup_status = startup.at("status").get<std::string>();
@@ -107,7 +119,7 @@ CalibrationDraw RunDraw(const CalibrationStudyOptions& o, const DatasetInfo& inf
   d.at50_deg = ErrorAtFrame(by_frame, 50, truth);
   d.at100_deg = ErrorAtFrame(by_frame, 100, truth);
   d.end_deg = ErrorAtFrame(by_frame, by_frame.empty() ? 0 : by_frame.rbegin()->first, truth);
-  d.converged = d.end_deg >= 0.0 && d.end_deg < o.converged_deg;
+  d.converged = d.end_deg >= 0.0 && d.end_deg < Bound(o);
   return d;
 }
 
@@ -121,11 +133,15 @@ std::string Deg(double v) {
 std::string ReproduceCommand(const CalibrationStudyOptions& o) {
   std::ostringstream s;
   if (o.shot_only) {
-    s << "rovo study calibration " << o.dataset_dir << " --shot-only --shot " << o.shot << " --draws 1 --seed {seed}";
+    s << "rovo study calibration " << o.dataset_dir << " --shot-only --shot " << o.shot;
+    if (o.startup_shots != 1) s << " --startup-shots " << o.startup_shots << " --shot-spacing " << o.shot_spacing;
+    s << " --draws 1 --seed {seed} --out study_{seed}";
   } else {
     s << "rovo vo " << o.dataset_dir << " --extrinsics online --draw-seed {seed} --draw-sigma " << o.sigma_deg;
     if (o.frames > 0) s << " --frames 0:" << o.frames;
-    if (o.startup_shots != 1) s << " --online-startup-shots " << o.startup_shots;
+    if (o.startup_shots != VoOptions{}.online_startup_shots || o.shot_spacing != VoOptions{}.online_startup_spacing) {
+      s << " --online-startup-shots " << o.startup_shots << " --online-startup-spacing " << o.shot_spacing;
+    }
     s << " --out run_{seed}";
   }
   return s.str();
@@ -145,12 +161,14 @@ void WriteOutputs(const CalibrationStudyOptions& o, const DatasetInfo& info, con
                     {"converged", d.converged}});
     if (!d.converged) failures.push_back(d.seed);
   }
-  const double bound = o.shot_only ? o.shot_converged_deg : o.converged_deg;
+  const double bound = Bound(o);
   const nlohmann::json j = {
       {"generator", "rovo study calibration"}, {"version", ROVO_VERSION},
       {"dataset", o.dataset_dir}, {"dataset_seed", info.seed},
       {"sigma_deg", o.sigma_deg}, {"first_seed", o.first_seed}, {"draws", o.draws},
       {"frames", o.frames}, {"shot_only", o.shot_only}, {"shot", o.shot}, {"startup_shots", o.startup_shots},
+      {"shot_spacing", o.shot_spacing}, {"startup_converged", result.startup_converged},
+      {"startup_agreement_deg", result.startup_agreement_deg},
       {"converged_below_deg", bound}, {"converged", result.converged},
       {"rate", result.draws.empty() ? 0.0 : static_cast<double>(result.converged) / result.draws.size()},
       {"failed_seeds", failures}, {"reproduce", result.reproduce}, {"per_draw", rows}};
@@ -169,9 +187,10 @@ std::string Table(const CalibrationStudyOptions& o, const CalibrationStudyResult
   }
   s << "\nExtrinsic error: largest over cameras i >= 1 of the rotation angle of est(cam_i_from_cam0) "
        "true(cam_i_from_cam0)^-1, degrees.\n";
-  s << "Converged (" << (o.shot_only ? "start-up" : "end of run") << " < "
-    << (o.shot_only ? o.shot_converged_deg : o.converged_deg) << " deg): " << result.converged << " of "
-    << result.draws.size() << ".\n";
+  s << "Converged (" << (o.shot_only ? "start-up" : "end of run") << " < " << Bound(o) << " deg): " << result.converged
+    << " of " << result.draws.size() << ".\n";
+  s << "Start-up calibration converged by its own verdict: " << result.startup_converged << " of " << result.draws.size()
+    << "; largest difference between two of those results: " << Deg(result.startup_agreement_deg) << " deg.\n";
   if (result.converged < static_cast<int>(result.draws.size())) {
     s << "Reproduce a failure: `" << result.reproduce << "` with {seed} one of:";
     for (const CalibrationDraw& d : result.draws) {
@@ -195,13 +214,22 @@ double ExtrinsicErrorDeg(const std::vector<Rigid3>& est, const std::vector<Rigid
   return worst;
 }
 
-CalibrationStudyResult RunCalibrationStudy(const CalibrationStudyOptions& o) {
+CalibrationStudyResult RunCalibrationStudy(const CalibrationStudyOptions& options) {
+  CalibrationStudyOptions o = options;
+  if (o.startup_shots == 0) o.startup_shots = o.shot_only ? 1 : VoOptions{}.online_startup_shots;
   if (o.draws < 1) throw std::invalid_argument("study calibration: --draws must be at least 1");
   if (!(o.sigma_deg >= 0.0)) throw std::invalid_argument("study calibration: --sigma must be non-negative");
   const DatasetInfo info = ReadDatasetInfo(o.dataset_dir);
   if (o.shot < 0 || o.shot >= info.frame_count) {
     throw std::invalid_argument("study calibration: --shot " + std::to_string(o.shot) + " is not a frame of " +
                                 DatasetJsonPath(o.dataset_dir) + " (frame_count " + std::to_string(info.frame_count) + ")");
+  }
+  const int last_shot = o.shot + (o.startup_shots - 1) * o.shot_spacing;
+  if (o.shot_only && last_shot >= info.frame_count) {
+    throw std::invalid_argument("study calibration: --startup-shots " + std::to_string(o.startup_shots) +
+                                " every --shot-spacing " + std::to_string(o.shot_spacing) + " from --shot " +
+                                std::to_string(o.shot) + " reach frame " + std::to_string(last_shot) + ", beyond " +
+                                DatasetJsonPath(o.dataset_dir) + "'s frame_count " + std::to_string(info.frame_count));
   }
   if (!o.shot_only && info.frame_count > 0 && !fs::exists(GroundTruthPath(o.dataset_dir))) {
     // The OnlineExt runs need no ground truth, but say what the numbers are measured against.
@@ -217,6 +245,17 @@ CalibrationStudyResult RunCalibrationStudy(const CalibrationStudyOptions& o) {
     progress.Add();
   }
   progress.Finish();
+  std::vector<const CalibrationDraw*> agreeing;
+  for (const CalibrationDraw& d : result.draws) {
+    if (d.startup_converged) agreeing.push_back(&d);
+  }
+  result.startup_converged = static_cast<int>(agreeing.size());
+  for (size_t i = 0; i < agreeing.size(); ++i) {
+    for (size_t j = i + 1; j < agreeing.size(); ++j) {
+      result.startup_agreement_deg = std::max(
+          result.startup_agreement_deg, ExtrinsicErrorDeg(agreeing[i]->startup_cam_from_rig, agreeing[j]->startup_cam_from_rig));
+    }
+  }
   WriteOutputs(o, info, result);
   const std::string table = Table(o, result);
   WriteFileAtomic((fs::path(o.out_dir) / "calibration.md").string(), table);
@@ -242,11 +281,20 @@ void AddCalibrationStudyCommand(CLI::App* study) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_flag("--shot-only", options->shot_only,
-                "Start-up calibration only, on one synchronous shot (no VO; no ground-truth poses needed)");
+                "Start-up calibration only, on one synchronous shot or --startup-shots pooled (no VO; no ground-truth poses "
+                "needed)");
   cmd->add_option("--shot", options->shot, "The frame of --shot-only")->check(CLI::NonNegativeNumber)->capture_default_str();
-  cmd->add_option("--startup-shots", options->startup_shots, "rovo vo --online-startup-shots of the runs")
+  cmd->add_option("--startup-shots", options->startup_shots,
+                  "Shots pooled by the start-up calibration, every --shot-spacing frames (rovo vo --online-startup-shots); "
+                  "default: 1 with --shot-only, else rovo vo's default")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
+  cmd->add_option("--shot-spacing", options->shot_spacing, "Frames between two shots of --startup-shots")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  cmd->add_option("--bound", options->bound_deg,
+                  "A draw converged when its error ends below this (degrees; default 0.5 with --shot-only, else 0.1)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--threads", options->threads, "Threads of each run (0: all cores)")->capture_default_str();
   cmd->add_flag("--quiet", options->quiet, "No progress output");
   cmd->callback([options] {

@@ -31,10 +31,13 @@ struct CalibrationStudyOptions {
   int frames = 0;                // > 0: the OnlineExt runs cover the first N frames; 0: all
   bool shot_only = false;        // start-up calibration on one shot, no VO
   int shot = 0;                  // the shot (first frame)
-  int startup_shots = 1;         // VoOptions::online_startup_shots
+  int startup_shots = 0;         // shots pooled by the start-up calibration; 0: 1 with shot_only, else
+                                 // VoOptions::online_startup_shots' default
+  int shot_spacing = 10;         // VoOptions::online_startup_spacing (frames between two shots)
   int threads = 0;
   double converged_deg = 0.1;    // the run's final error below: converged
   double shot_converged_deg = 0.5;  // shot_only: the start-up error below: converged
+  double bound_deg = -1.0;       // > 0: replaces converged_deg / shot_converged_deg
   bool quiet = false;
 };
 
@@ -46,11 +49,16 @@ struct CalibrationDraw {
   bool startup_converged = false;   // the start-up calibration's own verdict
   std::string startup_status;
   bool converged = false;           // the study's verdict (error below the bound)
+  std::vector<Rigid3> startup_cam_from_rig;  // the start-up calibration's result
 };
 
 struct CalibrationStudyResult {
   std::vector<CalibrationDraw> draws;
   int converged = 0;
+  // Largest extrinsic difference (ExtrinsicErrorDeg) between the start-up results of two draws whose
+  // start-up calibration converged by its own verdict; -1: fewer than two such draws.
+  double startup_agreement_deg = -1.0;
+  int startup_converged = 0;
   std::string reproduce;            // command template for one draw ("{seed}" replaced)
 };
 

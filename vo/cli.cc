@@ -100,8 +100,18 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
       ->check(CLI::Range(0.0, 45.0))
       ->capture_default_str();
   cmd->add_option("--online-startup-shots", args->options.online_startup_shots,
-                  "OnlineExt: synchronous shots (every 10 frames from the first) pooled by the start-up calibration")
+                  "OnlineExt: synchronous shots (every --online-startup-spacing frames from the first) pooled by the "
+                  "start-up calibration")
       ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  cmd->add_option("--online-anchor", args->options.online_anchor_deg,
+                  "OnlineExt: rotation sigma (degrees) with which every keyframe BA pulls the extrinsics towards a "
+                  "converged start-up calibration's result; 0: none")
+      ->check(CLI::Range(0.0, 45.0))
+      ->capture_default_str();
+  cmd->add_option("--online-startup-spacing", args->options.online_startup_spacing,
+                  "OnlineExt: frames between two shots of --online-startup-shots")
+      ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   cmd->add_option("--tau", args->options.ransac_tau_deg,
                   "RANSAC inlier threshold in degrees: the angle between observed and predicted bearing, the same "

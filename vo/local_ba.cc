@@ -340,6 +340,19 @@ LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& option
     }
   }
 
+  if (options.optimize_extrinsics && options.extrinsic_anchor_deg > 0.0 &&
+      static_cast<int>(options.extrinsic_anchor.size()) == num_cams) {
+    for (int j = 1; j < num_cams; ++j) {
+      if (!cam_used[j]) continue;
+      // The centre is held by the random-walk prior and the baseline terms; the anchor is on rotation.
+      ceres_problem.AddResidualBlock(
+          ExtrinsicPriorCost::Create(options.extrinsic_anchor[j],
+                                     options.extrinsic_anchor_deg * M_PI / 180.0 / options.observation_sigma_rad,
+                                     1.0 / options.observation_sigma_rad),
+          nullptr, cams[j].data());
+    }
+  }
+
   // Schur ordering: landmarks first, then poses and extrinsics.
   auto* ordering = new ceres::ParameterBlockOrdering;
   for (size_t i = 0; i < problem.points_in_world.size(); ++i) {

@@ -41,6 +41,11 @@ struct LocalBaOptions {
   // windows' estimates instead of letting each window's errors through.
   double extrinsic_prior_deg = 0.0;
   double extrinsic_prior_m = 0.005;
+  // Online mode: every solve also pulls each free cam_from_rig towards `extrinsic_anchor` (the start-up
+  // calibration's result) with this rotation standard deviation; empty or 0 deg: none. The start-up
+  // calibration sees thousands of overlap matches at once; one window's BA sees a few hundred.
+  std::vector<Rigid3> extrinsic_anchor;
+  double extrinsic_anchor_deg = 0.0;
   // The bearing residuals are sines of angles (radians to first order), unweighted: the prior is scaled by this assumed
   // bearing noise so that both terms are in units of standard deviations.
   double observation_sigma_rad = 0.001;

@@ -114,6 +114,7 @@ StartupCalibrationReport RunStartupCalibration(const VoOptions& options, const D
                                                const std::vector<Rigid3>& cam_from_rig) {
   StartupCalibrationOptions sopt;
   sopt.shots = options.online_startup_shots;
+  sopt.shot_spacing = options.online_startup_spacing;
   sopt.fallback_prior_deg = options.online_prior_deg;
   sopt.refine_rounds = options.online_bootstrap_rounds;
   auto load = [&](int frame) { return LoadFrameImages(options.dataset_dir, info.rig, frame); };
@@ -243,6 +244,9 @@ nlohmann::json RunInfoJson(const VoOptions& options, const DatasetInfo& info, co
   j["version"] = ROVO_VERSION;
   j["initial_world_from_rig"] = PoseJson(world_from_rig0);
   j["online_prior_deg"] = options.online_prior_deg;
+  j["online_startup_shots"] = options.online_startup_shots;
+  j["online_startup_spacing"] = options.online_startup_spacing;
+  j["online_anchor_deg"] = options.online_anchor_deg;
   j["max_new_features"] = options.max_new_features;
   j["warp_below_deg"] = options.warp_below_deg;
   if (RunsStartupCalibration(options)) j["startup_calibration"] = startup.ToJson();
@@ -302,11 +306,15 @@ VoSummary RunVo(const VoOptions& options) {
   }
   EnsureWritableDir(options.out_dir);
 
-  const BackendOptions backend_options = MakeBackendOptions(options);
+  BackendOptions backend_options = MakeBackendOptions(options);
   StartupCalibrationReport startup;
   if (RunsStartupCalibration(options)) {
     startup = RunStartupCalibration(options, info, begin, end, cam_from_rig);
     cam_from_rig = startup.cam_from_rig;
+    if (startup.converged) {
+      backend_options.ba.extrinsic_anchor = startup.cam_from_rig;
+      backend_options.ba.extrinsic_anchor_deg = options.online_anchor_deg;
+    }
   }
   Frontend frontend(info.rig.WithExtrinsics(cam_from_rig), MakeFrontendOptions(options));
   frontend.SetStaticMasks(LoadStaticMasks(options.dataset_dir, info.rig, info.has_static_masks));

@@ -132,13 +132,33 @@ std::vector<std::pair<int, int>> MutualRatioMatches(const cv::Mat& desc_a, const
   return out;
 }
 
+// Local contrast normalisation for KLT: (v - mean) / std over a Gaussian window of `sigma_px`,
+// mapped to 8 bits. Two cameras of a real rig see a surface with different exposure, gain and
+// vignetting, which biases KLT's brightness-constancy fit; ORB's descriptors are invariant to both.
+cv::Mat ContrastNormalized(const cv::Mat& view, double sigma_px) {
+  cv::Mat f, mean, var;
+  view.convertTo(f, CV_32F);
+  cv::GaussianBlur(f, mean, cv::Size(0, 0), sigma_px);
+  const cv::Mat centred = f - mean;
+  cv::GaussianBlur(centred.mul(centred), var, cv::Size(0, 0), sigma_px);
+  cv::sqrt(var, var);
+  const cv::Mat z = centred / (var + 2.0f);
+  cv::Mat out;
+  z.convertTo(out, CV_8U, 40.0, 128.0);
+  return out;
+}
+
 // Sub-pixel positions in view b of matches found by descriptors: pyramidal KLT from each point of
 // view a, started at its ORB match, kept when tracking back lands within 0.3 px of the start and the
-// refined point stays within 3 px of the ORB one. KLT's translation model holds only when the two
-// views are aligned (a second ring pass, whose views are placed by the first pass's result).
-void RefineMatchesKlt(const cv::Mat& view_a, const cv::Mat& view_b, std::vector<cv::Point2f>* points_a,
-                      std::vector<cv::Point2f>* points_b) {
+// refined point stays within 3 px of the ORB one (on ContrastNormalized views when `normalize_sigma_px`
+// > 0). KLT's translation model holds only when the two views are aligned (a second ring pass, whose
+// views are placed by the first pass's result).
+void RefineMatchesKlt(const cv::Mat& view_a_in, const cv::Mat& view_b_in, double normalize_sigma_px,
+                      std::vector<cv::Point2f>* points_a, std::vector<cv::Point2f>* points_b) {
   if (points_a->empty()) return;
+  const bool normalize = normalize_sigma_px > 0.0;
+  const cv::Mat view_a = normalize ? ContrastNormalized(view_a_in, normalize_sigma_px) : view_a_in;
+  const cv::Mat view_b = normalize ? ContrastNormalized(view_b_in, normalize_sigma_px) : view_b_in;
   std::vector<cv::Point2f> forward = *points_b, backward = *points_a;
   std::vector<uint8_t> status_fw, status_bw;
   std::vector<float> error;
@@ -287,7 +307,7 @@ void RingCalibrator::AddFrame(const std::vector<cv::Mat>& images) {
       points_a.push_back(keypoints[0][i].pt);
       points_b.push_back(keypoints[1][j].pt);
     }
-    if (o.refine_matches) RefineMatchesKlt(p.last_view[0], p.last_view[1], &points_a, &points_b);
+    if (o.refine_matches) RefineMatchesKlt(p.last_view[0], p.last_view[1], o.klt_normalize_sigma_px, &points_a, &points_b);
     for (size_t k = 0; k < points_a.size(); ++k) {
       const Eigen::Vector3d d_a = p.geometry.DirectionInRig(points_a[k].x, points_a[k].y);
       const Eigen::Vector3d d_b = p.geometry.DirectionInRig(points_b[k].x, points_b[k].y);

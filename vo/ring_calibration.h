@@ -43,6 +43,7 @@ struct RingCalibrationOptions {
   int orb_features = 3000;             // per overlap view
   int orb_fast_threshold = 10;
   bool refine_matches = false;         // KLT sub-pixel refinement of the matches (aligned views only)
+  double klt_normalize_sigma_px = 10.0; // KLT on locally contrast-normalised views (window sigma); 0: raw
   double max_ratio = 0.8;              // best / second-best Hamming distance
   int max_descriptor_distance = 80;
   double max_prior_angle_deg = 40.0;   // gross-outlier bound on the nominal rig-frame bearings
