@@ -68,7 +68,7 @@ class RealRigCalibration : public ::testing::Test {
 std::string RealRigCalibration::dir_;
 
 // One shot per frame, draws 7000-7009: no draw claims convergence beyond 1.0 deg from the file's
-// calibration. Measured: frame 0 converges on 2 of 10 draws (0.4-0.5 deg), frames 1 and 2 on none (a
+// calibration. Measured: frame 0 converges on 1 of 10 draws (0.35 deg), frames 1 and 2 on none (a
 // plain-walled pair leaves the ring open), and the start-up then keeps the drawn extrinsics and says
 // why, instead of returning a wrong result.
 TEST_F(RealRigCalibration, NoShotClaimsAWrongResult) {
