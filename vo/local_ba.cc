@@ -254,6 +254,7 @@ void LocalBaOptions::Check() const {
     throw std::invalid_argument("LocalBaOptions.extrinsic_prior_deg must be >= 0 and extrinsic_prior_m > 0");
   }
   if (num_threads < 1) throw std::invalid_argument("LocalBaOptions.num_threads must be >= 1");
+  if (!(extrinsic_anchor_deg >= 0.0)) throw std::invalid_argument("LocalBaOptions.extrinsic_anchor_deg must be >= 0");
 }
 
 std::vector<double> RingBaselineLengths(const std::vector<Rigid3>& cam_from_rig) {
@@ -267,6 +268,38 @@ std::vector<double> RingBaselineLengths(const std::vector<Rigid3>& cam_from_rig)
   }
   return out;
 }
+
+namespace {
+
+// Online mode: the random-walk prior towards the extrinsics before this solve and, after a converged
+// start-up calibration, the anchor towards its result (rotation only: the centre is held by the
+// random-walk prior and the baseline terms), on every free camera the window sees.
+void AddExtrinsicPriors(const LocalBaProblem& problem, const LocalBaOptions& options, const std::vector<char>& cam_used,
+                        PoseParams* cams, ceres::Problem* ceres_problem) {
+  const int num_cams = static_cast<int>(problem.cam_from_rig.size());
+  if (options.extrinsic_prior_deg > 0.0) {
+    for (int j = 1; j < num_cams; ++j) {
+      if (!cam_used[j]) continue;
+      ceres_problem->AddResidualBlock(
+          ExtrinsicPriorCost::Create(problem.cam_from_rig[j],
+                                     options.extrinsic_prior_deg * M_PI / 180.0 / options.observation_sigma_rad,
+                                     options.extrinsic_prior_m / options.observation_sigma_rad),
+          nullptr, cams[j].data());
+    }
+  }
+  if (options.extrinsic_anchor_deg > 0.0 && static_cast<int>(options.extrinsic_anchor.size()) == num_cams) {
+    for (int j = 1; j < num_cams; ++j) {
+      if (!cam_used[j]) continue;
+      ceres_problem->AddResidualBlock(
+          ExtrinsicPriorCost::Create(options.extrinsic_anchor[j],
+                                     options.extrinsic_anchor_deg * M_PI / 180.0 / options.observation_sigma_rad,
+                                     1.0 / options.observation_sigma_rad),
+          nullptr, cams[j].data());
+    }
+  }
+}
+
+}  // namespace
 
 LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& options) {
   options.Check();
@@ -329,29 +362,7 @@ LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& option
     ceres_problem.SetParameterBlockConstant(cams[j].data());
   }
 
-  if (options.optimize_extrinsics && options.extrinsic_prior_deg > 0.0) {
-    for (int j = 1; j < num_cams; ++j) {
-      if (!cam_used[j]) continue;
-      ceres_problem.AddResidualBlock(
-          ExtrinsicPriorCost::Create(problem.cam_from_rig[j],
-                                     options.extrinsic_prior_deg * M_PI / 180.0 / options.observation_sigma_rad,
-                                     options.extrinsic_prior_m / options.observation_sigma_rad),
-          nullptr, cams[j].data());
-    }
-  }
-
-  if (options.optimize_extrinsics && options.extrinsic_anchor_deg > 0.0 &&
-      static_cast<int>(options.extrinsic_anchor.size()) == num_cams) {
-    for (int j = 1; j < num_cams; ++j) {
-      if (!cam_used[j]) continue;
-      // The centre is held by the random-walk prior and the baseline terms; the anchor is on rotation.
-      ceres_problem.AddResidualBlock(
-          ExtrinsicPriorCost::Create(options.extrinsic_anchor[j],
-                                     options.extrinsic_anchor_deg * M_PI / 180.0 / options.observation_sigma_rad,
-                                     1.0 / options.observation_sigma_rad),
-          nullptr, cams[j].data());
-    }
-  }
+  if (options.optimize_extrinsics) AddExtrinsicPriors(problem, options, cam_used, cams, &ceres_problem);
 
   // Schur ordering: landmarks first, then poses and extrinsics.
   auto* ordering = new ceres::ParameterBlockOrdering;
