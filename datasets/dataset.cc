@@ -9,10 +9,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <map>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 namespace rovo {
@@ -358,6 +360,66 @@ PerturbedExtrinsics ParsePerturbed(JsonChecker& check, const json& pj, const std
   return set;
 }
 
+// /sensor (datasets/FORMAT.md, "Sensor"): every field present, typed and in range.
+SensorRecord ParseSensor(JsonChecker& check, const json& sj, const std::string& p, int num_cameras) {
+  SensorRecord s;
+  if (!check.Object(sj, p)) return s;
+  constexpr double kBig = 1e12;
+  s.profile = check.String(sj, p, "profile", true);
+  s.auto_exposure = check.Bool(sj, p, "auto_exposure");
+  s.exposure_ms = check.Number(sj, p, "exposure_ms", 1.0, 0.0, 1e6, /*lo_open=*/true);
+  s.gain = check.Number(sj, p, "gain", 1.0, 1.0, 1e6);
+  s.min_exposure_ms = check.Number(sj, p, "min_exposure_ms", 0.01, 0.0, 1e6, /*lo_open=*/true);
+  s.max_exposure_ms = check.Number(sj, p, "max_exposure_ms", 20.0, 0.0, 1e6, /*lo_open=*/true);
+  if (s.min_exposure_ms > s.max_exposure_ms)
+    check.Issue(p + "/min_exposure_ms", "greater than max_exposure_ms " + JsonChecker::Format(s.max_exposure_ms));
+  s.max_gain = check.Number(sj, p, "max_gain", 16.0, 1.0, 1e6);
+  s.ae_target = check.Number(sj, p, "ae_target", 0.18, 0.0, 1.0, /*lo_open=*/true);
+  s.ae_rate = check.Number(sj, p, "ae_rate", 0.25, 0.0, 1.0, /*lo_open=*/true);
+  s.ae_max_step_stops = check.Number(sj, p, "ae_max_step_stops", 0.5, 0.0, 100.0, /*lo_open=*/true);
+  s.meter_width = static_cast<int>(check.Integer(sj, p, "meter_width", 200, 1, 1 << 16));
+  s.sensitivity_e_per_ms = check.Number(sj, p, "sensitivity_e_per_ms", 1.0, 0.0, kBig, /*lo_open=*/true);
+  s.sensitivity_spread = check.Number(sj, p, "sensitivity_spread", 0.0, 0.0, 10.0);
+  s.camera_sensitivity = check.Numbers(sj, p, "camera_sensitivity", num_cameras);
+  for (size_t c = 0; c < s.camera_sensitivity.size(); ++c) {
+    if (!(s.camera_sensitivity[c] > 0.0))
+      check.Issue(p + "/camera_sensitivity/" + std::to_string(c), "must be > 0");
+  }
+  s.full_well_e = check.Number(sj, p, "full_well_e", 1.0, 0.0, kBig, /*lo_open=*/true);
+  s.shot_noise = check.Bool(sj, p, "shot_noise");
+  s.read_noise_e = check.Number(sj, p, "read_noise_e", 0.0, 0.0, kBig);
+  s.dark_current_e_per_s = check.Number(sj, p, "dark_current_e_per_s", 0.0, 0.0, kBig);
+  s.adc_bits = static_cast<int>(check.Integer(sj, p, "adc_bits", 12, 8, 16));
+  s.response = check.String(sj, p, "response", true);
+  if (!s.response.empty() && s.response != "srgb" && s.response != "bt709" && s.response != "linear")
+    check.Issue(p + "/response", "unknown response curve `" + s.response + "` (known: srgb, bt709, linear)");
+  s.grayscale = check.Bool(sj, p, "grayscale");
+  return s;
+}
+
+// /timing (datasets/FORMAT.md, "Timing"): every field present, typed and in range.
+TimingRecord ParseTiming(JsonChecker& check, const json& tj, const std::string& p, int num_cameras, bool has_sensor) {
+  TimingRecord t;
+  if (!check.Object(tj, p)) return t;
+  t.exposure = check.String(tj, p, "exposure", true);
+  if (!t.exposure.empty() && t.exposure != "none" && t.exposure != "fixed" && t.exposure != "sensor")
+    check.Issue(p + "/exposure", "unknown exposure `" + t.exposure + "` (known: none, fixed, sensor)");
+  if (t.exposure == "sensor" && !has_sensor)
+    check.Issue(p + "/exposure", "`sensor` needs the /sensor record (exposure.csv holds the exposure times)");
+  t.shutter_ms = check.Number(tj, p, "shutter_ms", 0.0, 0.0, 1000.0);
+  if (t.exposure == "fixed" && !(t.shutter_ms > 0.0)) check.Issue(p + "/shutter_ms", "must be > 0 with exposure `fixed`");
+  if (t.exposure != "fixed" && t.shutter_ms != 0.0)
+    check.Issue(p + "/shutter_ms", "must be 0 unless exposure is `fixed`");
+  t.rolling_shutter_ms = check.Number(tj, p, "rolling_shutter_ms", 0.0, 0.0, 1000.0);
+  t.trigger_offset_std_ms = check.Number(tj, p, "trigger_offset_std_ms", 0.0, 0.0, 1000.0);
+  t.trigger_offset_ms = check.Numbers(tj, p, "trigger_offset_ms", num_cameras);
+  for (size_t c = 0; c < t.trigger_offset_ms.size(); ++c) {
+    if (!(std::abs(t.trigger_offset_ms[c]) <= 1000.0))
+      check.Issue(p + "/trigger_offset_ms/" + std::to_string(c), "must be in [-1000, 1000]");
+  }
+  return t;
+}
+
 DatasetInfo ParseDatasetJson(JsonChecker& check, const json& root) {
   DatasetInfo info;
   if (!check.Object(root, "")) return info;
@@ -378,6 +440,10 @@ DatasetInfo ParseDatasetJson(JsonChecker& check, const json& root) {
   if (root.is_object() && root.contains("has_ground_truth")) info.has_ground_truth = check.Bool(root, "", "has_ground_truth");
   if (root.is_object() && root.contains("has_static_masks")) info.has_static_masks = check.Bool(root, "", "has_static_masks");
   if (const json* rig = check.Member(root, "", "rig")) info.rig = ParseRig(check, *rig, "/rig");
+  if (root.is_object() && root.contains("sensor"))
+    info.sensor = ParseSensor(check, root["sensor"], "/sensor", info.rig.NumCameras());
+  if (root.is_object() && root.contains("timing"))
+    info.timing = ParseTiming(check, root["timing"], "/timing", info.rig.NumCameras(), info.sensor.has_value());
   if (const json* perturbed = check.Member(root, "", "perturbed")) {
     if (!perturbed->is_array()) {
       check.Issue("/perturbed", "expected an array of perturbed extrinsic sets, found " + TypeName(*perturbed));
@@ -410,6 +476,38 @@ json CameraJson(const RigCamera& rc) {
   j["max_fov_deg"] = rc.camera.max_fov_deg;
   j["cam_from_rig"] = Rigid3ToJson(rc.cam_from_rig);
   return j;
+}
+
+json SensorJson(const SensorRecord& s) {
+  return json{{"profile", s.profile},
+              {"auto_exposure", s.auto_exposure},
+              {"exposure_ms", s.exposure_ms},
+              {"gain", s.gain},
+              {"min_exposure_ms", s.min_exposure_ms},
+              {"max_exposure_ms", s.max_exposure_ms},
+              {"max_gain", s.max_gain},
+              {"ae_target", s.ae_target},
+              {"ae_rate", s.ae_rate},
+              {"ae_max_step_stops", s.ae_max_step_stops},
+              {"meter_width", s.meter_width},
+              {"sensitivity_e_per_ms", s.sensitivity_e_per_ms},
+              {"sensitivity_spread", s.sensitivity_spread},
+              {"camera_sensitivity", s.camera_sensitivity},
+              {"full_well_e", s.full_well_e},
+              {"shot_noise", s.shot_noise},
+              {"read_noise_e", s.read_noise_e},
+              {"dark_current_e_per_s", s.dark_current_e_per_s},
+              {"adc_bits", s.adc_bits},
+              {"response", s.response},
+              {"grayscale", s.grayscale}};
+}
+
+json TimingJson(const TimingRecord& t) {
+  return json{{"exposure", t.exposure},
+              {"shutter_ms", t.shutter_ms},
+              {"rolling_shutter_ms", t.rolling_shutter_ms},
+              {"trigger_offset_std_ms", t.trigger_offset_std_ms},
+              {"trigger_offset_ms", t.trigger_offset_ms}};
 }
 
 // Image header check (OpenImageIO reads the header only).
@@ -458,7 +556,81 @@ std::set<int> FrameFilesIn(const std::string& folder, const std::string& extensi
   return frames;
 }
 
+constexpr const char* kExposureHeader = "frame,camera,exposure_ms,gain,meter_luminance,dn_per_radiance,dark_dn";
+
+// exposure.csv rows with every problem recorded as (path, "line N", message naming the column).
+std::vector<ExposureRow> ParseExposureCsv(const std::string& text, const std::string& path, int frame_count,
+                                          const Rig& rig, std::vector<ValidationIssue>* issues) {
+  std::vector<ExposureRow> rows;
+  const int num_cameras = rig.NumCameras();
+  std::stringstream in(text);
+  std::string line;
+  int line_number = 0;
+  auto issue = [&](const std::string& message) {
+    issues->push_back({path, "line " + std::to_string(line_number), message});
+  };
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line_number == 1) {
+      if (line != kExposureHeader) issue(std::string("expected the header `") + kExposureHeader + "`");
+      continue;
+    }
+    if (line.empty()) continue;
+    std::vector<std::string> fields;
+    std::stringstream fs_line(line);
+    for (std::string f; std::getline(fs_line, f, ',');) fields.push_back(f);
+    if (fields.size() != 7) {
+      issue("expected 7 comma-separated fields, found " + std::to_string(fields.size()));
+      continue;
+    }
+    const int index = static_cast<int>(rows.size());
+    ExposureRow row;
+    const int expected_frame = num_cameras > 0 ? index / num_cameras : 0;
+    const std::string expected_camera = num_cameras > 0 ? rig.cameras[index % num_cameras].name : "";
+    char* end = nullptr;
+    const long frame = std::strtol(fields[0].c_str(), &end, 10);
+    if (fields[0].empty() || *end != '\0' || frame != expected_frame)
+      issue("column frame: `" + fields[0] + "`, expected " + std::to_string(expected_frame) +
+            " (rows are frame-major, cameras in rig order)");
+    row.frame = static_cast<int>(frame);
+    row.camera = fields[1];
+    if (row.camera != expected_camera) issue("column camera: `" + row.camera + "`, expected `" + expected_camera + "`");
+    const char* names[5] = {"exposure_ms", "gain", "meter_luminance", "dn_per_radiance", "dark_dn"};
+    const double lower[5] = {0.0, 1.0, 0.0, 0.0, 0.0};
+    const bool lower_open[5] = {true, false, false, true, false};
+    double* values[5] = {&row.exposure_ms, &row.gain, &row.meter_luminance, &row.dn_per_radiance, &row.dark_dn};
+    for (int k = 0; k < 5; ++k) {
+      const std::string& f = fields[2 + k];
+      const double v = std::strtod(f.c_str(), &end);
+      if (f.empty() || *end != '\0' || !std::isfinite(v)) {
+        issue(std::string("column ") + names[k] + ": `" + f + "` is not a finite number");
+      } else if (v < lower[k] || (lower_open[k] && v == lower[k])) {
+        issue(std::string("column ") + names[k] + ": " + JsonChecker::Format(v) + " must be " +
+              (lower_open[k] ? "> " : ">= ") + JsonChecker::Format(lower[k]));
+      }
+      *values[k] = v;
+    }
+    rows.push_back(row);
+  }
+  const size_t expected_rows = static_cast<size_t>(frame_count) * num_cameras;
+  if (line_number == 0) {
+    issues->push_back({path, "file", "empty file (expected the header and one row per frame and camera)"});
+  } else if (rows.size() != expected_rows) {
+    issues->push_back({path, "lines", std::to_string(rows.size()) + " rows but dataset.json has " +
+                                          std::to_string(frame_count) + " frames x " + std::to_string(num_cameras) +
+                                          " cameras = " + std::to_string(expected_rows)});
+  }
+  return rows;
+}
+
 }  // namespace
+
+bool SensorRecord::operator==(const SensorRecord& o) const {
+  return SensorJson(*this) == SensorJson(o);
+}
+
+bool TimingRecord::operator==(const TimingRecord& o) const { return TimingJson(*this) == TimingJson(o); }
 
 // ---- paths --------------------------------------------------------------------------------------
 
@@ -467,6 +639,7 @@ std::string GroundTruthPath(const std::string& dir) { return JoinPath(dir, "grou
 std::string StaticMaskPath(const std::string& dir, const std::string& camera_name) {
   return JoinPath(JoinPath(dir, "static_masks"), camera_name + ".png");
 }
+std::string ExposurePath(const std::string& dir) { return JoinPath(dir, "exposure.csv"); }
 std::string ImagePath(const std::string& dir, const std::string& camera_name, int frame) {
   return (fs::path(dir) / camera_name / FrameFileName(frame, "png")).string();
 }
@@ -558,8 +731,30 @@ void WriteDatasetInfo(const std::string& dir, const DatasetInfo& info) {
                              {"cam_from_rig", transforms}});
   }
   root["perturbed"] = perturbed;
+  if (info.sensor) root["sensor"] = SensorJson(*info.sensor);
+  if (info.timing) root["timing"] = TimingJson(*info.timing);
   EnsureWritableDir(dir);
   WriteJsonFileAtomic(DatasetJsonPath(dir), root);
+}
+
+// ---- exposure.csv -------------------------------------------------------------------------------
+
+void WriteExposureCsv(const std::string& path, const std::vector<ExposureRow>& rows) {
+  std::string text = std::string(kExposureHeader) + "\n";
+  char buf[512];
+  for (const ExposureRow& r : rows) {
+    std::snprintf(buf, sizeof(buf), "%d,%s,%.17g,%.17g,%.17g,%.17g,%.17g\n", r.frame, r.camera.c_str(), r.exposure_ms,
+                  r.gain, r.meter_luminance, r.dn_per_radiance, r.dark_dn);
+    text += buf;
+  }
+  WriteFileAtomic(path, text);
+}
+
+std::vector<ExposureRow> ReadExposureCsv(const std::string& path, int frame_count, const Rig& rig) {
+  std::vector<ValidationIssue> issues;
+  std::vector<ExposureRow> rows = ParseExposureCsv(ReadFile(path), path, frame_count, rig, &issues);
+  if (!issues.empty()) throw std::runtime_error(JoinIssues(issues));
+  return rows;
 }
 
 // ---- validator ----------------------------------------------------------------------------------
@@ -573,6 +768,20 @@ static void CheckStaticMasks(const std::string& dir, const DatasetInfo& info, st
     } else {
       CheckImage(path, "header", rc.camera.width, rc.camera.height, 1, issues);
     }
+  }
+}
+
+// exposure.csv of a dataset whose dataset.json has /sensor: present, one row per frame and camera.
+static void CheckExposureRecord(const std::string& dir, const DatasetInfo& info, std::vector<ValidationIssue>* issues) {
+  const std::string path = ExposurePath(dir);
+  if (!fs::exists(path)) {
+    issues->push_back({path, "file", "missing exposure record of every frame and camera (dataset.json has /sensor)"});
+    return;
+  }
+  try {
+    ParseExposureCsv(ReadFile(path), path, info.frame_count, info.rig, issues);
+  } catch (const std::exception& e) {
+    issues->push_back({path, "file", e.what()});
   }
 }
 
@@ -643,6 +852,7 @@ std::vector<ValidationIssue> ValidateDataset(const std::string& dir) {
   }
 
   if (json_ok && info.has_static_masks) CheckStaticMasks(dir, info, &issues);
+  if (json_ok && info.sensor) CheckExposureRecord(dir, info, &issues);
 
   // Images (and depth/masks when declared): present, readable, the rig camera's size; no extras.
   struct Layer {
@@ -652,7 +862,8 @@ std::vector<ValidationIssue> ValidateDataset(const std::string& dir) {
     int max_channels;
     std::string (*path)(const std::string&, const std::string&, int);
   };
-  const Layer layers[3] = {{true, "", "png", 4, &ImagePath},
+  const int image_channels = info.sensor && info.sensor->grayscale ? 1 : 4;  // a grayscale sensor: 1 channel
+  const Layer layers[3] = {{true, "", "png", image_channels, &ImagePath},
                            {info.has_depth, "depth/", "exr", 1, &DepthPath},
                            {info.has_masks, "masks/", "png", 1, &MaskPath}};
   for (const Layer& layer : layers) {

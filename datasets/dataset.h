@@ -6,12 +6,65 @@
 #include "datasets/trajectory.h"
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace rovo {
 
 inline constexpr int kDatasetSchemaVersion = 1;
+
+// dataset.json "sensor": the physical sensor model a render used (render/sensor.h; the rules are
+// in datasets/FORMAT.md, section "Sensor"). Absent for the default rendering.
+struct SensorRecord {
+  std::string profile;               // "ideal", "realistic"
+  bool auto_exposure = true;
+  double exposure_ms = 0.1;          // fixed exposure (auto_exposure false)
+  double gain = 1.0;                 // fixed analogue gain (auto_exposure false)
+  double min_exposure_ms = 0.01;
+  double max_exposure_ms = 20.0;
+  double max_gain = 16.0;
+  double ae_target = 0.18;
+  double ae_rate = 0.25;
+  double ae_max_step_stops = 0.5;
+  int meter_width = 200;
+  double sensitivity_e_per_ms = 100000.0;
+  double sensitivity_spread = 0.0;
+  std::vector<double> camera_sensitivity;  // q_c, one per rig camera
+  double full_well_e = 10000.0;
+  bool shot_noise = true;
+  double read_noise_e = 0.0;
+  double dark_current_e_per_s = 0.0;
+  int adc_bits = 12;
+  std::string response = "srgb";     // "srgb", "bt709" or "linear"
+  bool grayscale = false;            // 1-channel images
+  bool operator==(const SensorRecord& other) const;
+  bool operator!=(const SensorRecord& other) const { return !(*this == other); }
+};
+
+// dataset.json "timing": trigger offsets, motion blur and rolling shutter of a render
+// (render/timing.h; the time rules are in datasets/FORMAT.md, section "Timing"). Absent when every
+// camera saw frame i at the time of line i of groundtruth.tum.
+struct TimingRecord {
+  std::string exposure = "none";        // motion blur interval: "none", "fixed" (shutter_ms), "sensor" (exposure.csv)
+  double shutter_ms = 0.0;              // the fixed interval ("fixed"), else 0
+  double rolling_shutter_ms = 0.0;      // readout of the whole image, top row first; 0 = global shutter
+  double trigger_offset_std_ms = 0.0;   // standard deviation of the seeded draw (0: explicit or none)
+  std::vector<double> trigger_offset_ms;  // o_c, one per rig camera
+  bool operator==(const TimingRecord& other) const;
+  bool operator!=(const TimingRecord& other) const { return !(*this == other); }
+};
+
+// One line of exposure.csv: the exposure of one camera at one dataset frame.
+struct ExposureRow {
+  int frame = 0;
+  std::string camera;
+  double exposure_ms = 0.0;
+  double gain = 1.0;
+  double meter_luminance = 0.0;  // the auto-exposure meter's centre-weighted mean luminance
+  double dn_per_radiance = 0.0;  // mean ADC codes per unit scene radiance (before clipping)
+  double dark_dn = 0.0;          // mean ADC codes of the dark signal
+};
 
 struct DatasetInfo {
   int schema_version = kDatasetSchemaVersion;
@@ -31,6 +84,10 @@ struct DatasetInfo {
   // vehicle, operator), honoured by the start-up calibration's detector.
   bool has_ground_truth = true;
   bool has_static_masks = false;
+  // Rendered with the sensor model: its parameters, and exposure.csv holds every frame's exposure.
+  std::optional<SensorRecord> sensor;
+  // Rendered with exposure timing effects (trigger offsets, motion blur, rolling shutter).
+  std::optional<TimingRecord> timing;
 };
 
 // Paths inside a dataset folder.
@@ -40,11 +97,18 @@ std::string ImagePath(const std::string& dir, const std::string& camera_name, in
 std::string DepthPath(const std::string& dir, const std::string& camera_name, int frame);  // depth/camN/NNNNNN.exr
 std::string MaskPath(const std::string& dir, const std::string& camera_name, int frame);   // masks/camN/NNNNNN.png
 std::string StaticMaskPath(const std::string& dir, const std::string& camera_name);      // static_masks/camN.png
+std::string ExposurePath(const std::string& dir);                                          // exposure.csv
 
 // Reads and checks dataset.json (throws std::runtime_error naming file and field).
 DatasetInfo ReadDatasetInfo(const std::string& dir);
 // Atomic write of dataset.json.
 void WriteDatasetInfo(const std::string& dir, const DatasetInfo& info);
+
+// exposure.csv (datasets/FORMAT.md): atomic write; the reader checks the header, every number and
+// that the rows are frames 0..frame_count-1 with the cameras in rig order, and throws
+// std::runtime_error naming the file, line and column.
+void WriteExposureCsv(const std::string& path, const std::vector<ExposureRow>& rows);
+std::vector<ExposureRow> ReadExposureCsv(const std::string& path, int frame_count, const Rig& rig);
 
 struct ValidationIssue {
   std::string file;   // path of the offending file

@@ -38,106 +38,216 @@ std::vector<int> ParseFrameList(const std::string& text) {
   return frames;
 }
 
+// The sensor options of `rovo render` (render/sensor.h); applied by Resolve() on top of --sensor.
+struct SensorArgs {
+  std::string profile = "off";
+  double exposure_ms = 0, gain = 0, ae_target = 0, sensitivity = 0, spread = 0, full_well = 0, read_noise = 0,
+         dark_current = 0;
+  std::string auto_exposure, shot_noise, response;
+  int adc_bits = 0;
+  bool grayscale = false;
+  float removed_noise = 0;
+  CLI::Option *o_exposure = nullptr, *o_gain = nullptr, *o_target = nullptr, *o_sensitivity = nullptr,
+              *o_spread = nullptr, *o_full_well = nullptr, *o_read = nullptr, *o_dark = nullptr, *o_ae = nullptr,
+              *o_shot = nullptr, *o_response = nullptr, *o_bits = nullptr, *o_gray = nullptr, *o_noise = nullptr;
+
+  void Add(CLI::App* cmd) {
+    const std::string g = "Sensor model (render/README.md; off by default: the scene's exposure and sRGB)";
+    cmd->add_option("--sensor", profile,
+                    "off | ideal (HDR sun, auto-exposure, sRGB response, no noise) | realistic (automotive fisheye "
+                    "camera: 12-bit ADC, 10 ke- full well, 3 e- read noise, shot noise, dark current, BT.709 "
+                    "response, 5 % per-camera sensitivity spread); exposure.csv records every exposure")
+        ->check(CLI::IsMember({"off", "ideal", "realistic"}))
+        ->group(g)
+        ->capture_default_str();
+    auto on_off = CLI::IsMember({"on", "off"});
+    o_ae = cmd->add_option("--auto-exposure", auto_exposure,
+                           "on | off (default on; off: the fixed --exposure-ms, default 0.1, and --gain, default 1)")
+               ->check(on_off)
+               ->group(g);
+    o_exposure = cmd->add_option("--exposure-ms", exposure_ms, "Fixed exposure time in ms (turns auto-exposure off)")
+                     ->group(g);
+    o_gain = cmd->add_option("--gain", gain, "Fixed analogue gain >= 1 (turns auto-exposure off)")->group(g);
+    o_target = cmd->add_option("--ae-target", ae_target,
+                               "Auto-exposure target: centre-weighted mean signal as a fraction of full scale "
+                               "(default 0.18)")
+                   ->group(g);
+    o_sensitivity = cmd->add_option("--sensitivity", sensitivity,
+                                    "Electrons per ms per unit scene radiance (default 100000)")
+                        ->group(g);
+    o_spread = cmd->add_option("--sensitivity-spread", spread,
+                               "Std. dev. of ln(per-camera sensitivity), seeded (ideal 0, realistic 0.05)")
+                   ->group(g);
+    o_full_well = cmd->add_option("--full-well", full_well, "Full-well capacity, electrons (default 10000)")->group(g);
+    o_read = cmd->add_option("--read-noise", read_noise, "Read noise, electrons rms (ideal 0, realistic 3)")->group(g);
+    o_dark = cmd->add_option("--dark-current", dark_current, "Dark current, electrons/s (ideal 0, realistic 50)")
+                 ->group(g);
+    o_shot = cmd->add_option("--shot-noise", shot_noise, "on | off: Poisson shot noise (ideal off, realistic on)")
+                 ->check(on_off)
+                 ->group(g);
+    o_bits = cmd->add_option("--adc-bits", adc_bits, "ADC bits in [8, 16] (ideal 16, realistic 12)")->group(g);
+    o_response = cmd->add_option("--response", response,
+                                 "Camera response curve: srgb | bt709 | linear (ideal srgb, realistic bt709)")
+                     ->check(CLI::IsMember({"srgb", "bt709", "linear"}))
+                     ->group(g);
+    o_gray = cmd->add_flag("--grayscale", grayscale, "Grayscale sensor: 1-channel PNG of the luminance")->group(g);
+    // Removed: the Gaussian 8-bit noise of earlier versions (hidden; fails with a pointer to --sensor).
+    o_noise = cmd->add_option("--noise", removed_noise, "")->group("");
+  }
+
+  SensorSettings Resolve() const {
+    if (o_noise->count() > 0)
+      throw std::invalid_argument(
+          "--noise was removed: the Gaussian noise in 8-bit units is replaced by the physical sensor model; use "
+          "--sensor realistic (shot, read and dark-current noise), or e.g. --sensor ideal --shot-noise on "
+          "--read-noise 3 (render/README.md, datasets/FORMAT.md section Sensor)");
+    SensorOverrides o;
+    if (o_exposure->count()) o.exposure_ms = exposure_ms;
+    if (o_gain->count()) o.gain = gain;
+    if (o_target->count()) o.ae_target = ae_target;
+    if (o_sensitivity->count()) o.sensitivity = sensitivity;
+    if (o_spread->count()) o.sensitivity_spread = spread;
+    if (o_full_well->count()) o.full_well = full_well;
+    if (o_read->count()) o.read_noise = read_noise;
+    if (o_dark->count()) o.dark_current = dark_current;
+    if (o_ae->count()) o.auto_exposure = auto_exposure == "on";
+    if (o_shot->count()) o.shot_noise = shot_noise == "on";
+    if (o_bits->count()) o.adc_bits = adc_bits;
+    if (o_response->count()) o.response = response;
+    if (o_gray->count()) o.grayscale = grayscale;
+    return MakeSensorSettings(profile, o);
+  }
+};
+
+// `rovo render`.
+void AddRenderCommand(CliGroups& groups) {
+  struct Args {
+    RenderOptions options;
+    std::string frames, shard;
+    SensorArgs sensor;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = groups.root->add_subcommand(
+      "render",
+      "Render a dataset (datasets/FORMAT.md) of a scene seen by a fisheye rig with the Embree tracer: "
+      "camN/NNNNNN.png, groundtruth.tum, dataset.json, optional depth/ and masks/ (and exposure.csv with "
+      "--sensor). Resumable: rerunning "
+      "skips frames whose files all exist.");
+  auto* preset = cmd->add_option("--preset", args->options.preset, "Scene preset to generate and render (e.g. static_urban)");
+  auto* scene = cmd->add_option("--scene", args->options.scene_dir, "Scene folder (scenes/FORMAT.md)");
+  preset->excludes(scene);
+  cmd->add_flag("--quick", args->options.quick, "The preset's quick form: fewer frames, smaller images");
+  cmd->add_option(
+      "--rig", args->options.rig,
+      "Rig preset (rovo4, omnimvs4, rovo4_real) or rig.json; default: the scene folder's rig.json, else the "
+      "scene's rig_preset, else rovo4 (the rig used is printed)");
+  cmd->add_option("--out", args->options.out_dir, "Output dataset folder")->required();
+  cmd->add_option("--frames", args->frames, "Trajectory frame range A:B (B exclusive; default: all)");
+  cmd->add_option("--shard", args->shard, "Render only shard I of N (chunks of 8 frames), e.g. 0/4");
+  cmd->add_option("--spp", args->options.spp,
+                  "Samples per pixel (default " + std::to_string(kDefaultSpp) + ", measured; 1 = pixel centres)");
+  cmd->add_option("--threads", args->options.threads, "Render threads (default: all cores)");
+  cmd->add_option("--seed", args->options.seed, "Scene seed (with --preset) and seed of the sensor model's draws")
+      ->capture_default_str();
+  cmd->add_flag("--depth", args->options.depth, "Also write depth/camN/NNNNNN.exr (ray length in metres)");
+  cmd->add_flag("--masks", args->options.masks, "Also write masks/camN/NNNNNN.png (16-bit object ids)");
+  cmd->add_option("--scale", args->options.scale,
+                  "Image size relative to the rig (same lens); default 1, or the preset's quick scale with --quick");
+  cmd->add_option("--vignetting", args->options.vignetting, "Vignetting strength in [0, 1] (default 0)");
+  args->sensor.Add(cmd);
+  {
+    const std::string g = "Timing (datasets/FORMAT.md, section Timing; all off by default)";
+    TimingSettings& t = args->options.timing;
+    cmd->add_option("--shutter-ms", t.shutter_ms,
+                    "Motion blur over a fixed exposure interval of this many ms, centred on each row's time "
+                    "(default spp " + std::to_string(kDefaultBlurSpp) + " when blurring)")
+        ->group(g);
+    cmd->add_flag("--motion-blur", t.shutter_from_sensor,
+                  "Motion blur over the sensor model's exposure time of each frame and camera (exposure.csv)")
+        ->group(g);
+    cmd->add_option("--rolling-shutter-ms", t.rolling_shutter_ms,
+                    "Rolling shutter: readout time of the whole image in ms, top row first")
+        ->group(g);
+    cmd->add_option("--trigger-offset-ms", t.trigger_offset_std_ms,
+                    "Per-camera trigger offsets: standard deviation in ms of a seeded normal draw (--seed)")
+        ->group(g);
+    cmd->add_option("--trigger-offsets-ms", t.trigger_offset_ms,
+                    "Per-camera trigger offsets in ms, one per camera in rig order, comma-separated")
+        ->delimiter(',')
+        ->group(g);
+  }
+  cmd->add_flag("--quiet", args->options.quiet, "No progress output");
+  cmd->callback([args] {
+    RenderOptions options = args->options;
+    if (!args->frames.empty()) ParseFrameRange(args->frames, &options.frame_begin, &options.frame_end);
+    if (!args->shard.empty()) ParseShard(args->shard, &options.shard_index, &options.shard_count);
+    options.sensor = args->sensor.Resolve();
+    const RenderSummary s = RenderDataset(options);
+    std::printf("rendered %d frames, skipped %d complete, %d in this shard, %.1f s\n%s\n", s.frames_rendered,
+                s.frames_skipped, s.frames_total, s.seconds, s.rig.c_str());
+  });
+}
+
+// `rovo scene preview`.
+void AddPreviewCommand(CliGroups& groups) {
+  struct Args {
+    PreviewOptions options;
+    std::string frames;
+    std::string dir;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = groups.scene->add_subcommand(
+      "preview", "Render a contact sheet of a scene: one row per frame, the rig's views side by side (PNG)");
+  cmd->add_option("dir", args->dir, "Scene folder (scenes/FORMAT.md)");
+  cmd->add_option("--preset", args->options.preset, "Instead of a folder: a scene preset (quick form)");
+  cmd->add_option("--seed", args->options.seed, "Seed of --preset")->capture_default_str();
+  cmd->add_option("--frames", args->frames, "Comma-separated trajectory frames (default: first, middle, last)");
+  cmd->add_option("--out", args->options.out_png, "Output PNG (default: <dir>/preview.png)");
+  cmd->add_option("--rig", args->options.rig, "Rig preset or rig.json (default: the scene's)");
+  cmd->add_option("--scale", args->options.scale, "Image scale of each view")->capture_default_str();
+  cmd->add_option("--spp", args->options.spp, "Samples per pixel")->capture_default_str();
+  cmd->add_option("--width", args->options.width, "Downscale the sheet to at most this many pixels wide (default: no limit)");
+  cmd->add_option("--threads", args->options.threads, "Threads (default: all cores)");
+  cmd->callback([args] {
+    PreviewOptions options = args->options;
+    options.scene_dir = args->dir;
+    if (!args->frames.empty()) options.frames = ParseFrameList(args->frames);
+    RenderScenePreview(options);
+  });
+}
+
+// `rovo bench render`.
+void AddRenderBenchCommand(CliGroups& groups) {
+  auto options = std::make_shared<RenderBenchOptions>();
+  CLI::App* cmd = groups.bench->add_subcommand(
+      "render",
+      "Render speed: s/frame and Mrays/s at 1 spp and default quality, raw Embree cast of the same rays "
+      "(ratio full/raw), BVH build time, peak memory, load average, optionally the Cycles ratio");
+  cmd->add_option("--preset", options->preset, "Scene preset")->capture_default_str();
+  cmd->add_option("--scene", options->scene_dir, "Scene folder instead of the preset");
+  cmd->add_option("--seed", options->seed, "Scene seed")->capture_default_str();
+  cmd->add_option("--frames", options->frames, "Frames to time")->capture_default_str();
+  cmd->add_option("--scale", options->scale, "Image scale")->capture_default_str();
+  cmd->add_option("--threads", options->threads, "Threads (default: all cores)");
+  cmd->add_option("--spp", options->spp, "Default-quality spp (0 = the default)");
+  cmd->add_flag("--quality", options->quality,
+                "Also measure anti-aliasing per spp, sample pattern and texture filter: mean error vs. a 32-spp "
+                "reference and shimmer (frame-to-frame change not in the reference) over quarter-pixel pan steps");
+  cmd->add_flag("--breakdown", options->breakdown,
+                "Also time the 1-spp render with bilinear (single mip level) texturing and without textures");
+  cmd->add_option("--cycles-timing", options->cycles_timing,
+                  "timing.json written by scenes/blender/time_cycles_vs_rovo.py: print the Cycles/rovo ratio "
+                  "(Cycles takes minutes per frame, so it is timed by that script, not here)");
+  cmd->add_option("--write", options->write_dir, "Also time a full `rovo render` of the frames into this folder");
+  cmd->callback([options] { RunRenderBenchmark(*options); });
+}
+
 }  // namespace
 
 void AddRenderCommands(CliGroups& groups) {
-  // ---- rovo render
-  {
-    struct Args {
-      RenderOptions options;
-      std::string frames, shard;
-    };
-    auto args = std::make_shared<Args>();
-    CLI::App* cmd = groups.root->add_subcommand(
-        "render",
-        "Render a dataset (datasets/FORMAT.md) of a scene seen by a fisheye rig with the Embree tracer: "
-        "camN/NNNNNN.png, groundtruth.tum, dataset.json, optional depth/ and masks/. Resumable: rerunning "
-        "skips frames whose files all exist.");
-    auto* preset = cmd->add_option("--preset", args->options.preset, "Scene preset to generate and render (e.g. static_urban)");
-    auto* scene = cmd->add_option("--scene", args->options.scene_dir, "Scene folder (scenes/FORMAT.md)");
-    preset->excludes(scene);
-    cmd->add_flag("--quick", args->options.quick, "The preset's quick form: fewer frames, smaller images");
-    cmd->add_option(
-        "--rig", args->options.rig,
-        "Rig preset (rovo4, omnimvs4, rovo4_real) or rig.json; default: the scene folder's rig.json, else the "
-        "scene's rig_preset, else rovo4 (the rig used is printed)");
-    cmd->add_option("--out", args->options.out_dir, "Output dataset folder")->required();
-    cmd->add_option("--frames", args->frames, "Trajectory frame range A:B (B exclusive; default: all)");
-    cmd->add_option("--shard", args->shard, "Render only shard I of N (chunks of 8 frames), e.g. 0/4");
-    cmd->add_option("--spp", args->options.spp,
-                    "Samples per pixel (default " + std::to_string(kDefaultSpp) + ", measured; 1 = pixel centres)");
-    cmd->add_option("--threads", args->options.threads, "Render threads (default: all cores)");
-    cmd->add_option("--seed", args->options.seed, "Scene seed (with --preset) and sensor-noise seed")->capture_default_str();
-    cmd->add_flag("--depth", args->options.depth, "Also write depth/camN/NNNNNN.exr (ray length in metres)");
-    cmd->add_flag("--masks", args->options.masks, "Also write masks/camN/NNNNNN.png (16-bit object ids)");
-    cmd->add_option("--scale", args->options.scale,
-                    "Image size relative to the rig (same lens); default 1, or the preset's quick scale with --quick");
-    cmd->add_option("--noise", args->options.noise_sigma, "Gaussian sensor noise, std. dev. in 8-bit units (default 0)");
-    cmd->add_option("--vignetting", args->options.vignetting, "Vignetting strength in [0, 1] (default 0)");
-    cmd->add_flag("--quiet", args->options.quiet, "No progress output");
-    cmd->callback([args] {
-      RenderOptions options = args->options;
-      if (!args->frames.empty()) ParseFrameRange(args->frames, &options.frame_begin, &options.frame_end);
-      if (!args->shard.empty()) ParseShard(args->shard, &options.shard_index, &options.shard_count);
-      const RenderSummary s = RenderDataset(options);
-      std::printf("rendered %d frames, skipped %d complete, %d in this shard, %.1f s\n%s\n", s.frames_rendered,
-                  s.frames_skipped, s.frames_total, s.seconds, s.rig.c_str());
-    });
-  }
-
-  // ---- rovo scene preview
-  {
-    struct Args {
-      PreviewOptions options;
-      std::string frames;
-      std::string dir;
-    };
-    auto args = std::make_shared<Args>();
-    CLI::App* cmd = groups.scene->add_subcommand(
-        "preview", "Render a contact sheet of a scene: one row per frame, the rig's views side by side (PNG)");
-    cmd->add_option("dir", args->dir, "Scene folder (scenes/FORMAT.md)");
-    cmd->add_option("--preset", args->options.preset, "Instead of a folder: a scene preset (quick form)");
-    cmd->add_option("--seed", args->options.seed, "Seed of --preset")->capture_default_str();
-    cmd->add_option("--frames", args->frames, "Comma-separated trajectory frames (default: first, middle, last)");
-    cmd->add_option("--out", args->options.out_png, "Output PNG (default: <dir>/preview.png)");
-    cmd->add_option("--rig", args->options.rig, "Rig preset or rig.json (default: the scene's)");
-    cmd->add_option("--scale", args->options.scale, "Image scale of each view")->capture_default_str();
-    cmd->add_option("--spp", args->options.spp, "Samples per pixel")->capture_default_str();
-    cmd->add_option("--width", args->options.width, "Downscale the sheet to at most this many pixels wide (default: no limit)");
-    cmd->add_option("--threads", args->options.threads, "Threads (default: all cores)");
-    cmd->callback([args] {
-      PreviewOptions options = args->options;
-      options.scene_dir = args->dir;
-      if (!args->frames.empty()) options.frames = ParseFrameList(args->frames);
-      RenderScenePreview(options);
-    });
-  }
-
-  // ---- rovo bench render
-  {
-    auto options = std::make_shared<RenderBenchOptions>();
-    CLI::App* cmd = groups.bench->add_subcommand(
-        "render",
-        "Render speed: s/frame and Mrays/s at 1 spp and default quality, raw Embree cast of the same rays "
-        "(ratio full/raw), BVH build time, peak memory, load average, optionally the Cycles ratio");
-    cmd->add_option("--preset", options->preset, "Scene preset")->capture_default_str();
-    cmd->add_option("--scene", options->scene_dir, "Scene folder instead of the preset");
-    cmd->add_option("--seed", options->seed, "Scene seed")->capture_default_str();
-    cmd->add_option("--frames", options->frames, "Frames to time")->capture_default_str();
-    cmd->add_option("--scale", options->scale, "Image scale")->capture_default_str();
-    cmd->add_option("--threads", options->threads, "Threads (default: all cores)");
-    cmd->add_option("--spp", options->spp, "Default-quality spp (0 = the default)");
-    cmd->add_flag("--quality", options->quality,
-                  "Also measure anti-aliasing per spp, sample pattern and texture filter: mean error vs. a 32-spp "
-                  "reference and shimmer (frame-to-frame change not in the reference) over quarter-pixel pan steps");
-    cmd->add_flag("--breakdown", options->breakdown,
-                  "Also time the 1-spp render with bilinear (single mip level) texturing and without textures");
-    cmd->add_option("--cycles-timing", options->cycles_timing,
-                    "timing.json written by scenes/blender/time_cycles_vs_rovo.py: print the Cycles/rovo ratio "
-                    "(Cycles takes minutes per frame, so it is timed by that script, not here)");
-    cmd->add_option("--write", options->write_dir, "Also time a full `rovo render` of the frames into this folder");
-    cmd->callback([options] { RunRenderBenchmark(*options); });
-  }
+  AddRenderCommand(groups);
+  AddPreviewCommand(groups);
+  AddRenderBenchCommand(groups);
 }
 
 }  // namespace rovo

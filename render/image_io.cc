@@ -43,6 +43,14 @@ void WritePngRgb8(const std::string& path, int width, int height, const std::vec
   WriteImage(path, "png", spec, rgb.data());
 }
 
+void WritePngGray8(const std::string& path, int width, int height, const std::vector<uint8_t>& gray) {
+  OIIO::ImageSpec spec(width, height, 1, OIIO::TypeDesc::UINT8);
+  spec.attribute("png:compressionLevel", 1);
+  spec.attribute("png:filter", 0x20);  // "Up" only, as WritePngRgb8
+  spec.attribute("Software", "rovo " ROVO_VERSION);
+  WriteImage(path, "png", spec, gray.data());
+}
+
 void WritePngGray16(const std::string& path, int width, int height, const std::vector<uint16_t>& values) {
   OIIO::ImageSpec spec(width, height, 1, OIIO::TypeDesc::UINT16);
   spec.attribute("png:compressionLevel", 1);

@@ -12,6 +12,8 @@ namespace rovo {
 // 8-bit RGB PNG (zlib level 1: the DESIGN.md measurement shows higher levels cost more than tracing;
 // the "Up" row filter only: half the encoding time of libpng's adaptive filter choice).
 void WritePngRgb8(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
+// 8-bit single-channel PNG (a grayscale sensor's images), same settings as WritePngRgb8.
+void WritePngGray8(const std::string& path, int width, int height, const std::vector<uint8_t>& gray);
 // 16-bit single-channel PNG (object ids).
 void WritePngGray16(const std::string& path, int width, int height, const std::vector<uint16_t>& values);
 // float32 single-channel OpenEXR (zip compression).

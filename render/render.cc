@@ -10,13 +10,16 @@
 
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
 #include <deque>
 #include <exception>
 #include <filesystem>
+#include <limits>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 
@@ -118,7 +121,12 @@ class FrameWriter {
     }
     for (int c = 0; c < rig_.NumCameras(); ++c) {
       const CameraImage& image = job.images[c];
-      WritePngRgb8(ImagePath(out_dir_, rig_.cameras[c].name, job.dataset_frame), image.width, image.height, image.rgb);
+      const std::string path = ImagePath(out_dir_, rig_.cameras[c].name, job.dataset_frame);
+      if (!image.gray.empty()) {
+        WritePngGray8(path, image.width, image.height, image.gray);  // a grayscale sensor
+      } else {
+        WritePngRgb8(path, image.width, image.height, image.rgb);
+      }
     }
   }
 
@@ -148,6 +156,10 @@ void CheckExistingDataset(const std::string& out_dir, const DatasetInfo& info) {
   if (old.seed != info.seed) differ("seed");
   if (old.has_depth != info.has_depth) differ("has_depth");
   if (old.has_masks != info.has_masks) differ("has_masks");
+  if (old.sensor.has_value() != info.sensor.has_value() || (old.sensor && *old.sensor != *info.sensor))
+    differ("sensor");
+  if (old.timing.has_value() != info.timing.has_value() || (old.timing && *old.timing != *info.timing))
+    differ("timing");
   if (old.rig.NumCameras() != info.rig.NumCameras()) differ("rig/cameras");
   for (int c = 0; c < info.rig.NumCameras(); ++c) {
     const Camera& a = old.rig.cameras[c].camera;
@@ -229,8 +241,9 @@ void CheckRenderOptions(const RenderOptions& options) {
                                 std::to_string(options.shard_count) + ": need 0 <= I < N");
   if (options.spp < 0 || options.spp > 1024) throw std::invalid_argument("--spp: must be in [1, 1024]");
   if (options.threads < 0) throw std::invalid_argument("--threads: must be >= 0");
-  if (options.noise_sigma < 0.0f || options.vignetting < 0.0f || options.vignetting > 1.0f)
-    throw std::invalid_argument("--noise must be >= 0 and --vignetting in [0, 1]");
+  if (!(options.vignetting >= 0.0f && options.vignetting <= 1.0f))
+    throw std::invalid_argument("--vignetting must be in [0, 1]");
+  options.sensor.Check();
 }
 
 // The scene has a trajectory and every dynamic object has one pose per trajectory frame.
@@ -245,8 +258,69 @@ void CheckSceneMotion(const Scene& scene, const std::string& scene_name) {
   }
 }
 
+// The sensor model's per-render state: camera sensitivities, the meter of every dataset frame and
+// camera, and the exposure schedule (empty without the sensor model).
+struct SensorPlan {
+  std::vector<double> sensitivity;
+  std::vector<std::vector<double>> meter;
+  std::vector<std::vector<CameraExposure>> exposure;
+  std::vector<double> trigger_offset_ms;  // per camera (timing; empty when timing is off)
+  Trajectory groundtruth;                 // the dataset's rig poses, which timing interpolates
+};
+
+// The auto-exposure meter of dataset frames [0, count) (trajectory frames begin + f): per camera a
+// 1-spp linear render with the sun, sensor.meter_width pixels wide (at most the image width), and
+// its MeterLuminance.
+std::vector<std::vector<double>> MeterFrames(const RenderOptions& options, const Scene& scene, const Rig& rig,
+                                             int begin, int count, tbb::task_arena& arena, Tracer& tracer) {
+  std::vector<CameraRays> rays;
+  arena.execute([&] {
+    std::vector<Camera> cameras;
+    for (const RigCamera& cam : rig.cameras) {
+      Rig one;
+      one.cameras = {cam};
+      const double scale = std::min(1.0, static_cast<double>(options.sensor.meter_width) / cam.camera.width);
+      cameras.push_back(scale < 1.0 ? one.Scaled(scale).cameras[0].camera : cam.camera);
+    }
+    rays = MakeCameraRays(cameras, 0, 1);
+  });
+  ShadeSettings settings;
+  settings.spp = 1;
+  settings.vignetting = options.vignetting;
+  settings.linear_output = true;
+  settings.sun_disc = true;
+  std::vector<std::vector<double>> meter(count, std::vector<double>(rig.NumCameras(), 0.0));
+  Progress progress("meter " + options.out_dir, count, "frames", options.quiet);
+  CameraImage image;
+  for (int f = 0; f < count; ++f) {
+    const Rigid3& world_from_rig = scene.rig_trajectory[begin + f].world_from_rig;
+    arena.execute([&] {
+      tracer.SetFrame(begin + f);
+      for (int c = 0; c < rig.NumCameras(); ++c) {
+        tracer.Render(rays[c], world_from_rig * rig.cameras[c].cam_from_rig.Inverse(), settings, &image);
+        meter[f][c] = MeterLuminance(image.linear, rays[c].bearing, rays[c].valid);
+      }
+    });
+    progress.Add(1);
+  }
+  progress.Finish();
+  return meter;
+}
+
+// Sensitivities, meter and exposure schedule of a render with the sensor model (else empty).
+SensorPlan PlanSensor(const RenderOptions& options, const Scene& scene, const Rig& rig, int begin, int count,
+                      tbb::task_arena& arena, Tracer& tracer) {
+  SensorPlan plan;
+  if (!options.sensor.enabled) return plan;
+  plan.sensitivity = CameraSensitivities(options.sensor, rig.NumCameras(), options.seed);
+  plan.meter = MeterFrames(options, scene, rig, begin, count, arena, tracer);
+  plan.exposure = ExposureSchedule(options.sensor, plan.meter, scene.frame_rate);
+  return plan;
+}
+
 // dataset.json of `count` frames rendered with `rig`.
-DatasetInfo MakeDatasetInfo(const RenderOptions& options, const Scene& scene, const Rig& rig, int count) {
+DatasetInfo MakeDatasetInfo(const RenderOptions& options, const Scene& scene, const Rig& rig, int count,
+                            const SensorPlan& plan) {
   DatasetInfo info;
   info.generator = "rovo render";
   info.generator_version = ROVO_VERSION;
@@ -261,6 +335,8 @@ DatasetInfo MakeDatasetInfo(const RenderOptions& options, const Scene& scene, co
   }
   info.has_depth = options.depth;
   info.has_masks = options.masks;
+  if (options.sensor.enabled) info.sensor = MakeSensorRecord(options.sensor, plan.sensitivity);
+  if (options.timing.Enabled()) info.timing = MakeTimingRecord(options.timing, plan.trigger_offset_ms);
   return info;
 }
 
@@ -271,10 +347,17 @@ void PrepareDir(const std::string& file_in_dir) {
 }
 
 // The output folder, its whole-range files (identical from every shard) and the per-camera folders.
-void PrepareOutput(const RenderOptions& options, const DatasetInfo& info, const Trajectory& groundtruth) {
+void PrepareOutput(const RenderOptions& options, const DatasetInfo& info, const Trajectory& groundtruth,
+                   const SensorPlan& plan) {
   EnsureWritableDir(options.out_dir);
   CheckExistingDataset(options.out_dir, info);
   WriteTum(GroundTruthPath(options.out_dir), groundtruth);
+  if (options.sensor.enabled) {
+    std::vector<std::string> names;
+    for (const RigCamera& cam : info.rig.cameras) names.push_back(cam.name);
+    WriteExposureCsv(ExposurePath(options.out_dir),
+                     MakeExposureRows(options.sensor, plan.exposure, plan.meter, plan.sensitivity, names));
+  }
   WriteDatasetInfo(options.out_dir, info);
   for (const RigCamera& cam : info.rig.cameras) {
     PrepareDir(ImagePath(options.out_dir, cam.name, 0));
@@ -298,10 +381,64 @@ std::vector<int> FramesToRender(const RenderOptions& options, const Rig& rig, in
   return todo;
 }
 
+// Exposure times (ms) of dataset frame f's cameras for the motion blur: the fixed shutter, the
+// sensor's exposure, or zeros.
+std::vector<double> ShutterMs(const TimingSettings& timing, const SensorPlan& plan, int f, int num_cameras) {
+  std::vector<double> shutter(num_cameras, timing.shutter_ms);
+  if (timing.shutter_from_sensor)
+    for (int c = 0; c < num_cameras; ++c) shutter[c] = plan.exposure[f][c].exposure_ms;
+  return shutter;
+}
+
+// Timing needs the trajectory around every frame: the window of each frame (HalfWindowSeconds)
+// must stay within its neighbouring trajectory intervals, so that the three motion steps of the
+// dynamic objects (Tracer::SetFrameWindow) hold the exact poses. Throws naming the options.
+void CheckTimingWindows(const RenderOptions& options, const Scene& scene, int begin, int count,
+                        const SensorPlan& plan, int num_cameras) {
+  const Trajectory& traj = scene.rig_trajectory;
+  for (int f = 0; f < count; ++f) {
+    const int i = begin + f;
+    const double h = HalfWindowSeconds(plan.trigger_offset_ms, options.timing.rolling_shutter_ms,
+                                       ShutterMs(options.timing, plan, f, num_cameras));
+    double room = std::numeric_limits<double>::infinity();
+    if (i > 0) room = std::min(room, traj[i].timestamp - traj[i - 1].timestamp);
+    if (i + 1 < static_cast<int>(traj.size())) room = std::min(room, traj[i + 1].timestamp - traj[i].timestamp);
+    if (h > room)
+      throw std::invalid_argument(
+          "--shutter-ms/--motion-blur, --rolling-shutter-ms, --trigger-offset(s)-ms: frame " + std::to_string(i) +
+          " is exposed up to " + std::to_string(h * 1000.0) + " ms from its time, beyond the trajectory interval of " +
+          std::to_string(room * 1000.0) + " ms");
+  }
+}
+
+// The images of one frame with timing (render/timing.h): the dynamic objects over the frame's
+// window (the scene's motion), each camera at its own times (the rig from the dataset's poses).
+void RenderTimedFrame(const RenderOptions& options, const Rig& rig, int traj_frame, int f,
+                      const SensorPlan& plan, const std::vector<CameraRays>& rays, const ShadeSettings& settings,
+                      Tracer& tracer, std::vector<float>* linear, const SensorPipeline* pipeline, FrameJob* job) {
+  const std::vector<double> shutter = ShutterMs(options.timing, plan, f, rig.NumCameras());
+  const double h = HalfWindowSeconds(plan.trigger_offset_ms, options.timing.rolling_shutter_ms, shutter);
+  tracer.SetFrameWindow(traj_frame, h);
+  for (int c = 0; c < rig.NumCameras(); ++c) {
+    Rigid3 world_from_cam;
+    const CameraMotion motion =
+        MakeCameraMotion(plan.groundtruth, f, rig.cameras[c].cam_from_rig, h > 0.0 ? h : 1.0,
+                         plan.trigger_offset_ms[c], shutter[c], options.timing.rolling_shutter_ms,
+                         rays[c].height, &world_from_cam);
+    CameraImage& image = job->images[c];
+    if (pipeline) image.linear.swap(*linear);
+    tracer.Render(rays[c], world_from_cam, settings, &image, &motion);
+    if (!pipeline) continue;
+    pipeline->Apply(image.linear, rays[c].valid, plan.exposure[f][c], plan.sensitivity[c],
+                    SensorNoiseSeed(options.seed, f, c), options.sensor.grayscale ? &image.gray : &image.rgb);
+    image.linear.swap(*linear);
+  }
+}
+
 // Renders the dataset frames `todo` (trajectory frames begin + f) and writes them beside the tracer.
 void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& rig, int begin,
-                  const std::vector<int>& todo, int spp, tbb::task_arena& arena, Tracer& tracer,
-                  RenderSummary* summary) {
+                  const std::vector<int>& todo, int spp, const SensorPlan& plan, tbb::task_arena& arena,
+                  Tracer& tracer, RenderSummary* summary) {
   std::vector<CameraRays> rays;
   arena.execute([&] {
     std::vector<Camera> cameras;
@@ -313,8 +450,14 @@ void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& r
   settings.spp = spp;
   settings.want_depth = options.depth;
   settings.want_mask = options.masks;
-  settings.noise_sigma = options.noise_sigma;
   settings.vignetting = options.vignetting;
+  // The sensor model: the tracer hands over linear radiance (with the sun), the pipeline makes the image.
+  const bool sensor = options.sensor.enabled;
+  settings.linear_output = sensor;
+  settings.sun_disc = sensor;
+  std::optional<SensorPipeline> pipeline;
+  if (sensor) pipeline.emplace(options.sensor);
+  std::vector<float> linear;  // reused between images
 
   Progress progress("render " + options.out_dir, static_cast<int64_t>(todo.size()), "frames", options.quiet);
   {
@@ -326,11 +469,21 @@ void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& r
       job.dataset_frame = f;
       job.images.resize(rig.NumCameras());
       arena.execute([&] {
+        if (options.timing.Enabled()) {
+          RenderTimedFrame(options, rig, traj_frame, f, plan, rays, settings, tracer, &linear,
+                           pipeline ? &*pipeline : nullptr, &job);
+          return;
+        }
         tracer.SetFrame(traj_frame);
         for (int c = 0; c < rig.NumCameras(); ++c) {
           const Rigid3 world_from_cam = world_from_rig * rig.cameras[c].cam_from_rig.Inverse();
-          settings.noise_seed = SplitMix(options.seed ^ SplitMix(static_cast<uint64_t>(traj_frame) * 16 + c));
-          tracer.Render(rays[c], world_from_cam, settings, &job.images[c]);
+          CameraImage& image = job.images[c];
+          if (sensor) image.linear.swap(linear);
+          tracer.Render(rays[c], world_from_cam, settings, &image);
+          if (!sensor) continue;
+          pipeline->Apply(image.linear, rays[c].valid, plan.exposure[f][c], plan.sensitivity[c],
+                          SensorNoiseSeed(options.seed, f, c), options.sensor.grayscale ? &image.gray : &image.rgb);
+          image.linear.swap(linear);
         }
       });
       writer.Push(std::move(job));
@@ -364,21 +517,39 @@ RenderSummary RenderDataset(const RenderOptions& options) {
                             ": outside the trajectory of " + scene_name + " (frames 0:" + std::to_string(num_traj) +
                             ")");
   const int count = end - begin;
-  const DatasetInfo info = MakeDatasetInfo(options, scene, rig, count);
+  const SensorSettings& sensor = options.sensor;
+  if (sensor.enabled && !sensor.auto_exposure && sensor.exposure_ms > 1000.0 / scene.frame_rate)
+    throw std::invalid_argument("--exposure-ms " + std::to_string(sensor.exposure_ms) +
+                                ": longer than the frame period of " + scene_name + " (" +
+                                std::to_string(1000.0 / scene.frame_rate) + " ms)");
   const Trajectory groundtruth(scene.rig_trajectory.begin() + begin, scene.rig_trajectory.begin() + end);
   RenderSummary summary;
   summary.rig = DescribeRigChoice(rig_choice);
   if (!options.quiet) std::fprintf(stderr, "%s\n", summary.rig.c_str());  // before the long part
 
+  options.timing.Check(rig.NumCameras(), sensor.enabled);
+  if (options.timing.Enabled() && count < 2)
+    throw std::invalid_argument("--frames " + std::to_string(begin) + ":" + std::to_string(end) +
+                                ": timing needs at least 2 frames (the rig between frames comes from groundtruth.tum)");
+  const bool blur = options.timing.shutter_ms > 0.0 || options.timing.shutter_from_sensor;
+  const int spp = options.spp > 0 ? options.spp : blur ? kDefaultBlurSpp : kDefaultSpp;
+
   // The build of the tracer validates the scene's indices (before any output).
-  const int spp = options.spp > 0 ? options.spp : kDefaultSpp;
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   std::unique_ptr<Tracer> tracer;
   arena.execute([&] { tracer = std::make_unique<Tracer>(scene); });
+  // The sensor model's exposure schedule covers every frame of the range (before any output).
+  SensorPlan plan = PlanSensor(options, scene, rig, begin, count, arena, *tracer);
+  if (options.timing.Enabled()) {
+    plan.trigger_offset_ms = TriggerOffsetsMs(options.timing, rig.NumCameras(), options.seed);
+    plan.groundtruth = groundtruth;
+    CheckTimingWindows(options, scene, begin, count, plan, rig.NumCameras());
+  }
+  const DatasetInfo info = MakeDatasetInfo(options, scene, rig, count, plan);
 
-  PrepareOutput(options, info, groundtruth);
+  PrepareOutput(options, info, groundtruth, plan);
   const std::vector<int> todo = FramesToRender(options, rig, count, &summary);
-  RenderFrames(options, scene, rig, begin, todo, spp, arena, *tracer, &summary);
+  RenderFrames(options, scene, rig, begin, todo, spp, plan, arena, *tracer, &summary);
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
 }

@@ -2,6 +2,8 @@
 // Renders a dataset (datasets/FORMAT.md) from a scene and a rig. Entry point of `rovo render`.
 
 #include "datasets/rig.h"
+#include "render/sensor.h"
+#include "render/timing.h"
 #include "scenes/scene.h"
 
 #include <cstdint>
@@ -22,13 +24,16 @@ struct RenderOptions {
   int shard_count = 1;
   int spp = 0;                 // samples per pixel; 0 = the measured default
   int threads = 0;             // 0 = all cores
-  uint64_t seed = 0;           // scene seed (preset) and sensor-noise seed
+  uint64_t seed = 0;           // scene seed (preset) and seed of the sensor model's draws
   bool depth = false;          // write depth/ (EXR ray length)
   bool masks = false;          // write masks/ (16-bit object ids)
   double scale = 0.0;          // image scale; 0 = 1.0, or the preset's quick scale with --quick
   bool quiet = false;          // no progress output
-  float noise_sigma = 0.0f;    // optional Gaussian sensor noise, std. dev. in 8-bit units (0 = off)
   float vignetting = 0.0f;     // optional vignetting: gain 1 - v * (theta / theta_max)^2 (0 = off)
+  // The physical sensor model (render/sensor.h); off by default (the scene's exposure and sRGB).
+  SensorSettings sensor;
+  // Exposure timing (render/timing.h): trigger offsets, motion blur, rolling shutter; off by default.
+  TimingSettings timing;
 };
 
 struct RenderSummary {
@@ -42,15 +47,19 @@ struct RenderSummary {
 // Renders the frames of `options` (see RenderOptions) into options.out_dir. Throws
 // std::invalid_argument / std::runtime_error naming the file or option for bad input, before any
 // output is written. Resumable: frames whose files all exist are skipped (files appear only by
-// atomic rename). groundtruth.tum and dataset.json cover the whole frame range and are identical
-// from every shard. Images are identical for any thread count. Unless quiet, prints the rig line
-// (DescribeRigChoice) to stderr before rendering.
+// atomic rename). groundtruth.tum, dataset.json and, with the sensor model, exposure.csv cover the
+// whole frame range and are identical from every shard. Images are identical for any thread count.
+// Unless quiet, prints the rig line (DescribeRigChoice) to stderr before rendering. With the sensor
+// model, a small meter render of every frame of the range comes first (the auto-exposure schedule).
 RenderSummary RenderDataset(const RenderOptions& options);
 
 // Samples per pixel when RenderOptions::spp is 0: the cheapest setting whose mean error against a
 // 32-spp reference is below one 8-bit code (fixed 2-sample diagonal pattern, trilinear textures,
 // LOD bias -0.5; measured with `rovo bench render --quality`, table in render/README.md).
 inline constexpr int kDefaultSpp = 2;
+// Samples per pixel when RenderOptions::spp is 0 and motion blur is on: eight time strata per
+// pixel (the blur of a fast pan is several pixels wide; measured in render/README.md).
+inline constexpr int kDefaultBlurSpp = 8;
 // Shards take frames in chunks of this many consecutive frames: frame f belongs to shard
 // (f / kShardChunkFrames) % shard_count.
 inline constexpr int kShardChunkFrames = 8;

@@ -1,5 +1,7 @@
 #include "render/tracer.h"
 
+#include "render/timing.h"
+
 #include <embree3/rtcore.h>
 #include <pmmintrin.h>
 #include <tbb/blocked_range.h>
@@ -25,7 +27,7 @@ constexpr int kTile = 8;
 constexpr int kTilePixels = kTile * kTile;
 constexpr float kInvPi = 0.318309886f;
 
-// splitmix64: the per-pixel hash behind the fixed sample patterns and the sensor noise.
+// splitmix64: the per-pixel hash behind the fixed sample patterns and the soft-shadow sun samples.
 uint64_t Mix64(uint64_t x) {
   x += 0x9e3779b97f4a7c15ull;
   x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
@@ -278,14 +280,55 @@ struct Tracer::Impl {
   Eigen::Vector3f sun_dir, sun_e1, sun_e2;
   float sun_disc_radius = 0.0f;  // tan(angular diameter / 2)
   Eigen::Vector3f sky_mean, ground_irradiance;
+  bool sun_on = true;  // false when sun_radiance is zero: no sun term, no sun shadow rays
+
+  // Point and spot lights at the current frame, in world coordinates (render/tracer.h).
+  struct ShadeLight {
+    Eigen::Vector3f position = Eigen::Vector3f::Zero();
+    Eigen::Vector3f intensity = Eigen::Vector3f::Zero();
+    float rank_intensity = 0.0f;  // intensity.r + g + b
+    float inv_range2 = 0.0f;      // 1 / range^2; 0: no cut-off
+    bool spot = false;
+    Eigen::Vector3f spot_axis = Eigen::Vector3f::UnitZ();  // unit, world
+    float spot_cos = -1.0f, spot_smooth = 0.0f;            // cos(angle / 2), (1 - spot_cos) * blend
+  };
+  std::vector<ShadeLight> lights;
+  bool lights_move = false;  // some light rides on a dynamic object: re-placed on every SetFrame
+  // The lights whose range disc reaches each cell of a 2-D grid over x, y (CSR lists), and the
+  // lights without a range (tested everywhere).
+  struct LightGrid {
+    float x0 = 0.0f, y0 = 0.0f, inv_cell = 1.0f;
+    int nx = 0, ny = 0;
+    std::vector<uint32_t> cell_begin;  // nx * ny + 1
+    std::vector<uint32_t> items;
+    std::vector<uint32_t> unbounded;
+  } light_grid;
+  // Per material: emission (r, g, b, 0), Blinn-Phong specular and shininess.
+  bool any_emission = false;
+  std::vector<std::array<float, 4>> material_emission;
+  std::vector<float> material_specular, material_shininess;
+
+  bool instances_move = false;  // SetFrameWindow gave the dynamic instances three time steps
 
   explicit Impl(const Scene& s) : scene(s) {}
+
+  // Time step `step` of dynamic instance k (index into dynamic_instances).
+  void SetInstanceTransform(size_t k, unsigned step, const Rigid3& world_from_object) {
+    const Eigen::Matrix<double, 3, 4> m = world_from_object.Matrix3x4();
+    float xfm[12];
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 3; ++r) xfm[3 * c + r] = static_cast<float>(m(r, c));
+    rtcSetGeometryTransform(dynamic_instances[k], step, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+  }
 
   // Steps of the Tracer constructor.
   void BuildShadeRecords();
   void BuildStaticScene(size_t* num_static_triangles, double* build_seconds);
   void BuildTopScene();
   void SetUpLighting();
+  void SetUpLights();
+  void PlaceLights(int frame);
+  void BuildLightGrid();
 
   ~Impl() {
     if (top) rtcReleaseScene(top);
@@ -498,6 +541,117 @@ void Tracer::Impl::SetUpLighting() {
     const float phi = 6.2831853f * Sobol2(static_cast<uint32_t>(i));
     sun_samples[i] = (sun_dir + radius * (std::cos(phi) * sun_e1 + std::sin(phi) * sun_e2)).normalized();
   }
+  sun_on = light.sun_radiance.maxCoeff() > 0.0f;
+  SetUpLights();
+}
+
+// Per-material emission and specular tables; the lights' constant parts (world-fixed lights are
+// placed here, lights on objects by PlaceLights).
+void Tracer::Impl::SetUpLights() {
+  material_emission.assign(scene.materials.size(), {0.0f, 0.0f, 0.0f, 0.0f});
+  material_specular.assign(scene.materials.size(), 0.0f);
+  material_shininess.assign(scene.materials.size(), 0.0f);
+  for (size_t m = 0; m < scene.materials.size(); ++m) {
+    const Material& mat = scene.materials[m];
+    if (mat.IsEmissive()) any_emission = true;
+    material_emission[m] = {mat.emission.x(), mat.emission.y(), mat.emission.z(), 0.0f};
+    material_specular[m] = mat.specular;
+    material_shininess[m] = mat.shininess;
+  }
+  lights.resize(scene.lights.size());
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& in = scene.lights[i];
+    if (in.object >= static_cast<int>(scene.objects.size()))
+      throw std::invalid_argument("light '" + in.name + "': object index " + std::to_string(in.object) +
+                                  " out of range");
+    ShadeLight& l = lights[i];
+    l.intensity = in.intensity;
+    l.rank_intensity = in.intensity.sum();
+    l.inv_range2 = in.range > 0.0 ? static_cast<float>(1.0 / (in.range * in.range)) : 0.0f;
+    l.spot = in.spot;
+    if (in.spot) {
+      const double c0 = std::cos(0.5 * in.spot_angle_deg * M_PI / 180.0);
+      l.spot_cos = static_cast<float>(c0);
+      l.spot_smooth = static_cast<float>((1.0 - c0) * in.spot_blend);
+    }
+    if (in.object >= 0 && scene.objects[in.object].IsDynamic()) lights_move = true;
+  }
+  if (!lights.empty()) PlaceLights(0);
+}
+
+// World positions and spot axes of the lights at `frame` (objects that move: their pose at the
+// frame), then the light grid.
+void Tracer::Impl::PlaceLights(int frame) {
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& in = scene.lights[i];
+    Rigid3 world_from_light_frame = Rigid3::Identity();
+    if (in.object >= 0) {
+      const Object& obj = scene.objects[in.object];
+      if (!obj.IsDynamic()) {
+        world_from_light_frame = obj.world_from_object;
+      } else if (frame >= 0 && frame < static_cast<int>(obj.world_from_object_per_frame.size())) {
+        world_from_light_frame = obj.world_from_object_per_frame[frame];
+      }
+    }
+    ShadeLight& l = lights[i];
+    l.position = (world_from_light_frame * in.position).cast<float>();
+    if (in.spot) l.spot_axis = (world_from_light_frame.rotation * in.spot_direction).normalized().cast<float>();
+  }
+  BuildLightGrid();
+}
+
+// Cells of about half the median range (at least 1 m, at most 1024 x 1024 cells) over the range
+// discs of the lights that have a range.
+void Tracer::Impl::BuildLightGrid() {
+  LightGrid& g = light_grid;
+  g = LightGrid();
+  std::vector<float> ranges;
+  Eigen::Vector2f lo(std::numeric_limits<float>::max(), std::numeric_limits<float>::max()), hi = -lo;
+  for (uint32_t i = 0; i < lights.size(); ++i) {
+    const ShadeLight& l = lights[i];
+    if (l.inv_range2 <= 0.0f) {
+      g.unbounded.push_back(i);
+      continue;
+    }
+    const float r = 1.0f / std::sqrt(l.inv_range2);
+    ranges.push_back(r);
+    lo = lo.cwiseMin(l.position.head<2>() - Eigen::Vector2f::Constant(r));
+    hi = hi.cwiseMax(l.position.head<2>() + Eigen::Vector2f::Constant(r));
+  }
+  if (ranges.empty()) return;
+  std::nth_element(ranges.begin(), ranges.begin() + ranges.size() / 2, ranges.end());
+  float cell = std::max(1.0f, 0.5f * ranges[ranges.size() / 2]);
+  cell = std::max(cell, std::max(hi.x() - lo.x(), hi.y() - lo.y()) / 1024.0f);
+  g.x0 = lo.x();
+  g.y0 = lo.y();
+  g.inv_cell = 1.0f / cell;
+  g.nx = std::max(1, static_cast<int>(std::ceil((hi.x() - lo.x()) * g.inv_cell)));
+  g.ny = std::max(1, static_cast<int>(std::ceil((hi.y() - lo.y()) * g.inv_cell)));
+  // Two passes over the lights' cell rectangles: count, then fill.
+  std::vector<uint32_t> count(static_cast<size_t>(g.nx) * g.ny + 1, 0);
+  for (int pass = 0; pass < 2; ++pass) {
+    for (uint32_t i = 0; i < lights.size(); ++i) {
+      const ShadeLight& l = lights[i];
+      if (l.inv_range2 <= 0.0f) continue;
+      const float r = 1.0f / std::sqrt(l.inv_range2);
+      const int cx0 = std::clamp(static_cast<int>((l.position.x() - r - g.x0) * g.inv_cell), 0, g.nx - 1);
+      const int cx1 = std::clamp(static_cast<int>((l.position.x() + r - g.x0) * g.inv_cell), 0, g.nx - 1);
+      const int cy0 = std::clamp(static_cast<int>((l.position.y() - r - g.y0) * g.inv_cell), 0, g.ny - 1);
+      const int cy1 = std::clamp(static_cast<int>((l.position.y() + r - g.y0) * g.inv_cell), 0, g.ny - 1);
+      for (int cy = cy0; cy <= cy1; ++cy)
+        for (int cx = cx0; cx <= cx1; ++cx) {
+          const size_t c = static_cast<size_t>(cy) * g.nx + cx;
+          if (pass == 0) ++count[c + 1];
+          else g.items[g.cell_begin[c] + count[c]++] = i;
+        }
+    }
+    if (pass == 0) {
+      for (size_t c = 1; c < count.size(); ++c) count[c] += count[c - 1];
+      g.cell_begin = count;
+      g.items.resize(count.back());
+      std::fill(count.begin(), count.end(), 0);
+    }
+  }
 }
 
 Tracer::Tracer(const Scene& scene) : impl_(std::make_unique<Impl>(scene)) {
@@ -525,34 +679,67 @@ void Tracer::SetFrame(int frame) {
       throw std::out_of_range("object '" + obj.name + "': no transform for frame " + std::to_string(frame) + " (has " +
                               std::to_string(obj.world_from_object_per_frame.size()) + ")");
     const Rigid3& world_from_object = obj.world_from_object_per_frame[frame];
-    const Eigen::Matrix<double, 3, 4> m = world_from_object.Matrix3x4();
-    float xfm[12];
-    for (int c = 0; c < 4; ++c)
-      for (int r = 0; r < 3; ++r) xfm[3 * c + r] = static_cast<float>(m(r, c));
-    rtcSetGeometryTransform(d.dynamic_instances[k], 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+    if (d.instances_move) rtcSetGeometryTimeStepCount(d.dynamic_instances[k], 1);
+    d.SetInstanceTransform(k, 0, world_from_object);
     rtcCommitGeometry(d.dynamic_instances[k]);
     d.object_rotation[d.dynamic_objects[k]] = world_from_object.RotationMatrix().cast<float>();
   }
+  d.instances_move = false;
+  if (d.lights_move) d.PlaceLights(frame);
   rtcCommitScene(d.top);
   d.CheckDevice("committing the top-level scene");
+}
+
+void Tracer::SetFrameWindow(int frame, double half_window_s) {
+  Impl& d = *impl_;
+  if (!(half_window_s > 0.0) || d.dynamic_objects.empty()) {
+    SetFrame(frame);
+    return;
+  }
+  const Trajectory& trajectory = d.scene.rig_trajectory;
+  if (frame < 0 || frame >= static_cast<int>(trajectory.size()))
+    throw std::out_of_range("trajectory: no frame " + std::to_string(frame) + " (has " +
+                            std::to_string(trajectory.size()) + ")");
+  const double t = trajectory[frame].timestamp;
+  for (size_t k = 0; k < d.dynamic_objects.size(); ++k) {
+    const Object& obj = d.scene.objects[d.dynamic_objects[k]];
+    if (obj.world_from_object_per_frame.size() != trajectory.size())
+      throw std::out_of_range("object '" + obj.name + "': " + std::to_string(obj.world_from_object_per_frame.size()) +
+                              " transforms for a trajectory of " + std::to_string(trajectory.size()));
+    rtcSetGeometryTimeStepCount(d.dynamic_instances[k], 3);
+    for (int step = 0; step < 3; ++step)
+      d.SetInstanceTransform(k, step,
+                             PoseAtTime(trajectory, &obj.world_from_object_per_frame, t + (step - 1) * half_window_s));
+    rtcCommitGeometry(d.dynamic_instances[k]);
+    d.object_rotation[d.dynamic_objects[k]] = obj.world_from_object_per_frame[frame].RotationMatrix().cast<float>();
+  }
+  d.instances_move = true;
+  if (d.lights_move) d.PlaceLights(frame);
+  rtcCommitScene(d.top);
+  d.CheckDevice("committing the top-level scene (motion)");
 }
 
 namespace {
 
 // A tile's rays and the shading state between its passes (structures of arrays; colours are SSE
 // registers (r, g, b, 0): every lane operation is the scalar one, so results do not depend on it).
+// A hit casts at most one sun and kMaxShadowedLights light shadow rays.
+constexpr int kMaxShadowRays = kTilePixels * (1 + kMaxShadowedLights);
+
 struct alignas(64) TileBuffers {
   RTCRayHit rayhit[kTilePixels];
-  RTCRay shadow[kTilePixels];
-  int pixel[kTilePixels];         // tile-local pixel index of each ray
-  int shadow_pixel[kTilePixels];  // tile-local pixel index of each shadow ray
-  __m128 direct[kTilePixels];     // albedo * E_sun * cos / pi of each shadow ray
+  RTCRay shadow[kMaxShadowRays];
+  int pixel[kTilePixels];            // tile-local pixel index of each ray
+  int shadow_pixel[kMaxShadowRays];  // tile-local pixel index of each shadow ray
+  __m128 direct[kMaxShadowRays];     // the light each shadow ray lets through (sun: albedo * E_sun * cos / pi)
   __m128 sum[kTilePixels];        // linear radiance sums per pixel
   int count[kTilePixels];
+  float pixel_time[kTilePixels];     // ray time of each pixel's ray in the current pass (CameraMotion)
   // The hits of the current sample pass, compacted.
   int hit_ray[kTilePixels];
   Eigen::Vector3f normal[kTilePixels];  // unit, facing the ray
   __m128 albedo[kTilePixels];           // base colour, then times the texture
+  int material[kTilePixels];            // material index (emission and specular of point lights)
   // The hits with a texture lookup, compacted (index into the hit arrays).
   int textured_hit[kTilePixels];
   const MipTexture* texture[kTilePixels];
@@ -561,7 +748,7 @@ struct alignas(64) TileBuffers {
   __m128 texel[kTilePixels];  // the filtered texture colour
 };
 
-void InitRay(RTCRayHit* rh, const Eigen::Vector3f& origin, const Eigen::Vector3f& dir) {
+void InitRay(RTCRayHit* rh, const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, float time = 0.0f) {
   rh->ray.org_x = origin.x();
   rh->ray.org_y = origin.y();
   rh->ray.org_z = origin.z();
@@ -569,7 +756,7 @@ void InitRay(RTCRayHit* rh, const Eigen::Vector3f& origin, const Eigen::Vector3f
   rh->ray.dir_x = dir.x();
   rh->ray.dir_y = dir.y();
   rh->ray.dir_z = dir.z();
-  rh->ray.time = 0.0f;
+  rh->ray.time = time;
   rh->ray.tfar = std::numeric_limits<float>::infinity();
   rh->ray.mask = 0xffffffffu;
   rh->ray.id = 0;
@@ -599,6 +786,10 @@ struct RenderJob {
   bool raw;
   Eigen::Matrix3f world_from_cam_rot = Eigen::Matrix3f::Identity();
   Eigen::Vector3f origin = Eigen::Vector3f::Zero();
+  // Timing (CameraMotion): null for the default; `moving` when rays differ in time and pose.
+  const CameraMotion* motion = nullptr;
+  bool moving = false;
+  float row_time_scale = 0.0f;  // readout / (height - 1)
   int spp = 1;
   float inv_sqrt_spp = 1.0f;
   float theta_max = 0.0f;
@@ -607,6 +798,9 @@ struct RenderJob {
   // a hashed multiple of spp (an elementary-interval-stratified set for power-of-two spp <= 64).
   uint32_t spp_u = 1;
   __m128 sky_horizon{}, sky_delta{}, sky_ground{}, ambient_ground{}, ambient_delta{}, sun_radiance{};
+  // ShadeSettings::sun_disc with a sun: misses see it; sun_var = r^2 / 4 (r: angular radius, radians).
+  bool sun_disc = false;
+  float sun_var = 0.0f;
   // exposure / (samples of a pixel): a pixel has at most spp samples.
   std::vector<float> exposure_over_count;
   std::array<Eigen::Vector2f, 64> offsets{};
@@ -620,6 +814,24 @@ struct TileRect {
     return static_cast<size_t>(ty0 + local / kTile) * job.width + tx0 + local % kTile;
   }
 };
+
+// A camera ray of a moving camera (render/tracer.h, CameraMotion): the time of sample s of pixel
+// pi in row y (s < 0: the pixel centre at the row's mid-exposure), and the pose at that time.
+void InitMovingRay(const RenderJob& job, size_t pi, int y, int s, const Eigen::Vector3f& bearing, RTCRayHit* rh) {
+  const CameraMotion& m = *job.motion;
+  float time = m.time_mid + (static_cast<float>(y) - 0.5f * static_cast<float>(job.height - 1)) * job.row_time_scale;
+  if (s >= 0 && job.spp > 1 && m.shutter > 0.0f) {
+    const float w = Wrap01((s + 0.5f) / static_cast<float>(job.spp) + UnitFloat(Mix64(pi * 0xd1b54a32d192ed03ull + 3)));
+    time += (w - 0.5f) * m.shutter;
+  }
+  time = std::clamp(time, 0.0f, 1.0f);
+  const float f = time * static_cast<float>(m.rotation.size() - 1);
+  const size_t k = std::min(static_cast<size_t>(f), m.rotation.size() - 2);
+  const float a = f - static_cast<float>(k);
+  const Eigen::Matrix3f rot = m.rotation[k] + a * (m.rotation[k + 1] - m.rotation[k]);
+  const Eigen::Vector3f org = m.origin[k] + a * (m.origin[k + 1] - m.origin[k]);
+  InitRay(rh, org, rot * bearing, time);
+}
 
 // The camera rays of sample s (-1 or spp == 1: pixel centres) of the tile's valid pixels into
 // tb.rayhit / tb.pixel; returns their count.
@@ -649,7 +861,12 @@ int MakeSampleRays(const RenderJob& job, const TileRect& t, int s, bool is_centr
         }
         if (!rays.SampleBearing(t.tx0 + lx + offset.x(), t.ty0 + ly + offset.y(), &bearing)) continue;
       }
-      InitRay(&tb.rayhit[n], job.origin, job.world_from_cam_rot * bearing);
+      if (job.moving) {
+        InitMovingRay(job, pi, t.ty0 + ly, is_centre ? -1 : s, bearing, &tb.rayhit[n]);
+        tb.pixel_time[ly * kTile + lx] = tb.rayhit[n].ray.time;
+      } else {
+        InitRay(&tb.rayhit[n], job.origin, job.world_from_cam_rot * bearing, job.motion ? job.motion->time_mid : 0.0f);
+      }
       tb.pixel[n] = ly * kTile + lx;
       ++n;
     }
@@ -689,9 +906,18 @@ void GatherHits(const RenderJob& job, const TileRect& t, int n, TileBuffers& tb,
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
       if (!raw) {
         // Sky: mix(horizon, zenith, sqrt(d.z)) above the horizon, ground_albedo * horizon below.
-        const __m128 sky = dir.z() >= 0.0f
-                               ? _mm_add_ps(job.sky_horizon, _mm_mul_ps(_mm_set1_ps(std::sqrt(dir.z())), job.sky_delta))
-                               : job.sky_ground;
+        __m128 sky = dir.z() >= 0.0f
+                         ? _mm_add_ps(job.sky_horizon, _mm_mul_ps(_mm_set1_ps(std::sqrt(dir.z())), job.sky_delta))
+                         : job.sky_ground;
+        if (job.sun_disc) {
+          // The HDR sun through the pixel footprint (render/tracer.h): E_sun exp(-c2 / 2s2) / (2 pi s2).
+          const float c2 = (dir - d.sun_dir).squaredNorm();
+          const float f = 0.5f * job.rays.pixel_angle[t.Pixel(job, local)];
+          const float s2 = job.sun_var + f * f;
+          if (c2 < 50.0f * s2)
+            sky = _mm_add_ps(sky, _mm_mul_ps(job.sun_radiance,
+                                             _mm_set1_ps(std::exp(-c2 / (2.0f * s2)) * (0.5f * kInvPi) / s2)));
+        }
         tb.sum[local] = _mm_add_ps(tb.sum[local], sky);
         ++tb.count[local];
       }
@@ -719,6 +945,7 @@ void GatherHits(const RenderJob& job, const TileRect& t, int n, TileBuffers& tb,
     const Tracer::Impl::TriangleShade& ts = shade[rh.hit.primID];
     const Tracer::Impl::ShadeMaterial& mat = d.shade_materials[ts.material];
     tb.albedo[h] = _mm_load_ps(mat.base_color);
+    tb.material[h] = ts.material;
     if (!job.textures || ts.texels_per_metre < 0.0f) continue;
     const float bu = rh.hit.u, bv = rh.hit.v, bw = 1.0f - bu - bv;
     const int k = num_textured++;
@@ -753,9 +980,114 @@ void ApplyTextures(const RenderJob& job, int num_textured, TileBuffers& tb) {
   }
 }
 
-// Shading pass 3: ambient light, and the shadow rays of the lit hits (sun sample of sample s) into
-// tb.shadow with their direct light; returns the shadow ray count. Without shadows the direct
-// light is added at once.
+// Appends a shadow ray from `org` along unit `dir` over (tnear, tfar) that adds `direct` to pixel
+// `local` when nothing blocks it.
+void PushShadowRay(TileBuffers& tb, int* num_shadow, const Eigen::Vector3f& org, const Eigen::Vector3f& dir,
+                   float tnear, float tfar, int local, __m128 direct) {
+  RTCRay& sr = tb.shadow[*num_shadow];
+  sr.org_x = org.x();
+  sr.org_y = org.y();
+  sr.org_z = org.z();
+  sr.dir_x = dir.x();
+  sr.dir_y = dir.y();
+  sr.dir_z = dir.z();
+  sr.tnear = tnear;
+  sr.tfar = tfar;
+  sr.mask = 0xffffffffu;
+  sr.time = 0.0f;
+  sr.id = 0;
+  sr.flags = 0;
+  tb.shadow_pixel[*num_shadow] = local;
+  tb.direct[*num_shadow] = direct;
+  ++*num_shadow;
+}
+
+// The lights that may reach world point x: the grid cell's list (empty outside the grid), then the
+// lights without a range.
+template <typename F>
+void ForEachLightNear(const Tracer::Impl::LightGrid& g, const Eigen::Vector3f& x, F&& visit) {
+  if (g.nx > 0) {
+    const float fx = (x.x() - g.x0) * g.inv_cell, fy = (x.y() - g.y0) * g.inv_cell;
+    if (fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(g.nx) && fy < static_cast<float>(g.ny)) {
+      const size_t c = static_cast<size_t>(static_cast<int>(fy)) * g.nx + static_cast<int>(fx);
+      for (uint32_t k = g.cell_begin[c]; k < g.cell_begin[c + 1]; ++k) visit(g.items[k]);
+    }
+  }
+  for (uint32_t i : g.unbounded) visit(i);
+}
+
+// Point and spot lights at hit h (formula: render/tracer.h): the `max_shadowed_lights` strongest
+// get a shadow ray from `shadow_origin`; the others are added to the pixel at once.
+void AddPointLights(const RenderJob& job, int h, const Eigen::Vector3f& x, const Eigen::Vector3f& view,
+                    const Eigen::Vector3f& shadow_origin, float offset, int local, TileBuffers& tb, int* num_shadow) {
+  const Tracer::Impl& d = job.d;
+  const Eigen::Vector3f& n = tb.normal[h];
+  const int material = tb.material[h];
+  const float ks = d.material_specular[material], shininess = d.material_shininess[material];
+  const __m128 diffuse = _mm_mul_ps(tb.albedo[h], _mm_set1_ps(kInvPi));
+  const int k_max = job.settings.shadows ? std::clamp(job.settings.max_shadowed_lights, 0, kMaxShadowedLights) : 0;
+  struct Candidate {
+    float rank;
+    uint32_t light;
+    __m128 direct;
+  };
+  Candidate best[kMaxShadowedLights];
+  int num_best = 0;
+  ForEachLightNear(d.light_grid, x, [&](uint32_t i) {
+    const Tracer::Impl::ShadeLight& l = d.lights[i];
+    const Eigen::Vector3f to = l.position - x;
+    const float d2 = to.squaredNorm();
+    float weight = 1.0f;  // A * W
+    if (l.inv_range2 > 0.0f) {
+      const float q = d2 * l.inv_range2;
+      if (q >= 1.0f) return;
+      weight = (1.0f - q * q) * (1.0f - q * q);
+    }
+    const float n_dot_to = n.dot(to);
+    if (n_dot_to <= 0.0f || !(d2 > 1e-12f)) return;  // behind the surface: no square root needed
+    const float inv_d = 1.0f / std::sqrt(d2);
+    const Eigen::Vector3f to_light = to * inv_d;
+    const float cos_light = n_dot_to * inv_d;
+    if (l.spot) {
+      const float c = -to_light.dot(l.spot_axis);
+      if (c <= l.spot_cos) return;
+      const float t = c - l.spot_cos;
+      float a = c;
+      if (t < l.spot_smooth) {
+        const float u = t / l.spot_smooth;
+        a *= u * u * (3.0f - 2.0f * u);
+      }
+      weight *= a;
+    }
+    const float geometry = weight * cos_light / d2;
+    __m128 brdf = diffuse;
+    if (ks > 0.0f) {
+      const float nh = std::max(0.0f, n.dot((to_light + view).normalized()));
+      brdf = _mm_add_ps(brdf, _mm_set1_ps(ks * (shininess + 8.0f) * (kInvPi / 8.0f) * std::pow(nh, shininess)));
+    }
+    Candidate c{l.rank_intensity * geometry, i,
+                _mm_mul_ps(brdf, _mm_mul_ps(Load3(l.intensity), _mm_set1_ps(geometry)))};
+    if (num_best < k_max) {
+      best[num_best++] = c;
+      return;
+    }
+    int weakest = -1;
+    for (int b = 0; b < num_best; ++b)
+      if (best[b].rank < (weakest < 0 ? c.rank : best[weakest].rank)) weakest = b;
+    if (weakest >= 0) std::swap(c, best[weakest]);
+    tb.sum[local] = _mm_add_ps(tb.sum[local], c.direct);  // beyond the shadowed ones: V = 1
+  });
+  for (int b = 0; b < num_best; ++b) {
+    const Eigen::Vector3f to = d.lights[best[b].light].position - shadow_origin;
+    const float dist = to.norm();
+    if (!(dist > offset + 1e-3f)) continue;
+    PushShadowRay(tb, num_shadow, shadow_origin, to / dist, offset, dist - 1e-3f, local, best[b].direct);
+  }
+}
+
+// Shading pass 3: ambient light, emission, point and spot lights, and the shadow rays of the lit
+// hits (sun sample of sample s; lights) into tb.shadow with their direct light; returns the shadow
+// ray count. Without shadows the direct light is added at once.
 int AmbientAndShadowRays(const RenderJob& job, const TileRect& t, int s, int num_hits, TileBuffers& tb) {
   const Tracer::Impl& d = job.d;
   const bool raw = job.raw;
@@ -765,6 +1097,10 @@ int AmbientAndShadowRays(const RenderJob& job, const TileRect& t, int s, int num
     const int local = tb.pixel[tb.hit_ray[h]];
     const Eigen::Vector3f& normal = tb.normal[h];
     __m128 albedo = _mm_setzero_ps();
+    const Eigen::Vector3f dir(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
+    const Eigen::Vector3f origin(rh.ray.org_x, rh.ray.org_y, rh.ray.org_z);  // per ray with CameraMotion
+    const float tfar = rh.ray.tfar;
+    const float offset = 1e-4f * (1.0f + tfar);
     if (!raw) {
       albedo = tb.albedo[h];
       // Ambient: hemisphere mix of sky and ground by the normal's elevation.
@@ -773,7 +1109,14 @@ int AmbientAndShadowRays(const RenderJob& job, const TileRect& t, int s, int num
           tb.sum[local],
           _mm_mul_ps(albedo, _mm_add_ps(job.ambient_ground, _mm_mul_ps(_mm_set1_ps(up), job.ambient_delta))));
       ++tb.count[local];
+      if (d.any_emission)
+        tb.sum[local] = _mm_add_ps(tb.sum[local], _mm_loadu_ps(d.material_emission[tb.material[h]].data()));
+      if (!d.lights.empty()) {
+        const Eigen::Vector3f x = origin + tfar * dir;
+        AddPointLights(job, h, x, -dir, x + offset * normal, offset, local, tb, &num_shadow);
+      }
     }
+    if (!d.sun_on) continue;
     const Eigen::Vector3f* to_sun = &d.sun_dir;
     if (job.soft_sun) {
       const size_t pi = t.Pixel(job, local);
@@ -789,34 +1132,52 @@ int AmbientAndShadowRays(const RenderJob& job, const TileRect& t, int s, int num
       if (!raw) tb.sum[local] = _mm_add_ps(tb.sum[local], direct);
       continue;
     }
-    const Eigen::Vector3f dir(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
-    const float tfar = rh.ray.tfar;
-    const float offset = 1e-4f * (1.0f + tfar);
-    const Eigen::Vector3f shadow_origin = job.origin + tfar * dir + offset * normal;
-    RTCRay& sr = tb.shadow[num_shadow];
-    sr.org_x = shadow_origin.x();
-    sr.org_y = shadow_origin.y();
-    sr.org_z = shadow_origin.z();
-    sr.dir_x = to_sun->x();
-    sr.dir_y = to_sun->y();
-    sr.dir_z = to_sun->z();
-    sr.tnear = offset;
-    sr.tfar = std::numeric_limits<float>::infinity();
-    sr.mask = 0xffffffffu;
-    sr.time = 0.0f;
-    sr.id = 0;
-    sr.flags = 0;
-    tb.shadow_pixel[num_shadow] = local;
-    tb.direct[num_shadow] = direct;
-    ++num_shadow;
+    const Eigen::Vector3f shadow_origin = origin + tfar * dir + offset * normal;
+    PushShadowRay(tb, &num_shadow, shadow_origin, *to_sun, offset, std::numeric_limits<float>::infinity(), local,
+                  direct);
   }
   return num_shadow;
 }
 
-// Resolve: box filter, exposure, optional vignetting and noise, sRGB. The encoding clamps to
-// [0, 1] (NaN -> 0) and reads the 64k table at round(65535 x).
+// Optional vignetting: 1 - vignetting * (theta / theta_max)^2 at pixel pi, at least 0.
+float VignettingGain(const RenderJob& job, size_t pi) {
+  const Eigen::Vector3f& b = job.rays.bearing[pi];
+  const float theta = std::atan2(std::hypot(b.x(), b.y()), b.z());
+  const float rel = theta / job.theta_max;
+  return std::max(0.0f, 1.0f - job.settings.vignetting * rel * rel);
+}
+
+// The linear resolve (ShadeSettings::linear_output): box filter times the vignetting gain, no
+// exposure, no clamp; pixels without samples are 0.
+void ResolveTileLinear(const RenderJob& job, const TileRect& t, const TileBuffers& tb) {
+  for (int ly = 0; ly < t.th; ++ly) {
+    const size_t row = static_cast<size_t>(t.ty0 + ly) * job.width + t.tx0;
+    for (int lx = 0; lx < t.tw; ++lx) {
+      const int local = ly * kTile + lx;
+      float* out = job.image->linear.data() + (row + lx) * 3;
+      if (tb.count[local] == 0) {
+        out[0] = out[1] = out[2] = 0.0f;
+        continue;
+      }
+      float gain = 1.0f / static_cast<float>(tb.count[local]);
+      if (job.settings.vignetting > 0.0f) gain *= VignettingGain(job, row + lx);
+      alignas(16) float c[4];
+      _mm_store_ps(c, _mm_mul_ps(tb.sum[local], _mm_set1_ps(gain)));
+      out[0] = c[0];
+      out[1] = c[1];
+      out[2] = c[2];
+    }
+  }
+}
+
+// Resolve: box filter, exposure, optional vignetting, sRGB. The encoding clamps to [0, 1]
+// (NaN -> 0) and reads the 64k table at round(65535 x).
 void ResolveTile(const RenderJob& job, const TileRect& t, const TileBuffers& tb) {
   const ShadeSettings& settings = job.settings;
+  if (settings.linear_output) {
+    ResolveTileLinear(job, t, tb);
+    return;
+  }
   const auto& srgb = SrgbTable();
   const __m128 one = _mm_set1_ps(1.0f), scale = _mm_set1_ps(65535.0f), half = _mm_set1_ps(0.5f);
   for (int ly = 0; ly < t.th; ++ly) {
@@ -829,28 +1190,12 @@ void ResolveTile(const RenderJob& job, const TileRect& t, const TileBuffers& tb)
       }
       const size_t pi = static_cast<size_t>(t.ty0 + ly) * job.width + t.tx0 + lx;
       float gain = job.exposure_over_count[tb.count[local]];
-      if (settings.vignetting > 0.0f) {
-        const Eigen::Vector3f& b = job.rays.bearing[pi];
-        const float theta = std::atan2(std::hypot(b.x(), b.y()), b.z());
-        const float rel = theta / job.theta_max;
-        gain *= std::max(0.0f, 1.0f - settings.vignetting * rel * rel);
-      }
+      if (settings.vignetting > 0.0f) gain *= VignettingGain(job, pi);
       const __m128 c = _mm_min_ps(_mm_max_ps(_mm_mul_ps(tb.sum[local], _mm_set1_ps(gain)), _mm_setzero_ps()), one);
       const __m128i i4 = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(c, scale), half));
       const int index[3] = {_mm_cvtsi128_si32(i4), _mm_cvtsi128_si32(_mm_shuffle_epi32(i4, 1)),
                             _mm_cvtsi128_si32(_mm_shuffle_epi32(i4, 2))};
-      for (int k = 0; k < 3; ++k) {
-        uint8_t value = srgb[index[k]];
-        if (settings.noise_sigma > 0.0f) {
-          // Box-Muller from two hashed uniforms: deterministic per (seed, pixel, channel).
-          const uint64_t h = Mix64(settings.noise_seed ^ Mix64(pi * 3 + k));
-          const float u1 = std::max(UnitFloat(h), 1e-7f);
-          const float u2 = UnitFloat(Mix64(h));
-          const float g = std::sqrt(-2.0f * std::log(u1)) * std::cos(6.2831853f * u2);
-          value = static_cast<uint8_t>(std::clamp(std::lround(value + settings.noise_sigma * g), 0L, 255L));
-        }
-        out[k] = value;
-      }
+      for (int k = 0; k < 3; ++k) out[k] = srgb[index[k]];
     }
   }
 }
@@ -897,6 +1242,10 @@ void RenderTile(const RenderJob& job, int tile, TileBuffers& tb) {
     if (num_textured > 0) ApplyTextures(job, num_textured, tb);
     const int num_shadow = AmbientAndShadowRays(job, t, s, num_hits, tb);
     if (num_shadow == 0) continue;
+    if (job.motion) {  // shadow rays at their camera ray's time (moving objects)
+      for (int k = 0; k < num_shadow; ++k)
+        tb.shadow[k].time = job.moving ? tb.pixel_time[tb.shadow_pixel[k]] : job.motion->time_mid;
+    }
     rtcOccluded1M(d.trace_scene, &shadow_context, tb.shadow, static_cast<unsigned>(num_shadow), sizeof(RTCRay));
     if (raw) continue;
     for (int k = 0; k < num_shadow; ++k) {
@@ -910,7 +1259,7 @@ void RenderTile(const RenderJob& job, int tile, TileBuffers& tb) {
 }  // namespace
 
 void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const ShadeSettings& settings,
-                    CameraImage* image) const {
+                    CameraImage* image, const CameraMotion* motion) const {
   const Impl& d = *impl_;
   const int width = rays.width, height = rays.height;
   const size_t num_pixels = static_cast<size_t>(width) * height;
@@ -919,7 +1268,14 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
     image->width = width;
     image->height = height;
     // The resolve writes every pixel (black outside the image circle): no clearing needed.
-    if (image->rgb.size() != num_pixels * 3) image->rgb.assign(num_pixels * 3, 0);
+    if (settings.linear_output) {
+      if (image->linear.size() != num_pixels * 3) image->linear.assign(num_pixels * 3, 0.0f);
+      image->rgb.clear();
+    } else {
+      if (image->rgb.size() != num_pixels * 3) image->rgb.assign(num_pixels * 3, 0);
+      image->linear.clear();
+    }
+    image->gray.clear();
     if (settings.want_depth) image->depth.assign(num_pixels, 0.0f);
     else image->depth.clear();
     if (settings.want_mask) image->mask.assign(num_pixels, 0);
@@ -930,6 +1286,11 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
   RenderJob job(d, rays, settings, image);
   job.world_from_cam_rot = world_from_cam.RotationMatrix().cast<float>();
   job.origin = ToF(world_from_cam.translation);
+  job.motion = motion;
+  job.moving = motion && (motion->shutter > 0.0f || motion->readout > 0.0f);
+  if (job.moving && (motion->rotation.size() < 2 || motion->origin.size() != motion->rotation.size()))
+    throw std::invalid_argument("CameraMotion: a moving camera needs at least two poses");
+  job.row_time_scale = job.moving && height > 1 ? motion->readout / static_cast<float>(height - 1) : 0.0f;
   job.spp = spp;
   job.inv_sqrt_spp = 1.0f / std::sqrt(static_cast<float>(spp));
   job.theta_max = static_cast<float>(0.5 * rays.camera.max_fov_deg * M_PI / 180.0);
@@ -943,6 +1304,9 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
   job.ambient_ground = Load3(light.ambient * d.ground_irradiance);
   job.ambient_delta = Load3(light.ambient * (d.sky_mean - d.ground_irradiance));
   job.sun_radiance = Load3(light.sun_radiance);
+  job.sun_disc = settings.sun_disc && light.sun_radiance.maxCoeff() > 0.0f;
+  const float sun_radius = static_cast<float>(0.5 * light.sun_angular_diameter_deg * M_PI / 180.0);
+  job.sun_var = 0.25f * sun_radius * sun_radius;
   job.exposure_over_count.assign(spp + 1, 0.0f);
   for (int c = 1; c <= spp; ++c) job.exposure_over_count[c] = light.exposure / static_cast<float>(c);
   for (int s = 0; s < std::min(spp, 64); ++s) job.offsets[s] = CameraRays::SampleOffset(s, spp);

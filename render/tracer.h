@@ -17,14 +17,38 @@
 // centre does not unproject are black, depth 0, mask 0. Scenes without dynamic objects are traced
 // in the static scene directly (no instance level).
 //
-// Shading (linear RGB, then exposure and sRGB):
+// Shading (linear RGB, then exposure and sRGB; with ShadeSettings::linear_output the linear RGB
+// goes to the sensor model, render/sensor.h):
 //   L = albedo * ( E_sun * max(0, n.s) * V / pi + ambient * E_sky(n) ),
 //   albedo = material base colour * texture (trilinear mip lookup), n faces the viewer,
 //   s = direction to the sun (jittered inside the sun disc per sample for soft shadows),
 //   V = shadow-ray visibility, E_sky(n) = mix(ground, sky, (1 + n.z) / 2) with
 //   sky = (zenith + horizon) / 2 and ground = ground_albedo * (E_sun * s.z / pi + sky).
+// Point and spot lights (Scene::lights, intensity I in linear RGB W/sr-like units, position p at
+// the frame, for objects that move: world_from_object(frame) * position) add, at a hit x with unit
+// normal n facing the viewer, view direction v (towards the camera), l = (p - x) / d, d = |p - x|:
+//   L += (albedo / pi + ks * (m + 8) / (8 pi) * max(0, n.h)^m) * I * max(0, n.l) / d^2 * A * W * V,
+//   h = normalize(l + v), ks = Material::specular, m = Material::shininess (Blinn-Phong, normalized),
+//   A = 1 for a point light; for a spot with axis a, c = -l.a, c0 = cos(angle / 2),
+//       s = (1 - c0) * blend: A = 0 if c <= c0, else c * smoothstep((c - c0) / s) if c - c0 < s,
+//       else c (Cycles 3.4's spot_light_attenuation, so Blender spots keep their look),
+//   W = (1 - (d / range)^4)^2 for d < range, 0 beyond (W = 1 when range = 0),
+//   V = shadow-ray visibility towards p (stopped 1 mm short of it).
+// Per hit, the ShadeSettings::max_shadowed_lights lights with the largest (I.r + I.g + I.b) * A * W
+// * max(0, n.l) / d^2 get a shadow ray each; further lights in range are added without one (V = 1),
+// which keeps the image continuous where the ranking changes. Lights are found through a 2-D grid
+// over x, y of the lights' range discs (lights without a range are tested at every hit). A
+// material's emission (radiance) is added to every hit on it. The sun term is skipped when
+// sun_radiance is zero. A Blender point or spot lamp of power P watts is I = colour * P / (4 pi).
+// The raw-cast benchmark (ShadeSettings::raw_cast_only) casts no light shadow rays.
 // Rays that miss see the sky: mix(horizon, zenith, sqrt(d.z)) above the horizon and
-// ground_albedo * horizon below.
+// ground_albedo * horizon below. With ShadeSettings::sun_disc they also see the sun, an HDR disc
+// of angular radius r (half of Lighting::sun_angular_diameter_deg) seen through the pixel's
+// footprint, a Gaussian of standard deviation f = pixel_angle / 2 (per axis):
+//   L_sun(d) = E_sun / (2 pi s^2) * exp(-|d - s_dir|^2 / (2 s^2)),  s^2 = r^2 / 4 + f^2,
+// zero where |d - s_dir|^2 >= 50 s^2 (d unit ray direction, s_dir unit direction to the sun). Over
+// the sphere it integrates to E_sun (the sun's irradiance) at any image size and sample count, so
+// the small auto-exposure meter render sees the same sun as the image.
 // Texture level of detail: ray-cone footprint f = t * pixel_angle / max(|cos|, 0.1) / sqrt(spp)
 // in metres, times texels per metre of the triangle, sqrt(A_uv / A_world) * sqrt(W * H).
 //
@@ -81,6 +105,9 @@ struct CameraRays {
 // parameters, FOV) share one computation (copied).
 std::vector<CameraRays> MakeCameraRays(const std::vector<Camera>& cameras, int threads = 0, int spp = 1);
 
+// Upper bound of ShadeSettings::max_shadowed_lights (sizes the per-tile shadow-ray buffers).
+inline constexpr int kMaxShadowedLights = 8;
+
 struct ShadeSettings {
   int spp = 1;
   bool shadows = true;
@@ -92,15 +119,39 @@ struct ShadeSettings {
   bool want_depth = false;      // fill CameraImage::depth
   bool want_mask = false;       // fill CameraImage::mask
   bool raw_cast_only = false;   // benchmark: intersect the camera rays, no shading, no output
-  float noise_sigma = 0.0f;     // optional sensor noise (std. dev. in 8-bit units); 0 = off
-  uint64_t noise_seed = 0;
   float vignetting = 0.0f;      // optional: gain = 1 - vignetting * (theta / theta_max)^2
+  // The sensor model's input (render/sensor.h): fill CameraImage::linear with the box-filtered
+  // scene radiance times the vignetting gain (no Lighting::exposure, no encoding) instead of rgb.
+  bool linear_output = false;
+  // Misses see the sun as well as the sky (the HDR sun of the sensor model, formula above).
+  bool sun_disc = false;
+  int max_shadowed_lights = 2;  // point/spot lights per hit with a shadow ray, in [0, kMaxShadowedLights]
+};
+
+// Time-dependent camera pose of one Render call (motion blur, rolling shutter, trigger offsets;
+// the rules are in datasets/FORMAT.md, section "Timing"). Times are ray times in [0, 1], Embree's
+// RTCRay::time, spanning the frame's time window set by Tracer::SetFrameWindow. Row v (0 = top) of
+// the image is exposed around tau_v = time_mid + (v / (H - 1) - 1/2) * readout; sample s of pixel
+// p (spp > 1) is at tau_v + (w - 1/2) * shutter with w = frac((s + 1/2) / spp + r_p), r_p a hashed
+// per-pixel rotation (stratified in time, uncorrelated between pixels); the pixel-centre ray
+// (depth, masks, and the only sample when spp = 1) is at tau_v. The ray at time tau starts at
+// origin(tau) along rotation(tau) * bearing, both linearly interpolated in the table below. With
+// shutter = readout = 0 every ray is at time_mid and uses Render's world_from_cam.
+struct CameraMotion {
+  float time_mid = 0.5f;  // ray time of the mid-exposure of the image's middle row
+  float readout = 0.0f;   // rolling shutter: top-to-bottom readout, in ray-time units
+  float shutter = 0.0f;   // exposure interval, in ray-time units
+  // world_from_cam at ray times k / (n - 1), k = 0 .. n - 1 (n >= 2 unless shutter = readout = 0).
+  std::vector<Eigen::Matrix3f> rotation;
+  std::vector<Eigen::Vector3f> origin;
 };
 
 struct CameraImage {
   int width = 0;
   int height = 0;
-  std::vector<uint8_t> rgb;      // sRGB, 3 bytes per pixel
+  std::vector<uint8_t> rgb;      // sRGB, 3 bytes per pixel (empty with ShadeSettings::linear_output)
+  std::vector<float> linear;     // ShadeSettings::linear_output: linear RGB radiance, 3 floats per pixel
+  std::vector<uint8_t> gray;     // a grayscale sensor's output, 1 byte per pixel (render/sensor.h)
   std::vector<float> depth;      // metres along the pixel-centre ray, 0 = no hit / outside FOV
   std::vector<uint16_t> mask;    // Object::id of the pixel-centre hit, 0 = static or none
 };
@@ -116,11 +167,19 @@ class Tracer {
 
   // Places the dynamic objects at trajectory frame `frame` and commits the top-level scene.
   void SetFrame(int frame);
+  // Motion of the dynamic objects over the window [t - half_window_s, t + half_window_s] around
+  // trajectory frame `frame` at time t: three Embree time steps (ray time 0, 1/2, 1) with each
+  // object's pose at those times (PoseAtTime, render/timing.h); Embree interpolates the 3x4
+  // matrices linearly between steps. half_window_s <= 0 is SetFrame(frame). Lights on objects are
+  // placed at t.
+  void SetFrameWindow(int frame, double half_window_s);
 
   // Renders one camera at world_from_cam. Work is split into 8x8 tiles run by tbb::parallel_for in
   // the calling task arena. Sets flush-to-zero / denormals-are-zero in every worker.
+  // With `motion`, rays take their times and poses from it (CameraMotion) and world_from_cam is
+  // the pose at motion->time_mid.
   void Render(const CameraRays& rays, const Rigid3& world_from_cam, const ShadeSettings& settings,
-              CameraImage* image) const;
+              CameraImage* image, const CameraMotion* motion = nullptr) const;
 
   double static_build_seconds() const { return static_build_seconds_; }
   size_t num_static_triangles() const { return num_static_triangles_; }

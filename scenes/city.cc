@@ -4,6 +4,8 @@
 
 #include "rovo/version.h"
 #include "scenes/city_layout.h"
+#include "scenes/indoor.h"
+#include "scenes/mesh_builder.h"
 #include "scenes/rng.h"
 #include "scenes/texture_gen.h"
 
@@ -15,6 +17,7 @@
 #include <map>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace rovo {
 
@@ -31,179 +34,39 @@ const std::vector<ScenePreset>& ScenePresets() {
   return presets;
 }
 
+const std::vector<ScenePreset>& HarderScenePresets() {
+  static const std::vector<ScenePreset> presets = [] {
+    std::vector<ScenePreset> p(3);
+    p[0] = {"indoor_hall", "Indoor hall and corridor: plain walls, polished floor, ceiling lights, people near the rig",
+            128, 1000, "indoor", true, "rovo4", 80, 0.5, 10.0, "indoor"};
+    p[1] = {"suburban_road", "Suburban road: plain houses behind lawns, wide spacing, open sky, sparse features",
+            600, 600, "sunny", false, "rovo4", 60, 0.5};
+    p[2] = {"night_street", "The cloudy_urban streets at night: street lamps, headlights, dark sky (high gain)",
+            350, 300, "night", true, "rovo4", 60, 0.5};
+    return p;
+  }();
+  return presets;
+}
+
+std::vector<ScenePreset> AllScenePresets() {
+  std::vector<ScenePreset> all = ScenePresets();
+  all.insert(all.end(), HarderScenePresets().begin(), HarderScenePresets().end());
+  return all;
+}
+
 const ScenePreset& FindScenePreset(const std::string& name) {
   std::string names;
-  for (const ScenePreset& p : ScenePresets()) {
-    if (p.name == name) return p;
-    names += (names.empty() ? "" : ", ") + p.name;
+  for (const auto* list : {&ScenePresets(), &HarderScenePresets()}) {
+    for (const ScenePreset& p : *list) {
+      if (p.name == name) return p;
+      names += (names.empty() ? "" : ", ") + p.name;
+    }
   }
   throw std::invalid_argument("unknown scene preset '" + name + "' (valid: " + names + ")");
 }
 
 namespace {
 
-using Vec3f = Eigen::Vector3f;
-using Vec2f = Eigen::Vector2f;
-
-// Appends geometry to one mesh with per-triangle materials. Faces are counter-clockwise seen from
-// the side their normal points to.
-class MeshBuilder {
- public:
-  explicit MeshBuilder(std::string name) { mesh_.name = std::move(name); }
-  void Tri(const Vec3f& a, const Vec3f& b, const Vec3f& c, const Vec2f& ua, const Vec2f& ub, const Vec2f& uc, int material) {
-    const int base = static_cast<int>(mesh_.positions.size());
-    mesh_.positions.insert(mesh_.positions.end(), {a, b, c});
-    mesh_.uvs.insert(mesh_.uvs.end(), {ua, ub, uc});
-    mesh_.triangles.emplace_back(base, base + 1, base + 2);
-    mesh_.triangle_materials.push_back(material);
-  }
-  // Quad a-b-c-d (counter-clockwise), two triangles sharing 4 vertices.
-  void Quad(const Vec3f& a, const Vec3f& b, const Vec3f& c, const Vec3f& d, const Vec2f& ua, const Vec2f& ub,
-            const Vec2f& uc, const Vec2f& ud, int material) {
-    const int base = static_cast<int>(mesh_.positions.size());
-    mesh_.positions.insert(mesh_.positions.end(), {a, b, c, d});
-    mesh_.uvs.insert(mesh_.uvs.end(), {ua, ub, uc, ud});
-    mesh_.triangles.emplace_back(base, base + 1, base + 2);
-    mesh_.triangles.emplace_back(base, base + 2, base + 3);
-    mesh_.triangle_materials.insert(mesh_.triangle_materials.end(), {material, material});
-  }
-  // Horizontal quad over [min, max] at height z facing up, UV = xy / tile (+ offset).
-  void Floor(const Eigen::Vector2d& min, const Eigen::Vector2d& max, double z, double tile, int material,
-             const Vec2f& offset = Vec2f::Zero()) {
-    auto uv = [&](double x, double y) -> Vec2f { return Vec2f(static_cast<float>(x / tile), static_cast<float>(-y / tile)) + offset; };
-    const float zf = static_cast<float>(z);
-    Quad(P(min.x(), min.y(), zf), P(max.x(), min.y(), zf), P(max.x(), max.y(), zf), P(min.x(), max.y(), zf),
-         uv(min.x(), min.y()), uv(max.x(), min.y()), uv(max.x(), max.y()), uv(min.x(), max.y()), material);
-  }
-  // Vertical wall from a to b (xy), z in [z0, z1], outward normal to the right of a->b.
-  // u = (u0 + distance) / tile_u; v = v_at_z0 - (z - z0) / tile_v.
-  void Wall(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double z0, double z1, double u0, double tile_u,
-            double v_at_z0, double tile_v, int material) {
-    const double len = (b - a).norm();
-    const float ua = static_cast<float>(u0 / tile_u), ub = static_cast<float>((u0 + len) / tile_u);
-    const float v0 = static_cast<float>(v_at_z0), v1 = static_cast<float>(v_at_z0 - (z1 - z0) / tile_v);
-    Quad(P(a.x(), a.y(), z0), P(b.x(), b.y(), z0), P(b.x(), b.y(), z1), P(a.x(), a.y(), z1), {ua, v0}, {ub, v0}, {ub, v1},
-         {ua, v1}, material);
-  }
-  // Block in front of a wall: along the wall d in [d0, d1] from `origin` in direction `along` (unit),
-  // out of it n in [n0, n1] along the wall's outward normal (right of `along`), z in [z0, z1]. Five
-  // faces (no back face, it touches the wall). The front face takes uv(d, z), so a block carrying
-  // the wall's material continues the wall's texture; the side, top and bottom faces continue it
-  // around the edges (their depth coordinate stretches d or z).
-  void WallBlock(const Eigen::Vector2d& origin, const Eigen::Vector2d& along, double d0, double d1, double n0, double n1,
-                 double z0, double z1, const std::function<Vec2f(double, double)>& uv, int material) {
-    const Eigen::Vector2d normal(along.y(), -along.x());
-    auto at = [&](double d, double n, double z) {
-      const Eigen::Vector2d xy = origin + d * along + n * normal;
-      return P(xy.x(), xy.y(), z);
-    };
-    const double depth = n1 - n0;
-    // Front (outward), seen from outside: d0 left, d1 right.
-    Quad(at(d0, n1, z0), at(d1, n1, z0), at(d1, n1, z1), at(d0, n1, z1), uv(d0, z0), uv(d1, z0), uv(d1, z1), uv(d0, z1), material);
-    // Side at d0 (normal -along) and at d1 (normal +along).
-    Quad(at(d0, n0, z0), at(d0, n1, z0), at(d0, n1, z1), at(d0, n0, z1), uv(d0 - depth, z0), uv(d0, z0), uv(d0, z1),
-         uv(d0 - depth, z1), material);
-    Quad(at(d1, n1, z0), at(d1, n0, z0), at(d1, n0, z1), at(d1, n1, z1), uv(d1, z0), uv(d1 + depth, z0), uv(d1 + depth, z1),
-         uv(d1, z1), material);
-    // Top (normal +z) and bottom (normal -z).
-    Quad(at(d0, n0, z1), at(d0, n1, z1), at(d1, n1, z1), at(d1, n0, z1), uv(d0, z1 + depth), uv(d0, z1), uv(d1, z1),
-         uv(d1, z1 + depth), material);
-    Quad(at(d0, n1, z0), at(d0, n0, z0), at(d1, n0, z0), at(d1, n1, z0), uv(d0, z0), uv(d0, z0 - depth), uv(d1, z0 - depth),
-         uv(d1, z0), material);
-  }
-  // Axis-aligned box; per-face materials in order -x, +x, -y, +y, top (bottom omitted unless
-  // `bottom`, then it takes the -x material). UVs map each face's full extent to [0, 1] unless
-  // tile > 0 (metres per texture tile).
-  void Box(const Vec3f& lo, const Vec3f& hi, const int materials[5], float tile = 0, bool bottom = false) {
-    auto uv = [&](float a, float b, float ext_a, float ext_b) {
-      return tile > 0 ? Vec2f(a / tile, -b / tile) : Vec2f(a / ext_a, 1.0f - b / ext_b);
-    };
-    const Vec3f e = hi - lo;
-    // -x face: seen from -x, u along -y.
-    Quad(P(lo.x(), hi.y(), lo.z()), P(lo.x(), lo.y(), lo.z()), P(lo.x(), lo.y(), hi.z()), P(lo.x(), hi.y(), hi.z()),
-         uv(0, 0, e.y(), e.z()), uv(e.y(), 0, e.y(), e.z()), uv(e.y(), e.z(), e.y(), e.z()), uv(0, e.z(), e.y(), e.z()), materials[0]);
-    Quad(P(hi.x(), lo.y(), lo.z()), P(hi.x(), hi.y(), lo.z()), P(hi.x(), hi.y(), hi.z()), P(hi.x(), lo.y(), hi.z()),
-         uv(0, 0, e.y(), e.z()), uv(e.y(), 0, e.y(), e.z()), uv(e.y(), e.z(), e.y(), e.z()), uv(0, e.z(), e.y(), e.z()), materials[1]);
-    Quad(P(lo.x(), lo.y(), lo.z()), P(hi.x(), lo.y(), lo.z()), P(hi.x(), lo.y(), hi.z()), P(lo.x(), lo.y(), hi.z()),
-         uv(0, 0, e.x(), e.z()), uv(e.x(), 0, e.x(), e.z()), uv(e.x(), e.z(), e.x(), e.z()), uv(0, e.z(), e.x(), e.z()), materials[2]);
-    Quad(P(hi.x(), hi.y(), lo.z()), P(lo.x(), hi.y(), lo.z()), P(lo.x(), hi.y(), hi.z()), P(hi.x(), hi.y(), hi.z()),
-         uv(0, 0, e.x(), e.z()), uv(e.x(), 0, e.x(), e.z()), uv(e.x(), e.z(), e.x(), e.z()), uv(0, e.z(), e.x(), e.z()), materials[3]);
-    Quad(P(lo.x(), lo.y(), hi.z()), P(hi.x(), lo.y(), hi.z()), P(hi.x(), hi.y(), hi.z()), P(lo.x(), hi.y(), hi.z()),
-         uv(0, 0, e.x(), e.y()), uv(e.x(), 0, e.x(), e.y()), uv(e.x(), e.y(), e.x(), e.y()), uv(0, e.y(), e.x(), e.y()), materials[4]);
-    if (bottom) {
-      Quad(P(lo.x(), lo.y(), lo.z()), P(lo.x(), hi.y(), lo.z()), P(hi.x(), hi.y(), lo.z()), P(hi.x(), lo.y(), lo.z()),
-           uv(0, 0, e.x(), e.y()), uv(0, e.y(), e.x(), e.y()), uv(e.x(), e.y(), e.x(), e.y()), uv(e.x(), 0, e.x(), e.y()), materials[0]);
-    }
-  }
-  // Vertical prism with a regular n-gon cross-section around `axis_centre`; axis along z (or along
-  // y when `along_y`, for wheels). Sides tile the texture once around.
-  void Prism(const Vec3f& centre, float radius, float z0, float z1, int n, int side_material, int cap_material,
-             bool along_y = false) {
-    auto at = [&](float ang, float h) {
-      const float c = radius * std::cos(ang), s = radius * std::sin(ang);
-      return along_y ? Vec3f(centre.x() + c, centre.y() + h, centre.z() + s) : Vec3f(centre.x() + c, centre.y() + s, centre.z() + h);
-    };
-    for (int k = 0; k < n; ++k) {
-      const float a0 = static_cast<float>(2 * M_PI * k / n), a1 = static_cast<float>(2 * M_PI * (k + 1) / n);
-      const float u0 = static_cast<float>(k) / n, u1 = static_cast<float>(k + 1) / n;
-      if (along_y) {
-        Quad(at(a0, z1), at(a1, z1), at(a1, z0), at(a0, z0), {u0, 0}, {u1, 0}, {u1, 1}, {u0, 1}, side_material);
-      } else {
-        Quad(at(a0, z0), at(a1, z0), at(a1, z1), at(a0, z1), {u0, 1}, {u1, 1}, {u1, 0}, {u0, 0}, side_material);
-      }
-    }
-    for (int k = 1; k + 1 < n; ++k) {  // caps
-      const float a0 = 0, a1 = static_cast<float>(2 * M_PI * k / n), a2 = static_cast<float>(2 * M_PI * (k + 1) / n);
-      const Vec2f z(0.5f, 0.5f);
-      if (along_y) {
-        Tri(at(a0, z0), at(a1, z0), at(a2, z0), z, z, z, cap_material);
-        Tri(at(a0, z1), at(a2, z1), at(a1, z1), z, z, z, cap_material);
-      } else {
-        Tri(at(a0, z1), at(a1, z1), at(a2, z1), z, z, z, cap_material);
-      }
-    }
-  }
-  Mesh Finish() {
-    mesh_.material = mesh_.triangle_materials.empty() ? 0 : mesh_.triangle_materials.front();
-    if (std::all_of(mesh_.triangle_materials.begin(), mesh_.triangle_materials.end(),
-                    [&](int m) { return m == mesh_.material; })) {
-      mesh_.triangle_materials.clear();
-    }
-    return std::move(mesh_);
-  }
-  size_t NumTriangles() const { return mesh_.triangles.size(); }
-
-  static Vec3f P(double x, double y, double z) { return Vec3f(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)); }
-
- private:
-  Mesh mesh_;
-};
-
-int AddMaterial(Scene& scene, const std::string& name, const Vec3f& color, int texture) {
-  Material m;
-  m.name = name;
-  m.base_color = color;
-  m.texture = texture;
-  scene.materials.push_back(m);
-  return static_cast<int>(scene.materials.size()) - 1;
-}
-
-int AddMesh(Scene& scene, Mesh mesh) {
-  scene.meshes.push_back(std::move(mesh));
-  return static_cast<int>(scene.meshes.size()) - 1;
-}
-
-void AddStatic(Scene& scene, const std::string& name, int mesh, const Rigid3& world_from_object) {
-  Object o;
-  o.name = name;
-  o.mesh = mesh;
-  o.world_from_object = world_from_object;
-  scene.objects.push_back(o);
-}
-
-Rigid3 PlaceYaw(double x, double y, double yaw_rad, double z = 0.0) {
-  return Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ())), Eigen::Vector3d(x, y, z));
-}
 
 // `high_sun_along_streets` (sunny only): a high sun 15-25 degrees off a street axis, so that light
 // reaches the floor of a narrow canyon in strips instead of only the upper floors.
@@ -243,8 +106,20 @@ Lighting MakeLighting(const std::string& preset, uint64_t seed, bool high_sun_al
     l.ground_albedo = {0.3f, 0.25f, 0.22f};
     l.ambient = 0.3f;
     l.exposure = 1.3f;
+  } else if (preset == "night") {
+    // Moonless, light-polluted night: no sun, a dark blue zenith and an orange glow at the horizon;
+    // the street lamps and headlights (scene lights) do the rest. Radiances are on the day presets'
+    // scale (sun irradiance 3), so the exposure is 1000 times a day preset's: a real camera
+    // needs a long exposure and high gain.
+    elevation_deg = -20.0;
+    l.sun_radiance = {0.0f, 0.0f, 0.0f};
+    l.sky_zenith = {0.6e-5f, 0.8e-5f, 1.8e-5f};
+    l.sky_horizon = {2.6e-5f, 2.0e-5f, 1.4e-5f};
+    l.ground_albedo = {0.2f, 0.2f, 0.2f};
+    l.ambient = 1.0f;
+    l.exposure = 1000.0f;
   } else {
-    throw std::invalid_argument("unknown lighting preset '" + preset + "' (valid: sunny, cloudy, sunset)");
+    throw std::invalid_argument("unknown lighting preset '" + preset + "' (valid: sunny, cloudy, sunset, night)");
   }
   const double el = elevation_deg * M_PI / 180, az = azimuth_deg * M_PI / 180;
   l.direction_to_sun = Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
@@ -275,13 +150,14 @@ class CarFactory {
     glass_ = AddMaterial(scene, "car_glass", {0.9f, 0.9f, 0.9f}, tex.glass);
     tyre_ = AddMaterial(scene, "car_tyre", {0.04f, 0.04f, 0.04f}, -1);
   }
-  // Mesh of a car: origin on the ground under the centre, x forward, z up.
-  int Get(int shape, int color) {
-    const int key = shape * kNumCarColors + color;
+  // Mesh of a car: origin on the ground under the centre, x forward, z up. `lit`: with glowing head
+  // and tail lamps (CarLamps gives the headlight positions).
+  int Get(int shape, int color, bool lit = false) {
+    const int key = (shape * kNumCarColors + color) * 2 + (lit ? 1 : 0);
     auto it = meshes_.find(key);
     if (it != meshes_.end()) return it->second;
     const CarShape& s = kCarShapes[shape];
-    const std::string name = std::string("car_") + s.name + "_" + std::to_string(color);
+    const std::string name = std::string("car_") + s.name + "_" + std::to_string(color) + (lit ? "_lit" : "");
     const Vec3f paint = kCarColors[color];
     const int side = AddMaterial(scene_, name + "_side", paint, tex_.side);
     const int end = AddMaterial(scene_, name + "_end", paint, tex_.end);
@@ -295,15 +171,55 @@ class CarFactory {
     b.Box({c0, -hw + 0.1f, s.body_top}, {c1, hw - 0.1f, s.cabin_top}, cabin);
     for (float wx : {-hl + 0.8f, hl - 0.8f})
       for (float wy : {-hw + 0.12f, hw - 0.34f}) b.Prism({wx, wy, 0.33f}, 0.33f, 0.0f, 0.22f, 8, tyre_, tyre_, true);
+    if (lit) AddLamps(b, s);
     const int mesh = AddMesh(scene_, b.Finish());
     meshes_[key] = mesh;
     return mesh;
   }
 
+  // Headlight spots of a lit car of `shape`, in the car's frame, riding on object `object`.
+  static std::vector<Light> Headlights(int shape, int object, const std::string& name) {
+    const CarShape& s = kCarShapes[shape];
+    std::vector<Light> lights;
+    for (const double side : {-1.0, 1.0}) {
+      Light l;
+      l.name = name + (side < 0 ? "_headlight_right" : "_headlight_left");
+      l.position = Eigen::Vector3d(0.5 * s.length + 0.05, side * (0.5 * s.width - 0.35), 0.65);
+      l.intensity = Eigen::Vector3f(0.3f, 0.3f, 0.28f);  // about 10 street lamps on axis
+      l.range = 60.0;
+      l.object = object;
+      l.spot = true;
+      l.spot_direction = Eigen::Vector3d(1.0, 0.0, -0.06);  // dipped beam, 3.4 degrees down
+      l.spot_angle_deg = 55.0;
+      l.spot_blend = 0.6;
+      lights.push_back(l);
+    }
+    return lights;
+  }
+
  private:
+  // Glowing head lamps (front corners) and tail lamps (rear corners) of a lit car.
+  void AddLamps(MeshBuilder& b, const CarShape& s) {
+    if (headlamp_ < 0) {
+      headlamp_ = AddMaterial(scene_, "car_headlamp", {0.9f, 0.9f, 0.9f}, -1);
+      scene_.materials[headlamp_].emission = {20.0f, 20.0f, 18.0f};
+      taillamp_ = AddMaterial(scene_, "car_taillamp", {0.6f, 0.05f, 0.05f}, -1);
+      scene_.materials[taillamp_].emission = {1.5f, 0.05f, 0.03f};
+    }
+    const float hl = 0.5f * s.length, hw = 0.5f * s.width;
+    const int head[5] = {headlamp_, headlamp_, headlamp_, headlamp_, headlamp_};
+    const int tail[5] = {taillamp_, taillamp_, taillamp_, taillamp_, taillamp_};
+    for (const float side : {-1.0f, 1.0f}) {
+      const float y0 = side * (hw - 0.35f) - 0.13f, y1 = y0 + 0.26f;
+      b.Box({hl - 0.02f, y0, 0.58f}, {hl + 0.03f, y1, 0.72f}, head);
+      b.Box({-hl - 0.03f, y0, 0.7f}, {-hl + 0.02f, y1, 0.82f}, tail);
+    }
+  }
+
   Scene& scene_;
   CarTextures tex_;
   int glass_, tyre_;
+  int headlamp_ = -1, taillamp_ = -1;
   std::map<int, int> meshes_;
 };
 
@@ -733,10 +649,76 @@ void AddBuilding(MeshBuilder& b, const BuildingPlan& p, const FacadeLayout& fl, 
   if (!hip_roof && r_rooftop < 0.55 && room.minCoeff() > 5.0) AddRooftopStructures(b, p, trim, am, arch);
 }
 
+// ---- suburban houses ----------------------------------------------------------------------------
+
+struct HouseMaterials {
+  int glass = -1, frame = -1, door = -1, plinth = -1;
+};
+
+// The four walls of a footprint, counter-clockwise seen from above: origin, unit direction (outward
+// normal on its right) and length; `street` is the index of the wall facing `facing`.
+struct FootprintWalls {
+  Eigen::Vector2d origin[4], along[4];
+  double length[4];
+  int street = 0;
+};
+
+FootprintWalls WallsOf(const Box2& fp, const Eigen::Vector2d& facing) {
+  FootprintWalls w;
+  const Eigen::Vector2d c[4] = {fp.min, {fp.max.x(), fp.min.y()}, fp.max, {fp.min.x(), fp.max.y()}};
+  for (int e = 0; e < 4; ++e) {
+    w.origin[e] = c[e];
+    w.length[e] = (c[(e + 1) % 4] - c[e]).norm();
+    w.along[e] = (c[(e + 1) % 4] - c[e]) / w.length[e];
+    if (Eigen::Vector2d(w.along[e].y(), -w.along[e].x()).dot(facing) > 0.5) w.street = e;
+  }
+  return w;
+}
+
+// A detached house: plain rendered walls, a plinth, a few framed windows per storey (more on the
+// street side), a front door and a hipped roof. `arch` draws every random choice in a fixed order.
+void AddHouse(MeshBuilder& b, const BuildingPlan& p, int m_wall, const HouseMaterials& hm,
+              const ArchitectureMaterials& am, SceneRng& arch) {
+  const FootprintWalls w = WallsOf(p.footprint, p.facing);
+  const int storeys = static_cast<int>(std::lround(p.height / kHouseStoreyMetres));
+  const int street_windows = arch.UniformInt(2, 3);
+  auto plain_uv = [](double d, double z) {
+    return Vec2f(static_cast<float>(d / kHouseWallTileMetres), static_cast<float>(-z / kHouseWallTileMetres));
+  };
+  for (int e = 0; e < 4; ++e) {
+    const double len = w.length[e];
+    b.Wall(w.origin[e], w.origin[e] + len * w.along[e], 0.0, p.height, 0.0, kHouseWallTileMetres, 0.0,
+           kHouseWallTileMetres, m_wall);
+    b.WallBlock(w.origin[e], w.along[e], 0.0, len, 0.0, 0.04, 0.0, 0.4, plain_uv, hm.plinth);
+    // Window centres along the wall (fractions); on the street side the door takes the middle of
+    // the ground floor.
+    const bool street = e == w.street;
+    std::vector<double> at;
+    if (street) at = street_windows == 2 ? std::vector<double>{0.25, 0.75} : std::vector<double>{0.2, 0.5, 0.8};
+    else if (len > 7.0) at = {0.5};
+    for (int k = 0; k < storeys; ++k) {
+      const double z0 = k * kHouseStoreyMetres + 0.9, z1 = z0 + 1.3;
+      for (const double f : at) {
+        if (street && k == 0 && f == 0.5) continue;
+        const double dc = f * len, d0 = dc - 0.6, d1 = dc + 0.6;
+        b.WallBlock(w.origin[e], w.along[e], d0, d1, 0.0, 0.02, z0, z1, plain_uv, hm.glass);
+        b.WallBlock(w.origin[e], w.along[e], d0 - 0.07, d1 + 0.07, 0.0, 0.06, z1, z1 + 0.07, plain_uv, hm.frame);
+        b.WallBlock(w.origin[e], w.along[e], d0 - 0.07, d1 + 0.07, 0.0, 0.08, z0 - 0.07, z0, plain_uv, hm.frame);
+        b.WallBlock(w.origin[e], w.along[e], d0 - 0.07, d0, 0.0, 0.06, z0, z1, plain_uv, hm.frame);
+        b.WallBlock(w.origin[e], w.along[e], d1, d1 + 0.07, 0.0, 0.06, z0, z1, plain_uv, hm.frame);
+      }
+    }
+    if (street)
+      b.WallBlock(w.origin[e], w.along[e], 0.5 * len - 0.5, 0.5 * len + 0.5, 0.0, 0.05, 0.0, 2.1, plain_uv, hm.door);
+  }
+  AddHipRoof(b, p.footprint, p.height, am.trim[arch.UniformInt(0, static_cast<int>(am.trim.size()) - 1)], am, arch);
+}
+
 // Texture indices of the generated textures (in scene.textures).
 struct CityTextures {
   int num_facades = 0, num_storefronts = 0, num_awnings = 0;  // facades first, then storefronts
   int road = 0, intersection = 0, sidewalk = 0, concrete = 0, ground = 0, bark = 0, foliage = 0, sign = 0, awning = 0;
+  int lawn = -1;  // suburban lots only
   CarTextures car;
 };
 
@@ -745,9 +727,13 @@ CityTextures GenerateTextures(Scene& scene, const CityStyle& st, uint64_t textur
   CityTextures t;
   t.num_facades = quick ? std::max(4, st.facade_textures / 3) : st.facade_textures;
   t.num_storefronts = quick ? std::max(3, st.storefront_textures / 2) : st.storefront_textures;
+  if (st.houses) t.num_storefronts = 0;  // houses: plain walls (MakeHouseWallTexture), no shops
   t.num_awnings = quick ? 3 : 6;
   std::vector<std::function<Texture()>> jobs;
-  for (int i = 0; i < t.num_facades; ++i) jobs.push_back([=] { return MakeFacadeTexture(texture_seed, i); });
+  for (int i = 0; i < t.num_facades; ++i) {
+    if (st.houses) jobs.push_back([=] { return MakeHouseWallTexture(texture_seed, i); });
+    else jobs.push_back([=] { return MakeFacadeTexture(texture_seed, i); });
+  }
   for (int i = 0; i < t.num_storefronts; ++i) jobs.push_back([=] { return MakeStorefrontTexture(texture_seed, i); });
   const auto next = [&jobs] { return static_cast<int>(jobs.size()); };
   t.road = next();
@@ -774,6 +760,10 @@ CityTextures GenerateTextures(Scene& scene, const CityStyle& st, uint64_t textur
   for (int k = 0; k < kSignKinds; ++k) jobs.push_back([=] { return MakeSignTexture(texture_seed, k); });
   t.awning = next();
   for (int k = 0; k < t.num_awnings; ++k) jobs.push_back([=] { return MakeAwningTexture(texture_seed, k); });
+  if (st.houses) {
+    t.lawn = next();
+    jobs.push_back([=] { return MakeLawnTexture(texture_seed); });
+  }
   scene.textures.resize(jobs.size());
   tbb::parallel_for(size_t{0}, jobs.size(), [&](size_t i) { scene.textures[i] = jobs[i](); });
   return t;
@@ -783,6 +773,7 @@ CityTextures GenerateTextures(Scene& scene, const CityStyle& st, uint64_t textur
 struct CityMaterials {
   int road[2] = {0, 0};
   int intersection = 0, sidewalk = 0, curb = 0, roof = 0, ground = 0, metal = 0, lamp = 0, bark = 0, foliage = 0;
+  int lawn = -1;  // suburban lots only
 };
 
 CityMaterials AddSharedMaterials(Scene& scene, const CityTextures& t) {
@@ -798,7 +789,17 @@ CityMaterials AddSharedMaterials(Scene& scene, const CityTextures& t) {
   m.lamp = AddMaterial(scene, "lamp", {0.9f, 0.9f, 0.8f}, -1);
   m.bark = AddMaterial(scene, "bark", {1, 1, 1}, t.bark);
   m.foliage = AddMaterial(scene, "foliage", {1, 1, 1}, t.foliage);
+  if (t.lawn >= 0) m.lawn = AddMaterial(scene, "lawn", {1, 1, 1}, t.lawn);
   return m;
+}
+
+HouseMaterials AddHouseMaterials(Scene& scene, const CityTextures& t) {
+  HouseMaterials hm;
+  hm.glass = AddMaterial(scene, "house_window", {0.08f, 0.1f, 0.13f}, -1);
+  hm.frame = AddMaterial(scene, "house_frame", {0.85f, 0.85f, 0.83f}, -1);
+  hm.door = AddMaterial(scene, "house_door", {0.25f, 0.15f, 0.1f}, -1);
+  hm.plinth = AddMaterial(scene, "house_plinth", {0.55f, 0.55f, 0.55f}, t.concrete);
+  return hm;
 }
 
 // Ground beyond the city.
@@ -871,9 +872,15 @@ void AddBuildings(Scene& scene, const CityLayout& L, const CityTextures& t, cons
     am.awning.push_back(AddMaterial(scene, "awning_" + std::to_string(i), {1, 1, 1}, t.awning + i));
   SceneRng arch(SubSeed(layout_seed, "architecture"));
   MeshBuilder b("buildings");
+  HouseMaterials hm;
+  if (L.style.houses) hm = AddHouseMaterials(scene, t);
   for (size_t k = 0; k < L.buildings.size(); ++k) {
     const BuildingPlan& p = L.buildings[k];
     const std::string name = "building_" + std::to_string(k);
+    if (p.house) {
+      AddHouse(b, p, AddMaterial(scene, name + "_wall", p.tint, p.facade), hm, am, arch);
+      continue;
+    }
     const int m_facade = AddMaterial(scene, name + "_facade", p.tint, p.facade);
     const int m_shop = AddMaterial(scene, name + "_shop", p.tint, t.num_facades + p.storefront);
     AddBuilding(b, p, GetFacadeLayout(texture_seed, p.facade), m_facade, m_shop, am, L.style, arch);
@@ -974,12 +981,13 @@ void FurnishStreets(Scene& scene, const CityLayout& L, int mesh_light, const int
                      const Eigen::Vector2d& to_road) {
     // a: start of the curb line; dir: along the street; to_road: unit normal from sidewalk to road.
     const double yaw_to_road = std::atan2(to_road.y(), to_road.x());
-    for (double s = 6.0; s < length - 6.0; s += 28.0) {
+    const double half_spacing = 0.5 * st.light_spacing_m;
+    for (double s = 6.0; s < length - 6.0; s += st.light_spacing_m) {
       const Eigen::Vector2d p = a + s * dir - 0.45 * to_road;
       AddStatic(scene, "light_" + std::to_string(lights++), mesh_light,
                 PlaceYaw(p.x(), p.y(), yaw_to_road, kCurbHeight));
-      if (st.trees && s + 14.0 < length - 6.0 && rng.Bernoulli(0.8)) {
-        const Eigen::Vector2d q = a + (s + 14.0) * dir - 1.0 * to_road;
+      if (st.trees && s + half_spacing < length - 6.0 && rng.Bernoulli(st.tree_probability)) {
+        const Eigen::Vector2d q = a + (s + half_spacing) * dir - 1.0 * to_road;
         AddStatic(scene, "tree_" + std::to_string(trees++), mesh_tree[rng.UniformInt(0, 2)],
                   PlaceYaw(q.x(), q.y(), rng.Uniform(0, 2 * M_PI), kCurbHeight));
       }
@@ -1008,31 +1016,61 @@ void FurnishStreets(Scene& scene, const CityLayout& L, int mesh_light, const int
     }
 }
 
-// Moving vehicles (ids 1..N for the masks).
-void AddTraffic(Scene& scene, const CityLayout& L, uint64_t traffic_seed, double frame_rate, CarFactory& cars) {
+// Moving vehicles (ids 1..N for the masks); with `lights_on`, glowing lamps and two headlight
+// spots riding on each.
+void AddTraffic(Scene& scene, const CityLayout& L, uint64_t traffic_seed, double frame_rate, CarFactory& cars,
+                bool lights_on) {
   const int frames = static_cast<int>(L.trajectory.size());
   const std::vector<VehicleTrack> tracks = PlanTraffic(L, traffic_seed, frames, frame_rate);
   uint16_t id = 1;
   for (const VehicleTrack& v : tracks) {
     Object o;
     o.name = "vehicle_" + std::to_string(id) + "_" + v.kind;
-    o.mesh = cars.Get(v.shape, v.color);
+    o.mesh = cars.Get(v.shape, v.color, lights_on);
     o.id = id++;
     o.world_from_object_per_frame = v.world_from_object;
     scene.objects.push_back(std::move(o));
+    if (!lights_on) continue;
+    const int object = static_cast<int>(scene.objects.size()) - 1;
+    for (const Light& l : CarFactory::Headlights(v.shape, object, scene.objects.back().name)) scene.lights.push_back(l);
   }
+}
+
+// Street lamps at night: the lamp head's underside glows and a light just below it shines down.
+void LightStreetLamps(Scene& scene, int mesh_light, int m_lamp) {
+  scene.materials[m_lamp].emission = {5.0f, 4.4f, 3.4f};  // warm white
+  for (size_t o = 0; o < scene.objects.size(); ++o) {
+    if (scene.objects[o].mesh != mesh_light) continue;
+    Light l;
+    l.name = scene.objects[o].name + "_lamp";
+    l.position = Eigen::Vector3d(1.6, 0.0, 6.1);  // in the street light's frame (AddStreetLightMesh)
+    l.intensity = Eigen::Vector3f(0.035f, 0.03f, 0.024f);  // about 25 lux below on the day scale
+    l.range = 30.0;
+    l.object = static_cast<int>(o);
+    // A full cut-off luminaire: light goes down (A = cos of the angle off the axis, none above
+    // 75 degrees), so the road is lit in pools and the facades stay dark.
+    l.spot = true;
+    l.spot_direction = Eigen::Vector3d(0.0, 0.0, -1.0);
+    l.spot_angle_deg = 150.0;
+    l.spot_blend = 0.3;
+    scene.lights.push_back(l);
+  }
+}
+
+// Suburban lots: a lawn over each block inside its sidewalk ring, 1 cm above the sidewalk.
+void AddLawns(Scene& scene, const CityLayout& L, int m_lawn) {
+  MeshBuilder b("lawns");
+  for (const Box2& blk : L.blocks) {
+    const Eigen::Vector2d lo = blk.min.array() + L.style.sidewalk_width_m;
+    const Eigen::Vector2d hi = blk.max.array() - L.style.sidewalk_width_m;
+    if ((hi - lo).minCoeff() > 0.0) b.Floor(lo, hi, kCurbHeight + 0.01, kLawnTileMetres, m_lawn);
+  }
+  AddStatic(scene, "lawns", AddMesh(scene, b.Finish()), Rigid3::Identity());
 }
 
 }  // namespace
 
-Scene GenerateScene(const std::string& preset_name, uint64_t seed, bool quick) {
-  const ScenePreset& preset = FindScenePreset(preset_name);
-  const CityLayout L = MakeCityLayout(preset, seed, quick);
-  const CityStyle& st = L.style;
-  const uint64_t layout_seed = LayoutSeed(preset.name, seed);
-  const uint64_t texture_seed = SubSeed(layout_seed, "textures");
-  SceneRng rng(SubSeed(layout_seed, "props"));
-
+Scene ProceduralSceneHeader(const ScenePreset& preset, uint64_t seed, bool quick, Trajectory rig_trajectory) {
   Scene scene;
   scene.metadata.generator = "rovo";
   scene.metadata.generator_version = ROVO_VERSION;
@@ -1041,7 +1079,20 @@ Scene GenerateScene(const std::string& preset_name, uint64_t seed, bool quick) {
   scene.metadata.seed = seed;
   scene.frame_rate = preset.frame_rate;
   scene.rig_preset = preset.rig_preset;
-  scene.rig_trajectory = L.trajectory;
+  scene.rig_trajectory = std::move(rig_trajectory);
+  return scene;
+}
+
+Scene GenerateScene(const std::string& preset_name, uint64_t seed, bool quick) {
+  const ScenePreset& preset = FindScenePreset(preset_name);
+  if (preset.world == "indoor") return GenerateIndoorScene(preset, seed, quick);
+  const CityLayout L = MakeCityLayout(preset, seed, quick);
+  const CityStyle& st = L.style;
+  const uint64_t layout_seed = LayoutSeed(preset.name, seed);
+  const uint64_t texture_seed = SubSeed(layout_seed, "textures");
+  SceneRng rng(SubSeed(layout_seed, "props"));
+
+  Scene scene = ProceduralSceneHeader(preset, seed, quick, L.trajectory);
   scene.lighting = MakeLighting(preset.lighting, SubSeed(seed, preset.lighting.c_str()), st.high_sun_along_streets);
 
   const CityTextures textures = GenerateTextures(scene, st, texture_seed, quick);
@@ -1061,7 +1112,10 @@ Scene GenerateScene(const std::string& preset_name, uint64_t seed, bool quick) {
   CarFactory cars(scene, textures.car);
   FurnishStreets(scene, L, mesh_light, mesh_tree, cars, rng);
 
-  if (preset.traffic) AddTraffic(scene, L, layout_seed ^ seed, preset.frame_rate, cars);
+  const bool night = preset.lighting == "night";
+  if (preset.traffic) AddTraffic(scene, L, layout_seed ^ seed, preset.frame_rate, cars, night);
+  if (night) LightStreetLamps(scene, mesh_light, materials.lamp);
+  if (st.houses) AddLawns(scene, L, materials.lawn);
   return scene;
 }
 

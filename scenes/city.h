@@ -1,5 +1,6 @@
 #pragma once
-// Procedural urban scenes and the paper's Table I presets.
+// Procedural scenes: the paper's Table I presets (urban streets) and harder worlds (an indoor hall
+// and corridor, a low-texture suburban road, a night street).
 
 #include "scenes/scene.h"
 
@@ -14,18 +15,28 @@ struct ScenePreset {
   std::string description;
   double path_length_m = 0;    // full form
   int frames = 0;              // full form, at 10 Hz
-  std::string lighting;        // "sunny" | "cloudy" | "sunset"
-  bool traffic = false;        // moving vehicles
+  std::string lighting;        // "sunny" | "cloudy" | "sunset" | "night" | "indoor"
+  bool traffic = false;        // moving objects (vehicles; people in indoor_hall)
   std::string rig_preset = "rovo4";
   int quick_frames = 0;        // --quick form
   double quick_scale = 0.5;    // image scale for the --quick form
   double frame_rate = 10.0;    // Hz
+  std::string world = "city";  // "city" (street grid, city_layout.h) or "indoor" (hall and corridor, indoor.h)
 };
 
-// All presets, in Table I order.
+// The Table I presets, in Table I order (what `rovo suite` runs by default).
 const std::vector<ScenePreset>& ScenePresets();
-// Throws std::invalid_argument listing the valid names.
+// Harder worlds beyond Table I: indoor_hall, suburban_road, night_street.
+const std::vector<ScenePreset>& HarderScenePresets();
+// Both lists, Table I first.
+std::vector<ScenePreset> AllScenePresets();
+// Any preset of AllScenePresets(); throws std::invalid_argument listing the valid names.
 const ScenePreset& FindScenePreset(const std::string& name);
+
+// A procedural scene's header: metadata (generator, version, preset, seed, source), frame rate, rig
+// preset and rig trajectory.
+Scene ProceduralSceneHeader(const ScenePreset& preset, uint64_t seed, bool quick,
+                            Trajectory rig_trajectory);
 
 // Deterministic: the same (preset, seed, quick) gives the same scene, byte for byte.
 Scene GenerateScene(const std::string& preset, uint64_t seed, bool quick);

@@ -25,7 +25,7 @@ const Eigen::Vector2i kDirs[4] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
 }  // namespace
 
 uint64_t LayoutSeed(const std::string& preset, uint64_t seed) {
-  const bool town = preset == "cloudy_urban" || preset == "sunset_urban";
+  const bool town = preset == "cloudy_urban" || preset == "sunset_urban" || preset == "night_street";
   return SubSeed(seed, town ? "town" : preset.c_str());
 }
 
@@ -37,7 +37,7 @@ CityStyle StyleForPreset(const std::string& preset) {
     s.height_min_m = 10;
     s.height_max_m = 35;
     s.straight_preference = 0.7;
-  } else if (preset == "cloudy_urban" || preset == "sunset_urban") {
+  } else if (preset == "cloudy_urban" || preset == "sunset_urban" || preset == "night_street") {
     s.block_min_m = 60;
     s.block_max_m = 90;
     s.height_min_m = 7;
@@ -59,6 +59,24 @@ CityStyle StyleForPreset(const std::string& preset) {
     s.trees = false;
     s.parked_cars = false;
     s.high_sun_along_streets = true;
+  } else if (preset == "suburban_road") {
+    // Wide lots with one low house each, far apart; no parking lane, few trees, sparse lights.
+    s.block_min_m = 100;
+    s.block_max_m = 150;
+    s.road_width_m = 7.5;
+    s.parking_lane_m = 0.0;
+    s.sidewalk_width_m = 2.0;
+    s.lot_width_min_m = 20;
+    s.lot_width_max_m = 30;
+    s.lot_depth_min_m = 20;
+    s.lot_depth_max_m = 24;
+    s.straight_preference = 0.8;
+    s.parked_cars = false;
+    s.tree_probability = 0.2;
+    s.light_spacing_m = 40.0;
+    s.houses = true;
+    s.facade_textures = 6;
+    s.storefront_textures = 0;
   }
   return s;
 }
@@ -410,6 +428,40 @@ BuildingPlan PlanBuilding(const CityStyle& st, const Box2& lots, int side, doubl
   return p;
 }
 
+// One detached house on the lot [a, b] of strip `side` (as PlanBuilding) whose strip is `depth`
+// deep: house_width wide, centred in the lot with some jitter, set back from the lot's street edge.
+BuildingPlan PlanHouse(const CityStyle& st, const Box2& lots, int side, double a, double b, double depth,
+                       const FacadeCounts& counts, SceneRng& rng) {
+  const double width = std::min(b - a - 4.0, rng.Uniform(st.house_width_min_m, st.house_width_max_m));
+  const double slack = b - a - width;
+  const double a0 = a + slack * rng.Uniform(0.3, 0.7), a1 = a0 + width;
+  const double setback = rng.Uniform(st.setback_min_m, st.setback_max_m);
+  const double deep = std::min(depth - setback - 1.0, rng.Uniform(st.house_depth_min_m, st.house_depth_max_m));
+  const double n0 = setback, n1 = setback + deep;  // distances from the street edge of the strip
+  BuildingPlan p;
+  p.house = true;
+  switch (side) {
+    case 0:
+      p.footprint = {{a0, lots.min.y() + n0}, {a1, lots.min.y() + n1}}, p.facing = {0, -1};
+      break;
+    case 1:
+      p.footprint = {{a0, lots.max.y() - n1}, {a1, lots.max.y() - n0}}, p.facing = {0, 1};
+      break;
+    case 2:
+      p.footprint = {{lots.min.x() + n0, a0}, {lots.min.x() + n1, a1}}, p.facing = {-1, 0};
+      break;
+    default:
+      p.footprint = {{lots.max.x() - n1, a0}, {lots.max.x() - n0, a1}}, p.facing = {1, 0};
+      break;
+  }
+  static const Eigen::Vector3f kHouseColours[] = {{0.92f, 0.9f, 0.84f}, {0.85f, 0.8f, 0.7f}, {0.8f, 0.84f, 0.86f},
+                                                  {0.93f, 0.88f, 0.78f}, {0.75f, 0.78f, 0.72f}, {0.95f, 0.95f, 0.93f}};
+  p.height = rng.Bernoulli(0.6) ? 2 * kHouseStoreyMetres : kHouseStoreyMetres;
+  p.facade = rng.UniformInt(0, counts.facades - 1);
+  p.tint = kHouseColours[rng.UniformInt(0, 5)];
+  return p;
+}
+
 // Blocks between the street lines `ex` x `ey` (block edges) and their buildings: four strips of
 // lots per block; south and north span the full width, west and east fill between them.
 void PlanBlocks(CityLayout* L, const std::vector<double>& ex, const std::vector<double>& ey, const FacadeCounts& counts,
@@ -432,6 +484,11 @@ void PlanBlocks(CityLayout* L, const std::vector<double>& ex, const std::vector<
           double w = rng.Uniform(st.lot_width_min_m, st.lot_width_max_m);
           if (a1 - (a + w) < st.lot_width_min_m) w = a1 - a;
           const double b = a + w;
+          if (st.houses) {
+            if (w > 12.0) L->buildings.push_back(PlanHouse(st, lots, side, a, b, depth, counts, rng));
+            a = b;
+            continue;
+          }
           const bool gap = st.trees && rng.Bernoulli(0.07);
           const BuildingPlan p = PlanBuilding(st, lots, side, a, b, depth, counts, rng);
           if (!gap && w > 2.0) L->buildings.push_back(p);

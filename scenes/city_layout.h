@@ -44,6 +44,14 @@ struct CityStyle {
   int facade_textures = 24, storefront_textures = 8;  // texture pool sizes (full form)
   int grid_streets_min = 6;                           // streets per axis at least
   bool high_sun_along_streets = false;  // sunny: high sun near a street axis (canyons)
+  double tree_probability = 0.8;        // a tree between two street lights
+  double light_spacing_m = 28.0;        // street lights along each curb
+  // Suburban: detached houses (no shops) of house_width x house_depth set back from the sidewalk
+  // behind lawns, one per lot, with plain walls (MakeHouseWallTexture) and few windows.
+  bool houses = false;
+  double setback_min_m = 6, setback_max_m = 10;
+  double house_width_min_m = 9, house_width_max_m = 14;
+  double house_depth_min_m = 8, house_depth_max_m = 11;
 };
 
 CityStyle StyleForPreset(const std::string& preset);
@@ -65,6 +73,7 @@ struct BuildingPlan {
   int facade = 0, storefront = 0;  // texture pool indices
   Eigen::Vector3f tint{1, 1, 1};
   double u_offset = 0;             // metres, shifts the facade pattern
+  bool house = false;              // a detached house (CityStyle::houses): no shop floor, hipped roof
 };
 
 struct StreetGrid {
@@ -134,11 +143,11 @@ struct CityLayout {
 };
 
 // Plan of the city and the rig's drive. Layout depends on (style family, seed); presets that share
-// a family (cloudy_urban, sunset_urban) share streets and buildings for the same seed.
+// a family (cloudy_urban, sunset_urban, night_street) share streets and buildings for the same seed.
 CityLayout MakeCityLayout(const ScenePreset& preset, uint64_t seed, bool quick);
 
 // Seed of everything that shapes the world (plan, textures, props) for a preset and user seed.
-// cloudy_urban and sunset_urban share one layout family, so they share it.
+// cloudy_urban, sunset_urban and night_street share one layout family, so they share it.
 uint64_t LayoutSeed(const std::string& preset, uint64_t seed);
 
 // Quick-form path length: the full length scaled by the frame ratio (same speeds).

@@ -50,6 +50,7 @@ void PrintSceneSummary(const Scene& scene, const ScenePreset* nominal, bool quic
   std::printf("objects      %zu (%zu moving)\n", scene.objects.size(), dynamic);
   std::printf("textures     %zu (%.1f MB)\n", scene.textures.size(), texture_bytes / 1048576.0);
   std::printf("materials    %zu\n", scene.materials.size());
+  std::printf("lights       %zu point/spot lights\n", scene.lights.size());
   std::printf("memory       %.1f MB\n", bytes / 1048576.0);
   std::printf("path         %.1f m in %zu frames at %.0f Hz", PathLength(scene.rig_trajectory), scene.rig_trajectory.size(),
               scene.frame_rate);
@@ -61,8 +62,9 @@ void PrintSceneSummary(const Scene& scene, const ScenePreset* nominal, bool quic
 }
 
 const ScenePreset* PresetOf(const Scene& scene) {
-  for (const ScenePreset& p : ScenePresets())
-    if (p.name == scene.metadata.preset) return &p;
+  for (const auto* list : {&ScenePresets(), &HarderScenePresets()})
+    for (const ScenePreset& p : *list)
+      if (p.name == scene.metadata.preset) return &p;
   return nullptr;
 }
 
@@ -93,7 +95,7 @@ void RunInfo(const std::string& dir) {
 
 void RunList() {
   std::printf("%-16s %7s %9s %7s %8s %7s %-9s  %s\n", "preset", "frames", "length_m", "quick", "scale", "traffic", "lighting", "description");
-  for (const ScenePreset& p : ScenePresets()) {
+  for (const ScenePreset& p : AllScenePresets()) {
     std::printf("%-16s %7d %9.0f %7d %8.2f %7s %-9s  %s\n", p.name.c_str(), p.frames, p.path_length_m, p.quick_frames,
                 p.quick_scale, p.traffic ? "yes" : "no", p.lighting.c_str(), p.description.c_str());
   }
@@ -104,7 +106,9 @@ void RunList() {
 void AddSceneCommands(CliGroups& groups) {
   auto opts = std::make_shared<GenerateOptions>();
   CLI::App* gen = groups.scene->add_subcommand(
-      "generate", "Generate a procedural city (streets, facades, traffic, lighting, rig drive) and save it as a scene folder");
+      "generate",
+      "Generate a procedural scene (streets, a suburb or an indoor hall, its lighting and the rig's path) and save it "
+      "as a scene folder");
   gen->add_option("--preset", opts->preset, "Scene preset (see `rovo scene list`)")->required();
   gen->add_option("--seed", opts->seed, "Random seed; the same preset, seed and form give the same scene byte for byte")
       ->capture_default_str();
@@ -117,7 +121,8 @@ void AddSceneCommands(CliGroups& groups) {
   info->add_option("dir", *info_dir, "Scene folder (scenes/FORMAT.md)")->required();
   info->callback([info_dir] { RunInfo(*info_dir); });
 
-  CLI::App* list = groups.scene->add_subcommand("list", "List the scene presets (the paper's Table I sequences)");
+  CLI::App* list = groups.scene->add_subcommand(
+      "list", "List the scene presets (the paper's Table I sequences, then the harder worlds)");
   list->callback([] { RunList(); });
 }
 

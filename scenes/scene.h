@@ -29,6 +29,10 @@ struct Material {
   std::string name;
   Eigen::Vector3f base_color{0.8f, 0.8f, 0.8f};  // linear RGB albedo (multiplies the texture)
   int texture = -1;                              // index into Scene::textures, -1 for none
+  Eigen::Vector3f emission{0.0f, 0.0f, 0.0f};    // linear RGB radiance the surface emits (lamps)
+  float specular = 0.0f;    // Blinn-Phong highlight of point lights: reflectance in [0, 1], 0 = matte
+  float shininess = 0.0f;   // Blinn-Phong exponent (> 0 when specular > 0)
+  bool IsEmissive() const { return emission.x() > 0.0f || emission.y() > 0.0f || emission.z() > 0.0f; }
 };
 
 // Triangle mesh in its object frame.
@@ -62,6 +66,22 @@ struct Lighting {
   float exposure = 1.0f;                           // linear scale before the sRGB curve
 };
 
+// A point light, optionally a spot (render/tracer.h gives the shading formula). Intensity is a
+// radiant intensity in linear RGB (W/sr-like): a surface facing the light at distance d receives the
+// irradiance intensity / d^2. A light with `object` >= 0 rides on that object: `position` and
+// `spot_direction` are then in the object's frame and follow it from frame to frame.
+struct Light {
+  std::string name;
+  Eigen::Vector3d position{0.0, 0.0, 0.0};      // world, or object frame when object >= 0
+  Eigen::Vector3f intensity{0.0f, 0.0f, 0.0f};  // linear RGB radiant intensity (Blender power / 4 pi)
+  double range = 0.0;                           // > 0: smooth cut-off, no light at d >= range; 0: none
+  int object = -1;                              // index into Scene::objects, -1 for a world-fixed light
+  bool spot = false;                            // a cone instead of all directions
+  Eigen::Vector3d spot_direction{0.0, 0.0, -1.0};  // cone axis (world or object frame), need not be unit
+  double spot_angle_deg = 45.0;                 // full cone angle in (0, 180]
+  double spot_blend = 0.0;                      // softness of the cone edge in [0, 1]
+};
+
 struct SceneMetadata {
   std::string generator = "rovo";
   std::string generator_version;
@@ -77,6 +97,7 @@ struct Scene {
   std::vector<Mesh> meshes;
   std::vector<Object> objects;
   Lighting lighting;
+  std::vector<Light> lights;  // point and spot lights besides the sun and sky (may be empty)
   double frame_rate = 10.0;
   Trajectory rig_trajectory;  // world_from_rig per frame (the ground truth)
   std::string rig_preset;     // rig the scene was made for ("" = caller chooses)

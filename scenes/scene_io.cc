@@ -261,6 +261,28 @@ class Hasher {
   uint64_t state_ = 0;
 };
 
+json LightsJson(const Scene& scene) {
+  json lights = json::array();
+  for (const Light& light : scene.lights) {
+    if (light.object < -1 || light.object >= static_cast<int>(scene.objects.size())) {
+      throw std::runtime_error("SaveScene: light '" + light.name + "': object index " + std::to_string(light.object) +
+                               " out of range");
+    }
+    json jl = {{"name", light.name},
+               {"position", VecJson(light.position)},
+               {"intensity", VecJson(light.intensity)},
+               {"range", light.range},
+               {"object", light.object}};
+    if (light.spot) {
+      jl["spot"] = {{"direction", VecJson(light.spot_direction)},
+                    {"angle_deg", light.spot_angle_deg},
+                    {"blend", light.spot_blend}};
+    }
+    lights.push_back(jl);
+  }
+  return lights;
+}
+
 }  // namespace
 
 // ------------------------------------------------------------------------------------------------
@@ -312,7 +334,14 @@ void SaveScene(const Scene& scene, const std::string& dir) {
 
   json materials = json::array();
   for (const Material& m : scene.materials) {
-    materials.push_back({{"name", m.name}, {"base_color", VecJson(m.base_color)}, {"texture", m.texture}});
+    json jm = {{"name", m.name}, {"base_color", VecJson(m.base_color)}, {"texture", m.texture}};
+    // Optional fields are written only when set, so matte scenes keep their exact scene.json.
+    if (m.IsEmissive()) jm["emission"] = VecJson(m.emission);
+    if (m.specular > 0.0f) {
+      jm["specular"] = static_cast<double>(m.specular);
+      jm["shininess"] = static_cast<double>(m.shininess);
+    }
+    materials.push_back(jm);
   }
   root["materials"] = materials;
 
@@ -369,6 +398,7 @@ void SaveScene(const Scene& scene, const std::string& dir) {
     objects.push_back(jo);
   }
   root["objects"] = objects;
+  if (!scene.lights.empty()) root["lights"] = LightsJson(scene);
 
   WriteFileAtomic((fs::path(dir) / kGeometryFile).string(), geometry);
   WriteFileAtomic((fs::path(dir) / kMotionFile).string(), motion);
@@ -436,6 +466,46 @@ void ReadMaterials(const Field& root, Scene* scene) {
     m.name = f["name"].String();
     m.base_color = f["base_color"].Vector<3>().cast<float>();
     m.texture = static_cast<int>(f["texture"].Int(-1, static_cast<int64_t>(scene->textures.size()) - 1));
+    if (f.Has("emission")) {
+      m.emission = f["emission"].Vector<3>().cast<float>();
+      if (m.emission.minCoeff() < 0.0f) Fail(f.file(), f.path() + ".emission", "must not be negative");
+    }
+    if (f.Has("specular")) {
+      const double specular = f["specular"].Number();
+      if (specular < 0.0 || specular > 1.0) Fail(f.file(), f.path() + ".specular", "must be in [0, 1]");
+      m.specular = static_cast<float>(specular);
+      const double shininess = f["shininess"].Number();
+      if (specular > 0.0 && !(shininess > 0.0)) Fail(f.file(), f.path() + ".shininess", "must be positive");
+      m.shininess = static_cast<float>(shininess);
+    }
+  }
+}
+
+// /lights (optional): point and spot lights; read after the objects they may ride on.
+void ReadLights(const Field& root, Scene* scene) {
+  if (!root.Has("lights")) return;
+  const Field jl = root["lights"];
+  scene->lights.resize(jl.ArraySize());
+  for (size_t i = 0; i < scene->lights.size(); ++i) {
+    const Field f = jl[i];
+    Light& l = scene->lights[i];
+    l.name = f["name"].String();
+    l.position = f["position"].Vector<3>();
+    l.intensity = f["intensity"].Vector<3>().cast<float>();
+    if (l.intensity.minCoeff() < 0.0f) Fail(f.file(), f.path() + ".intensity", "must not be negative");
+    l.range = f["range"].Number();
+    if (l.range < 0.0) Fail(f.file(), f.path() + ".range", "must not be negative (0: no cut-off)");
+    l.object = static_cast<int>(f["object"].Int(-1, static_cast<int64_t>(scene->objects.size()) - 1));
+    if (!f.Has("spot")) continue;
+    const Field fs = f["spot"];
+    l.spot = true;
+    l.spot_direction = fs["direction"].Vector<3>();
+    if (!(l.spot_direction.norm() > 0.0)) Fail(f.file(), fs.path() + ".direction", "must not be zero");
+    l.spot_angle_deg = fs["angle_deg"].Number();
+    if (!(l.spot_angle_deg > 0.0 && l.spot_angle_deg <= 180.0))
+      Fail(f.file(), fs.path() + ".angle_deg", "must be in (0, 180]");
+    l.spot_blend = fs["blend"].Number();
+    if (l.spot_blend < 0.0 || l.spot_blend > 1.0) Fail(f.file(), fs.path() + ".blend", "must be in [0, 1]");
   }
 }
 
@@ -561,6 +631,7 @@ Scene LoadScene(const std::string& dir) {
   scene.objects.resize(jo.ArraySize());
   for (size_t i = 0; i < scene.objects.size(); ++i)
     scene.objects[i] = ReadObject(jo[i], buffers, file, static_cast<int64_t>(scene.meshes.size()), frames);
+  ReadLights(root, &scene);
   return scene;
 }
 
@@ -595,6 +666,12 @@ std::string SceneHash(const Scene& scene) {
     h.Str(m.name);
     h.Bytes(m.base_color.data(), sizeof(float) * 3);
     h.U64(static_cast<uint64_t>(static_cast<int64_t>(m.texture)));
+    // Emission and specular enter only when set (matte scenes keep their hash).
+    if (m.IsEmissive()) h.Bytes(m.emission.data(), sizeof(float) * 3);
+    if (m.specular > 0.0f) {
+      h.Bytes(&m.specular, sizeof(float));
+      h.Bytes(&m.shininess, sizeof(float));
+    }
   }
   h.U64(scene.meshes.size());
   for (const Mesh& m : scene.meshes) {
@@ -622,6 +699,22 @@ std::string SceneHash(const Scene& scene) {
   for (const StampedPose& p : scene.rig_trajectory) {
     h.F64(p.timestamp);
     h.Rigid(p.world_from_rig);
+  }
+  if (!scene.lights.empty()) {  // scenes without lights keep their hash
+    h.U64(scene.lights.size());
+    for (const Light& l : scene.lights) {
+      h.Str(l.name);
+      h.Bytes(l.position.data(), sizeof(double) * 3);
+      h.Bytes(l.intensity.data(), sizeof(float) * 3);
+      h.F64(l.range);
+      h.U64(static_cast<uint64_t>(static_cast<int64_t>(l.object)));
+      h.U64(l.spot ? 1 : 0);
+      if (l.spot) {
+        h.Bytes(l.spot_direction.data(), sizeof(double) * 3);
+        h.F64(l.spot_angle_deg);
+        h.F64(l.spot_blend);
+      }
+    }
   }
   return h.Hex();
 }

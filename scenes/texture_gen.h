@@ -56,4 +56,23 @@ inline constexpr int kSignKinds = 5;
 Texture MakeSignTexture(uint64_t seed, int kind);
 Texture MakeFoliageTexture(uint64_t seed);
 
+// ---- harder worlds: plain, low-contrast surfaces ----
+inline constexpr double kHouseStoreyMetres = 2.9;
+inline constexpr double kHouseWallTileMetres = 4.0;   // 512 px: about 8 mm per texel
+inline constexpr double kLawnTileMetres = 6.0;
+inline constexpr double kHallWallTileMetres = 4.0;
+inline constexpr double kHallFloorTileMetres = 4.8;   // 4 x 4 polished stone slabs of 1.2 m
+inline constexpr double kHallCeilingTileMetres = 2.4;  // 4 x 4 acoustic panels of 0.6 m
+// Suburban house wall: smooth render (stucco) with only faint large-scale shading and fine grain
+// (RMS contrast a few percent), near white so the material tint sets the colour.
+Texture MakeHouseWallTexture(uint64_t seed, int index);
+// Mown lawn: green with low-contrast large patches and fine grain (no blades, soil or edges).
+Texture MakeLawnTexture(uint64_t seed);
+// Indoor: plain painted wall (faint roller marks), polished stone floor slabs (soft veins, thin
+// light joints), acoustic ceiling panels (thin grid lines), a notice-board poster (index varies).
+Texture MakeWallPaintTexture(uint64_t seed);
+Texture MakePolishedFloorTexture(uint64_t seed);
+Texture MakeCeilingTileTexture(uint64_t seed);
+Texture MakePosterTexture(uint64_t seed, int index);  // 256 x 360 px for 0.7 m x 1.0 m
+
 }  // namespace rovo

@@ -18,13 +18,22 @@ since a background Blender evaluates a viewport depsgraph; at the first exported
     world_from_object in motion.bin); their mesh is the one of the first frame (rigid motion
     only: deformation is not exported). Instances are static.
   * materials: Principled BSDF (or Diffuse BSDF) Base Color: its value, or the first Image Texture
-    found upstream of it (then base_color = 1). Images are written as 8-bit sRGB PNG, top row
-    first; UV v is flipped (rovo: v down from the top-left corner, Blender: v up from bottom-left).
+    found upstream of it (then base_color = 1, or the constant colour of a Multiply MixRGB node
+    between them). Images are written as 8-bit sRGB PNG, top row first; UV v is flipped (rovo: v
+    down from the top-left corner, Blender: v up from bottom-left). Emission: Principled Emission x
+    Emission Strength (or an Emission shader). Blinn-Phong highlight: the custom properties
+    rovo_specular and rovo_shininess (import_scene.py writes them).
+  * objects that share a mesh datablock (and have no modifiers) share one rovo mesh; objects with
+    the custom properties rovo_name / rovo_index (import_scene.py) keep that name and order.
   * lighting: the first render-enabled Sun lamp: direction_to_sun = its local +z,
     sun_radiance = colour * strength (irradiance; the renderer shades albedo * sun_radiance * cos / pi,
     the radiance Cycles computes for a Lambertian surface), angular diameter = its angle; world Background
-    colour * strength -> uniform sky (zenith = horizon) with ambient 1; exposure from the film and
-    view transform exposure.
+    colour * strength -> uniform sky (zenith = horizon) with ambient 1, or the World's custom
+    properties rovo_sky_zenith, rovo_sky_horizon, rovo_ground_albedo, rovo_ambient and
+    rovo_lighting_preset when present; exposure from the film and view transform exposure.
+  * point and spot lamps -> lights: intensity = colour * power / (4 pi) (Cycles' radiant intensity),
+    range = the lamp's custom distance (Eevee's cutoff) when enabled, else 0; spot angle and blend;
+    a lamp parented to an exported object rides on it. Area lamps are reported and ignored.
   * rig: an Empty named 'rig' (or --rig NAME) whose children are Cycles FISHEYE_EQUIDISTANT
     cameras: rig.json with one equidistant camera per child (sorted by name -> cam0, cam1, ...;
     lens mapping in rovo_blender.py) and cam_from_rig from the first frame; the trajectory is the
@@ -44,6 +53,7 @@ import zlib
 from array import array
 
 import bpy
+from mathutils import Matrix, Vector
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -125,6 +135,23 @@ def _upstream_image(socket, depth=0):
     return None
 
 
+def _multiply_tint(socket):
+    """The constant colour of a Multiply MixRGB node (factor 1) feeding `socket` whose other colour
+    input is linked (an image times a tint, as import_scene.py builds it), else None."""
+    if not socket.is_linked:
+        return None
+    node = socket.links[0].from_node
+    if node.type != "MIX_RGB" or node.blend_type != "MULTIPLY" or node.inputs["Fac"].is_linked or \
+            abs(node.inputs["Fac"].default_value - 1.0) > 1e-9:
+        return None
+    a, b = node.inputs["Color1"], node.inputs["Color2"]
+    const = b if a.is_linked and not b.is_linked else a if b.is_linked and not a.is_linked else None
+    if const is None:
+        return None
+    v = const.default_value
+    return float(v[0]), float(v[1]), float(v[2])
+
+
 def material_albedo(mat):
     """(linear RGB base colour, image or None) of a Blender material."""
     if mat is None:
@@ -137,11 +164,36 @@ def material_albedo(mat):
                     break
                 img = _upstream_image(sock)
                 if img is not None:
-                    return (1.0, 1.0, 1.0), img
+                    return _multiply_tint(sock) or (1.0, 1.0, 1.0), img
                 v = sock.default_value
                 return (float(v[0]), float(v[1]), float(v[2])), None
     c = mat.diffuse_color
     return (float(c[0]), float(c[1]), float(c[2])), None
+
+
+def material_extras(mat):
+    """Optional rovo material fields: emission (Principled Emission x Emission Strength, or an
+    Emission shader's Color x Strength) and the Blinn-Phong highlight (custom properties
+    rovo_specular and rovo_shininess)."""
+    extras = {}
+    if mat is None:
+        return extras
+    if mat.use_nodes and mat.node_tree is not None:
+        for node in mat.node_tree.nodes:
+            if node.type == "BSDF_PRINCIPLED":
+                c, k = node.inputs["Emission"].default_value, node.inputs["Emission Strength"].default_value
+            elif node.type == "EMISSION":
+                c, k = node.inputs["Color"].default_value, node.inputs["Strength"].default_value
+            else:
+                continue
+            e = [float(c[0] * k), float(c[1] * k), float(c[2] * k)]
+            if max(e) > 0.0:
+                extras["emission"] = e
+                break
+    if float(mat.get("rovo_specular", 0.0)) > 0.0:
+        extras["specular"] = float(mat["rovo_specular"])
+        extras["shininess"] = float(mat.get("rovo_shininess", 0.0))
+    return extras
 
 
 class Exporter:
@@ -185,6 +237,7 @@ class Exporter:
         color, img = material_albedo(mat)
         entry = {"name": key or "default", "base_color": list(color),
                  "texture": self.texture_for(img) if img is not None else -1}
+        entry.update(material_extras(mat))
         self.material_index[key] = len(self.materials)
         self.materials.append(entry)
         return self.material_index[key]
@@ -281,7 +334,8 @@ class Exporter:
         """world matrix -> (rigid world_from_object 4x4, object-frame linear part 3x3 or None)."""
         rigid = rb.rigid_matrix(m)
         linear = rigid.to_3x3().transposed() @ m.to_3x3()
-        ident = all(abs(linear[r][c] - (1.0 if r == c else 0.0)) < 1e-7 for r in range(3) for c in range(3))
+        # 1e-6: float32 rotations of unscaled objects deviate from orthonormal by about 1e-7.
+        ident = all(abs(linear[r][c] - (1.0 if r == c else 0.0)) < 1e-6 for r in range(3) for c in range(3))
         return rigid, (None if ident else linear)
 
     def collect_geometry(self):
@@ -302,21 +356,30 @@ class Exporter:
             rigid, linear = self.split_matrix(inst.matrix_world.copy())
             src = ob.original.name
             key = ("instance:" if inst.is_instance else "object:") + src
+            if not inst.is_instance and ob.original.type == "MESH" and not ob.original.modifiers:
+                key = "data:" + ob.original.data.name  # objects sharing a mesh datablock share the mesh
             if linear is not None:
                 key += ":" + ",".join("%.7g" % linear[r][c] for r in range(3) for c in range(3))
             if key not in self.mesh_index:
-                self.mesh_index[key] = self.add_mesh(src, ob, linear)
+                mesh_name = ob.original.data.name if key.startswith("data:") else src
+                self.mesh_index[key] = self.add_mesh(mesh_name, ob, linear)
             mesh = self.mesh_index[key]
             if mesh is None:
                 continue
-            name = src
+            name = ob.original.get("rovo_name", src) if not inst.is_instance else src
             if inst.is_instance:
                 name = "%s[%s]" % (src, inst.parent.original.name if inst.parent is not None else "")
                 self.instance_names[name] = self.instance_names.get(name, 0) + 1
                 if self.instance_names[name] > 1:
                     name += "#%d" % (self.instance_names[name] - 1)
             self.objects.append({"name": name, "mesh": mesh, "matrix": rigid,
-                                 "source": None if inst.is_instance else src, "linear": linear})
+                                 "source": None if inst.is_instance else src, "linear": linear,
+                                 "order": ob.original.get("rovo_index", -1) if not inst.is_instance else -1})
+        # Objects made by import_scene.py keep their rovo order (the others follow, as listed).
+        if any(o["order"] >= 0 for o in self.objects):
+            big = len(self.objects) + 1
+            self.objects = [o for _, o in sorted(enumerate(self.objects), key=lambda io: (
+                io[1]["order"] if io[1]["order"] >= 0 else big + io[0]))]
 
     # ---- lighting --------------------------------------------------------------------------
     def lighting(self):
@@ -335,9 +398,10 @@ class Exporter:
             k = sun.data.energy  # W/m^2 irradiance; the renderer divides by pi (Lambertian)
             light["sun_radiance"] = [sun.data.color[0] * k, sun.data.color[1] * k, sun.data.color[2] * k]
             light["sun_angular_diameter_deg"] = math.degrees(sun.data.angle)
-        others = [o.name for o in scene.objects if o.type == "LIGHT" and o.data.type != "SUN" and not o.hide_render]
+        others = [o.name for o in scene.objects
+                  if o.type == "LIGHT" and o.data.type not in ("SUN", "POINT", "SPOT") and not o.hide_render]
         if others:
-            self.warn("lights other than sun are not exported: %s" % ", ".join(sorted(others)))
+            self.warn("area lights are not exported: %s" % ", ".join(sorted(others)))
         world = scene.world
         if world is not None:
             color, strength = (world.color[0], world.color[1], world.color[2]), 1.0
@@ -353,8 +417,46 @@ class Exporter:
             sky = [float(v * strength) for v in color]
             light["sky_zenith"] = sky
             light["sky_horizon"] = list(sky)
+            if "rovo_sky_zenith" in world:  # written by import_scene.py: rovo's sky model exactly
+                light["preset"] = str(world.get("rovo_lighting_preset", "blender"))
+                light["sky_zenith"] = [float(v) for v in world["rovo_sky_zenith"]]
+                light["sky_horizon"] = [float(v) for v in world["rovo_sky_horizon"]]
+                light["ground_albedo"] = [float(v) for v in world["rovo_ground_albedo"]]
+                light["ambient"] = float(world["rovo_ambient"])
         light["exposure"] = float(scene.cycles.film_exposure) * 2.0 ** float(scene.view_settings.exposure)
         return light
+
+    def point_lights(self):
+        """Point and spot lamps (at the first exported frame) -> rovo lights. A lamp whose parent is
+        an exported object rides on it (position and spot axis in the parent's rigid frame);
+        otherwise it is fixed in the world. Radius (soft shadows) is ignored: rovo lights are points."""
+        exported = {o["source"]: i for i, o in enumerate(self.objects) if o["source"] is not None}
+        lights = []
+        soft = []
+        for ob in sorted(self.scene.objects, key=lambda o: o.name):
+            if ob.type != "LIGHT" or ob.data.type not in ("POINT", "SPOT") or ob.hide_render:
+                continue
+            d = ob.data
+            if d.shadow_soft_size > 0.0:
+                soft.append(ob.name)
+            frame = Matrix.Identity(4)
+            index = -1
+            if ob.parent is not None and ob.parent.name in exported:
+                index = exported[ob.parent.name]
+                frame = rb.rigid_matrix(ob.parent.matrix_world).inverted()
+            m = frame @ rb.rigid_matrix(ob.matrix_world)
+            k = d.energy / (4.0 * math.pi)  # Cycles: radiant intensity = power / (4 pi)
+            entry = {"name": ob.get("rovo_name", ob.name), "position": list(m.translation),
+                     "intensity": [d.color[0] * k, d.color[1] * k, d.color[2] * k],
+                     "range": float(d.cutoff_distance) if d.use_custom_distance else 0.0, "object": index}
+            if d.type == "SPOT":
+                axis = m.to_3x3() @ Vector((0.0, 0.0, -1.0))  # a spot shines along its local -z
+                entry["spot"] = {"direction": list(axis), "angle_deg": min(180.0, math.degrees(d.spot_size)),
+                                 "blend": float(d.spot_blend)}
+            lights.append(entry)
+        if soft:
+            self.warn("%d point/spot lamps have a radius > 0 (soft shadows); exported as points" % len(soft))
+        return lights
 
     # ---- animation -------------------------------------------------------------------------
     def sample_animation(self):
@@ -371,8 +473,12 @@ class Exporter:
                 if cam_from_rig is None:
                     cam_from_rig = now
                 else:
+                    # Blender composes parent and child in float32: allow its rounding at the
+                    # rig's distance from the origin (1e-5 in rotation, 1e-6 relative in position).
+                    far = 1.0 + self.rig.matrix_world.translation.length
                     for c, a, b in zip(self.rig_cams, cam_from_rig, now):
-                        if max(abs(a[r][s] - b[r][s]) for r in range(4) for s in range(4)) > 1e-6:
+                        if max(abs(a[r][s] - b[r][s]) for r in range(3) for s in range(3)) > 1e-5 or \
+                                max(abs(a[r][3] - b[r][3]) for r in range(3)) > 1e-5 + 1e-6 * far:
                             self.warn("camera '%s' moves relative to the rig at frame %d; cam_from_rig is "
                                       "the one of frame %d" % (c.name, frame, self.frames[0]))
             for name in tracked:
@@ -468,6 +574,7 @@ class Exporter:
             "materials": self.materials,
             "meshes": self.meshes,
             "objects": objects_json,
+            "lights": self.point_lights(),
             "blender": {"frames": self.frames, "rig": self.rig.name if self.rig else None,
                         "rig_cameras": [c.name for c in self.rig_cams], "warnings": self.warnings},
         }

@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <unistd.h>
 
@@ -237,6 +239,94 @@ TEST(SceneIo, ErrorsNameFileAndField) {
     WriteFileAtomic(dir + "/trajectory.tum", "0 1 2 3 0 0 0 1\n0.1 1 2 x\n");
     const std::string err = LoadError(dir);
     EXPECT_NE(err.find("trajectory.tum: line 2"), std::string::npos) << err;
+  }
+}
+
+// Lights (a world-fixed point light and a spot riding on the dynamic object) and the optional
+// material fields round-trip exactly; a scene without them keeps its scene.json keys and hash.
+Scene WithLights(Scene scene) {
+  scene.materials[1].emission = {2.0f, 1.5f, 1.0f / 3.0f};
+  scene.materials[2].specular = 0.25f;
+  scene.materials[2].shininess = 80.0f;
+  Light bulb;
+  bulb.name = "bulb";
+  bulb.position = {1.0 / 3.0, -2.0, 2.9};
+  bulb.intensity = {0.1f, 0.2f, 0.3f};
+  bulb.range = 7.5;
+  Light headlight;
+  headlight.name = "car_headlight";
+  headlight.position = {2.3, 0.6, 0.65};
+  headlight.intensity = {0.3f, 0.3f, 0.28f};
+  headlight.object = 1;
+  headlight.spot = true;
+  headlight.spot_direction = {1.0, 0.0, -0.06};
+  headlight.spot_angle_deg = 55.0;
+  headlight.spot_blend = 0.6;
+  scene.lights = {bulb, headlight};
+  return scene;
+}
+
+TEST(SceneIo, LightsAndMaterialExtensionsRoundTrip) {
+  const Scene plain = MakeTestScene();
+  const Scene scene = WithLights(plain);
+  const std::string dir = FreshDir("lights");
+  SaveScene(scene, dir);
+  const Scene loaded = LoadScene(dir);
+  EXPECT_EQ(SceneHash(loaded), SceneHash(scene));
+  ASSERT_EQ(loaded.lights.size(), 2u);
+  const Light& h = loaded.lights[1];
+  EXPECT_EQ(h.name, "car_headlight");
+  EXPECT_EQ(h.object, 1);
+  EXPECT_TRUE(h.spot);
+  EXPECT_EQ(h.spot_direction, scene.lights[1].spot_direction);
+  EXPECT_EQ(h.spot_angle_deg, 55.0);
+  EXPECT_EQ(h.spot_blend, 0.6);
+  EXPECT_EQ(loaded.lights[0].position, scene.lights[0].position);
+  EXPECT_EQ(loaded.lights[0].range, 7.5);
+  EXPECT_FALSE(loaded.lights[0].spot);
+  EXPECT_EQ(loaded.materials[1].emission, scene.materials[1].emission);
+  EXPECT_EQ(loaded.materials[2].specular, 0.25f);
+  EXPECT_EQ(loaded.materials[2].shininess, 80.0f);
+  // Every light and material field enters the hash.
+  Scene moved = scene;
+  moved.lights[1].spot_blend = 0.5;
+  EXPECT_NE(SceneHash(moved), SceneHash(scene));
+  moved = scene;
+  moved.materials[1].emission.x() = 2.5f;
+  EXPECT_NE(SceneHash(moved), SceneHash(scene));
+  EXPECT_NE(SceneHash(plain), SceneHash(scene));
+  // Without lights or emission the file has no such keys (older readers and hashes unchanged).
+  const std::string plain_dir = FreshDir("no_lights");
+  SaveScene(plain, plain_dir);
+  const nlohmann::json j = nlohmann::json::parse(ReadFile(plain_dir + "/scene.json"));
+  EXPECT_FALSE(j.contains("lights"));
+  EXPECT_FALSE(j["materials"][0].contains("emission"));
+  EXPECT_FALSE(j["materials"][0].contains("specular"));
+  EXPECT_TRUE(LoadScene(plain_dir).lights.empty());
+}
+
+TEST(SceneIo, LightErrorsNameFileAndField) {
+  const Scene scene = WithLights(MakeTestScene());
+  const std::vector<std::pair<std::function<void(nlohmann::json&)>, std::string>> cases = {
+      {[](nlohmann::json& j) { j["lights"][0]["intensity"] = {0.1, -0.2, 0.3}; },
+       "lights[0].intensity: must not be negative"},
+      {[](nlohmann::json& j) { j["lights"][1]["object"] = 2; }, "lights[1].object: value 2 outside [-1, 1]"},
+      {[](nlohmann::json& j) { j["lights"][0]["range"] = -1.0; }, "lights[0].range"},
+      {[](nlohmann::json& j) { j["lights"][1]["spot"]["angle_deg"] = 190.0; }, "lights[1].spot.angle_deg"},
+      {[](nlohmann::json& j) { j["lights"][1]["spot"]["direction"] = {0, 0, 0}; }, "lights[1].spot.direction"},
+      {[](nlohmann::json& j) { j["lights"][1]["spot"]["blend"] = 1.5; }, "lights[1].spot.blend"},
+      {[](nlohmann::json& j) { j["lights"][0].erase("position"); }, "lights[0].position: missing"},
+      {[](nlohmann::json& j) { j["materials"][1]["emission"] = {1.0, -1.0, 0.0}; }, "materials[1].emission"},
+      {[](nlohmann::json& j) { j["materials"][2].erase("shininess"); }, "materials[2].shininess: missing"},
+      {[](nlohmann::json& j) { j["materials"][2]["specular"] = 2.0; }, "materials[2].specular"},
+  };
+  for (size_t k = 0; k < cases.size(); ++k) {
+    const std::string dir = FreshDir("light_error_" + std::to_string(k));
+    SaveScene(scene, dir);
+    EditJson(dir, cases[k].first);
+    const std::string err = LoadError(dir);
+    EXPECT_NE(err.find(dir + "/scene.json"), std::string::npos) << err;
+    EXPECT_NE(err.find(cases[k].second), std::string::npos) << "case " << k << ": " << err;
   }
 }
 

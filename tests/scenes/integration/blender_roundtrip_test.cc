@@ -7,6 +7,7 @@
 //
 // Needs `blender` (Debian package) and `oiiotool` (openimageio-tools) on PATH.
 
+#include "tests/scenes/integration/shell_log.h"
 #include "datasets/rig.h"
 #include "scenes/scene.h"
 
@@ -30,27 +31,13 @@ namespace rovo {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::Quote;
+using testing::RunShell;
+using testing::Tail;
 
 constexpr int kImageSize = 192;  // square: Cycles' fisheye normalises u and v separately
 constexpr int kFrames = 2;
 constexpr int kCameras = 4;
-
-std::string Quote(const std::string& s) { return "'" + s + "'"; }
-
-// Runs a shell command, output appended to `log`; returns the exit status.
-int RunShell(const std::string& command, const std::string& log) {
-  std::ofstream(log, std::ios::app) << "\n$ " << command << "\n";
-  const int status = std::system((command + " >> " + Quote(log) + " 2>&1").c_str());
-  return status == -1 ? -1 : WEXITSTATUS(status);
-}
-
-std::string Tail(const std::string& path, size_t max_chars = 4000) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string s = ss.str();
-  return s.size() > max_chars ? s.substr(s.size() - max_chars) : s;
-}
 
 // One float channel of an EXR (by exact name, or the first channel when `channel` is empty).
 std::vector<float> ReadExrChannel(const std::string& path, const std::string& channel, int* width, int* height) {

@@ -1,0 +1,303 @@
+// Exposure timing (render/timing.h, datasets/FORMAT.md "Timing"): trigger offsets, motion blur and
+// rolling shutter against their analytic expectations on a wall with one vertical edge.
+#include "render/timing.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "datasets/dataset.h"
+#include "render/tracer.h"
+#include "tests/render/box_scene.h"
+
+namespace rovo {
+namespace {
+
+// A wall at x = kWallX: dark for y > 0, bright for y < 0 (the edge is the vertical line y = 0),
+// lit by ambient light only. The rig moves along +y at kSpeed m/s (frames at 10 Hz), one
+// equidistant camera of kF px/rad looking along +x (the rig's forward axis).
+constexpr double kWallX = 5.0, kSpeed = 10.0, kF = 200.0;
+constexpr int kSize = 256;
+
+Scene MakeEdgeScene() {
+  Scene scene;
+  scene.metadata.preset = "test_edge";
+  Material bright, dark;
+  bright.name = "bright";
+  bright.base_color = Eigen::Vector3f(0.9f, 0.9f, 0.9f);
+  dark.name = "dark";
+  dark.base_color = Eigen::Vector3f(0.1f, 0.1f, 0.1f);
+  scene.materials = {bright, dark};
+  const float x = static_cast<float>(kWallX);
+  scene.meshes.push_back(testing::MakeQuad("bright", Eigen::Vector3f(x, -50, -50), Eigen::Vector3f(x, 0, -50),
+                                           Eigen::Vector3f(x, 0, 50), Eigen::Vector3f(x, -50, 50), 0));
+  scene.meshes.push_back(testing::MakeQuad("dark", Eigen::Vector3f(x, 0, -50), Eigen::Vector3f(x, 50, -50),
+                                           Eigen::Vector3f(x, 50, 50), Eigen::Vector3f(x, 0, 50), 1));
+  for (int m = 0; m < 2; ++m) {
+    scene.meshes[m].uvs.clear();
+    Object o;
+    o.name = scene.meshes[m].name;
+    o.mesh = m;
+    scene.objects.push_back(o);
+  }
+  scene.lighting.sun_radiance = Eigen::Vector3f::Zero();
+  scene.lighting.ambient = 1.0f;
+  scene.frame_rate = 10.0;
+  for (int i = 0; i < 3; ++i) {
+    StampedPose p;
+    p.timestamp = i / scene.frame_rate;
+    p.world_from_rig = Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.0, kSpeed * p.timestamp, 0.0));
+    scene.rig_trajectory.push_back(p);
+  }
+  return scene;
+}
+
+Camera EdgeCamera() {
+  Camera cam;
+  cam.model = CameraModelId::kEquidistant;
+  cam.width = kSize;
+  cam.height = kSize;
+  cam.params = {kF, kF, (kSize - 1) / 2.0, (kSize - 1) / 2.0, 0, 0, 0, 0};
+  cam.max_fov_deg = 180.0;
+  cam.Check("edge test camera");
+  return cam;
+}
+
+// Looking along the rig's +x: camera x (right) = rig -y, camera y (down) = rig -z.
+Rigid3 CamFromRig() {
+  Eigen::Matrix3d r;
+  r << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+  return Rigid3(r, Eigen::Vector3d::Zero());
+}
+
+struct EdgeRender {
+  Scene scene = MakeEdgeScene();
+  Tracer tracer{scene};
+  CameraRays rays = CameraRays::Make(EdgeCamera(), 0, 1);
+  ShadeSettings settings;
+  EdgeRender(int spp) {
+    settings.spp = spp;
+    settings.linear_output = true;
+    settings.shadows = false;
+  }
+  // Camera image at trajectory frame 1 with the given timing (ms).
+  CameraImage Render(double offset_ms, double shutter_ms, double readout_ms) {
+    const double h = HalfWindowSeconds({offset_ms}, readout_ms, {shutter_ms});
+    tracer.SetFrameWindow(1, h);
+    Rigid3 world_from_cam;
+    const CameraMotion motion = MakeCameraMotion(scene.rig_trajectory, 1, CamFromRig(), h > 0 ? h : 1.0, offset_ms,
+                                                 shutter_ms, readout_ms, kSize, &world_from_cam);
+    CameraImage image;
+    tracer.Render(rays, world_from_cam, settings, &image, &motion);
+    return image;
+  }
+};
+
+// Red channel of row y, normalised so that the bright side is 1 and the dark side 0.
+std::vector<double> Profile(const CameraImage& image, int y) {
+  std::vector<double> p(image.width);
+  const double lo = 0.1, hi = 0.9;
+  for (int x = 0; x < image.width; ++x)
+    p[x] =
+        (image.linear[(static_cast<size_t>(y) * image.width + x) * 3] / image.linear[(y * image.width) * 3] * hi - lo) /
+        (hi - lo);
+  return p;
+}
+
+// Mean and variance (px, px^2) of the edge's gradient |dp/du| over rows [y0, y1].
+void EdgeMoments(const CameraImage& image, int y0, int y1, double* mean, double* var) {
+  std::vector<double> g(image.width - 1, 0.0);
+  for (int y = y0; y <= y1; ++y) {
+    const std::vector<double> p = Profile(image, y);
+    for (int x = 0; x + 1 < image.width; ++x) g[x] += std::abs(p[x + 1] - p[x]);
+  }
+  double s0 = 0, s1 = 0, s2 = 0;
+  for (int x = 0; x + 1 < image.width; ++x) {
+    s0 += g[x];
+    s1 += g[x] * (x + 0.5);
+  }
+  *mean = s1 / s0;
+  for (int x = 0; x + 1 < image.width; ++x) s2 += g[x] * (x + 0.5 - *mean) * (x + 0.5 - *mean);
+  *var = s2 / s0;
+}
+
+// Expected image position (u) of the edge for the rig at y = rig_y, in the image row through the
+// optical axis: the edge is at bearing angle atan(rig_y / D) to the right.
+double EdgeU(double rig_y) { return (kSize - 1) / 2.0 + kF * std::atan(rig_y / kWallX); }
+
+TEST(PoseAtTime, InterpolatesAndExtrapolates) {
+  const Scene scene = MakeEdgeScene();
+  const Trajectory& traj = scene.rig_trajectory;
+  EXPECT_NEAR(PoseAtTime(traj, nullptr, 0.125).translation.y(), 1.25, 1e-12);
+  EXPECT_NEAR(PoseAtTime(traj, nullptr, -0.01).translation.y(), -0.1, 1e-12);  // before the first sample
+  EXPECT_NEAR(PoseAtTime(traj, nullptr, 0.21).translation.y(), 2.1, 1e-12);    // after the last
+  EXPECT_EQ(PoseAtTime(traj, nullptr, 0.1).translation, traj[1].world_from_rig.translation);
+  Trajectory turning = traj;
+  turning[1].world_from_rig.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitZ()));
+  const Rigid3 mid = PoseAtTime(turning, nullptr, 0.075);
+  EXPECT_NEAR(Eigen::AngleAxisd(mid.rotation).angle(), 0.15, 1e-9);
+}
+
+TEST(TriggerOffsets, SeededDrawAndExplicitValues) {
+  TimingSettings t;
+  t.trigger_offset_std_ms = 2.0;
+  const std::vector<double> a = TriggerOffsetsMs(t, 4, 7), b = TriggerOffsetsMs(t, 4, 7), c = TriggerOffsetsMs(t, 4, 8);
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, c);
+  for (double o : a) EXPECT_LT(std::abs(o), 10.0);
+  t.trigger_offset_std_ms = 0.0;
+  t.trigger_offset_ms = {0.0, 1.0, -2.0, 3.5};
+  EXPECT_EQ(TriggerOffsetsMs(t, 4, 7), t.trigger_offset_ms);
+  EXPECT_NO_THROW(t.Check(4, false));
+  EXPECT_THROW(t.Check(3, false), std::invalid_argument);
+  TimingSettings blur;
+  blur.shutter_from_sensor = true;
+  EXPECT_THROW(blur.Check(4, false), std::invalid_argument);
+}
+
+// A camera triggered o ms late sees exactly what a camera at the rig's pose at t + o sees.
+TEST(Timing, TriggerOffsetEqualsRenderAtShiftedPose) {
+  EdgeRender r(16);
+  const CameraImage offset = r.Render(7.0, 0.0, 0.0);
+  CameraImage shifted;
+  r.tracer.SetFrame(1);
+  const Rigid3 world_from_cam = PoseAtTime(r.scene.rig_trajectory, nullptr, 0.107) * CamFromRig().Inverse();
+  r.tracer.Render(r.rays, world_from_cam, r.settings, &shifted);
+  EXPECT_EQ(offset.linear, shifted.linear);
+  // And the edge moved right by f * atan(speed * o / D) from the frame's time.
+  double m0, v0, m1, v1;
+  EdgeMoments(r.Render(0.0, 0.0, 0.0), 120, 135, &m0, &v0);
+  EdgeMoments(offset, 120, 135, &m1, &v1);
+  EXPECT_NEAR(m0, EdgeU(1.0), 0.1);
+  EXPECT_NEAR(m1 - m0, EdgeU(1.07) - EdgeU(1.0), 0.1);
+}
+
+// Motion blur over [t - T/2, t + T/2]: the edge stays centred at its mid-exposure position and its
+// gradient widens to a box of the distance the edge moves, W = f * speed * T / D:
+// var = var_static + W^2 / 12.
+TEST(Timing, MotionBlurWidthIsTheDistanceTravelled) {
+  EdgeRender r(16);
+  double m0, v0, m1, v1;
+  EdgeMoments(r.Render(0.0, 0.0, 0.0), 110, 145, &m0, &v0);
+  const double shutter_ms = 20.0;
+  EdgeMoments(r.Render(0.0, shutter_ms, 0.0), 110, 145, &m1, &v1);
+  const double expected_width = EdgeU(1.0 + kSpeed * shutter_ms / 2000.0) - EdgeU(1.0 - kSpeed * shutter_ms / 2000.0);
+  EXPECT_NEAR(m1, m0, 0.15);
+  EXPECT_NEAR(std::sqrt(12.0 * (v1 - v0)), expected_width, 0.05 * expected_width);
+  std::printf("blur: centre %.3f -> %.3f px, width %.3f px (expected %.3f)\n", m0, m1, std::sqrt(12.0 * (v1 - v0)),
+              expected_width);
+}
+
+// Rolling shutter, top row first: row v is exposed at t + (v / (H - 1) - 1/2) R, so with the rig
+// moving left the edge shifts right going down; each row equals the global-shutter image at the
+// row's time.
+TEST(Timing, RollingShutterShearsTopRowsEarlier) {
+  EdgeRender r(4);
+  const double readout_ms = 30.0;
+  const CameraImage rs = r.Render(0.0, 0.0, readout_ms);
+  for (int y : {40, 90, 128, 170, 215}) {
+    const double dt_ms = (y / (kSize - 1.0) - 0.5) * readout_ms;
+    double m_rs, v_rs, m_gs, v_gs;
+    EdgeMoments(rs, y, y, &m_rs, &v_rs);
+    EdgeMoments(r.Render(dt_ms, 0.0, 0.0), y, y, &m_gs, &v_gs);
+    EXPECT_NEAR(m_rs, m_gs, 0.05) << "row " << y;
+  }
+  double top, bottom, v;
+  EdgeMoments(rs, 118, 118, &top, &v);
+  EdgeMoments(rs, 138, 138, &bottom, &v);
+  // Near the axis the edge moves f * speed * dt / D pixels in the time between the rows.
+  const double expected = kF * kSpeed * (20.0 / (kSize - 1.0)) * readout_ms / 1000.0 / kWallX;
+  EXPECT_GT(bottom - top, 0.0);
+  std::printf("rolling shutter: rows 118 -> 138 shift %.3f px (expected %.3f)\n", bottom - top, expected);
+  EXPECT_NEAR(bottom - top, expected, 0.15 * expected + 0.05);
+}
+
+// A CameraMotion at one time without shutter or readout renders the same bytes as without one.
+TEST(Timing, NoEffectIsByteIdentical) {
+  const Scene scene = testing::MakeBoxScene(3, true);
+  Tracer tracer(scene);
+  const Rig rig = MakeRigPreset("omnimvs4").Scaled(0.2);
+  const CameraRays rays = CameraRays::Make(rig.cameras[0].camera, 0, 2);
+  ShadeSettings settings;
+  settings.spp = 2;
+  settings.want_depth = true;
+  settings.want_mask = true;
+  tracer.SetFrame(1);
+  const Rigid3 world_from_cam = scene.rig_trajectory[1].world_from_rig * rig.cameras[0].cam_from_rig.Inverse();
+  CameraImage plain, timed;
+  tracer.Render(rays, world_from_cam, settings, &plain);
+  CameraMotion still;
+  tracer.Render(rays, world_from_cam, settings, &timed, &still);
+  EXPECT_EQ(plain.rgb, timed.rgb);
+  EXPECT_EQ(plain.depth, timed.depth);
+  EXPECT_EQ(plain.mask, timed.mask);
+  // The dynamic cube over a window, seen at the window's middle (its frame time): same image.
+  tracer.SetFrameWindow(1, 0.01);
+  tracer.Render(rays, world_from_cam, settings, &timed, &still);
+  int differ = 0;
+  for (size_t i = 0; i < plain.rgb.size(); ++i) differ += std::abs(plain.rgb[i] - timed.rgb[i]) > 1;
+  EXPECT_LE(differ, 3);
+  EXPECT_EQ(plain.mask, timed.mask);
+}
+
+// A moving object blurs: the box scene's cube moves 0.25 m per frame along -y; over a shutter of
+// the whole frame period its mask (pixel centres at mid-exposure) stays, its image smears.
+TEST(Timing, DynamicObjectBlursAlongItsMotion) {
+  const Scene scene = testing::MakeBoxScene(3, true);
+  Tracer tracer(scene);
+  const Rig rig = MakeRigPreset("omnimvs4").Scaled(0.2);
+  const CameraRays rays = CameraRays::Make(rig.cameras[0].camera, 0, 1);
+  ShadeSettings settings;
+  settings.spp = 16;
+  settings.want_mask = true;
+  Rigid3 world_from_cam;
+  const double h = 0.05;
+  tracer.SetFrameWindow(1, h);
+  CameraMotion still =
+      MakeCameraMotion(scene.rig_trajectory, 1, rig.cameras[0].cam_from_rig, h, 0, 0, 0, rays.height, &world_from_cam);
+  CameraMotion blur = MakeCameraMotion(scene.rig_trajectory, 1, rig.cameras[0].cam_from_rig, h, 0, 100.0, 0,
+                                       rays.height, &world_from_cam);
+  CameraImage sharp, blurred;
+  tracer.Render(rays, world_from_cam, settings, &sharp, &still);
+  tracer.Render(rays, world_from_cam, settings, &blurred, &blur);
+  EXPECT_EQ(sharp.mask, blurred.mask);
+  int changed = 0;
+  for (size_t i = 0; i < sharp.rgb.size(); ++i) changed += std::abs(sharp.rgb[i] - blurred.rgb[i]) > 8;
+  EXPECT_GT(changed, 20);
+}
+
+TEST(TimingRecord, RoundTripAndValidation) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "rovo_timing_record_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  DatasetInfo info;
+  info.generator = "test";
+  info.frame_count = 1;
+  info.rig = MakeRigPreset("omnimvs4");
+  TimingSettings t;
+  t.shutter_ms = 5.0;
+  t.rolling_shutter_ms = 20.0;
+  t.trigger_offset_std_ms = 1.0;
+  info.timing = MakeTimingRecord(t, TriggerOffsetsMs(t, 4, 3));
+  WriteDatasetInfo(dir.string(), info);
+  const DatasetInfo back = ReadDatasetInfo(dir.string());
+  ASSERT_TRUE(back.timing.has_value());
+  EXPECT_EQ(*back.timing, *info.timing);
+  EXPECT_EQ(back.timing->exposure, "fixed");
+  info.timing->trigger_offset_ms.pop_back();
+  WriteDatasetInfo(dir.string(), info);
+  try {
+    ReadDatasetInfo(dir.string());
+    ADD_FAILURE() << "expected an error";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("/timing/trigger_offset_ms"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rovo
