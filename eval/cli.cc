@@ -81,6 +81,7 @@ std::vector<std::string> SplitCommaList(const std::string& list) {
 SuiteOptions SuiteCliArgs::Options() const {
   SuiteOptions o = options;
   o.presets = SplitCommaList(presets);
+  if (robustness) o.presets = RobustnessEntries(o.presets);
   o.plots = !no_plots;
   return o;
 }
@@ -89,7 +90,14 @@ void AddSuiteOptions(CLI::App* cmd, SuiteCliArgs* args) {
   SuiteOptions* options = &args->options;
   std::string preset_names;
   for (const ScenePreset& p : ScenePresets()) preset_names += (preset_names.empty() ? "" : ",") + p.name;
-  cmd->add_option("--presets", args->presets, "Comma-separated presets (default: all: " + preset_names + ")");
+  std::string variants;
+  for (const std::string& v : SuiteVariantNames()) variants += (variants.empty() ? "" : ",") + v;
+  cmd->add_option("--presets", args->presets,
+                  "Comma-separated presets (default: all: " + preset_names + "); PRESET+VARIANT renders the preset with "
+                  "sensor or timing effects (" + variants + "; eval/suite.h)");
+  cmd->add_flag("--robustness", args->robustness,
+                "Robustness table: each preset (default cloudy_urban) plain and with every variant, then the harder "
+                "worlds (indoor_hall, suburban_road, night_street)");
   cmd->add_flag("--quick", options->quick, "Use the presets' quick forms (fewer frames, smaller images)");
   cmd->add_option("--frames", options->frames,
                   "Only the first N frames of each preset: rendered, run and scored on that span (0: all; e.g. a "

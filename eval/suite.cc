@@ -403,7 +403,54 @@ SuiteOptions SuiteOptionsFromJson(const nlohmann::json& j, const std::string& so
   return o;
 }
 
+const std::vector<std::string>& SuiteVariantNames() {
+  static const std::vector<std::string> names = {"ideal", "realistic", "gray", "blur", "rolling", "trigger", "all"};
+  return names;
+}
+
+SuiteEntry ParseSuiteEntry(const std::string& entry) {
+  const size_t plus = entry.find('+');
+  if (plus == std::string::npos) return {entry, ""};
+  SuiteEntry e{entry.substr(0, plus), entry.substr(plus + 1)};
+  const auto& names = SuiteVariantNames();
+  if (std::find(names.begin(), names.end(), e.variant) == names.end()) {
+    std::string valid;
+    for (const std::string& n : names) valid += (valid.empty() ? "" : ", ") + n;
+    throw std::invalid_argument("rovo suite: preset entry \"" + entry + "\": unknown variant \"" + e.variant +
+                                "\" (valid: " + valid + ")");
+  }
+  return e;
+}
+
+std::vector<std::string> RobustnessEntries(const std::vector<std::string>& presets) {
+  std::vector<std::string> base = presets.empty() ? std::vector<std::string>{"cloudy_urban"} : presets;
+  std::vector<std::string> out;
+  for (const std::string& p : base) {
+    out.push_back(p);
+    for (const std::string& v : SuiteVariantNames()) out.push_back(p + "+" + v);
+  }
+  for (const ScenePreset& p : HarderScenePresets()) {
+    if (std::find(out.begin(), out.end(), p.name) == out.end()) out.push_back(p.name);
+  }
+  return out;
+}
+
 namespace {
+
+// The render settings of a variant (ParseSuiteEntry), on top of the preset's.
+void ApplySuiteVariant(const std::string& variant, RenderOptions* render) {
+  if (variant.empty()) return;
+  const bool sensor = variant == "realistic" || variant == "gray" || variant == "all";
+  if (variant == "ideal") render->sensor = MakeSensorSettings("ideal", {});
+  if (sensor) {
+    SensorOverrides overrides;
+    if (variant == "gray") overrides.grayscale = true;
+    render->sensor = MakeSensorSettings("realistic", overrides);
+  }
+  if (variant == "blur" || variant == "all") render->timing.shutter_ms = 10.0;
+  if (variant == "rolling" || variant == "all") render->timing.rolling_shutter_ms = 30.0;
+  if (variant == "trigger" || variant == "all") render->timing.trigger_offset_std_ms = 1.0;
+}
 
 std::string DatasetDirFor(const std::string& data_dir, const std::string& preset, const SuiteOptions& options) {
   return (fs::path(data_dir) / (preset + (options.quick ? "_quick" : "") + "_s" + std::to_string(options.scene_seed)))
@@ -578,7 +625,7 @@ SuitePlan PlanSuite(const SuiteOptions& options) {
   plan.data_dir = options.data_dir.empty() ? (fs::path(options.out_dir) / "data").string() : options.data_dir;
   for (size_t i = 0; i < plan.options.presets.size(); ++i) {
     const std::string& preset = plan.options.presets[i];
-    const ScenePreset& p = FindScenePreset(preset);  // throws listing the valid names
+    const ScenePreset& p = FindScenePreset(ParseSuiteEntry(preset).preset);  // throws listing the valid names
     const int trajectory_frames = options.quick ? p.quick_frames : p.frames;
     const int frame_end = options.frames > 0 ? std::min(options.frames, trajectory_frames) : trajectory_frames;
     plan.dataset_dirs.push_back(DatasetDirFor(plan.data_dir, preset, options));
@@ -603,7 +650,9 @@ void RenderSuiteDataset(const SuitePlan& plan, size_t preset_index, int shard, i
   }
   EnsureWritableDir(plan.data_dir);
   RenderOptions render;
-  render.preset = preset;
+  const SuiteEntry entry = ParseSuiteEntry(preset);
+  render.preset = entry.preset;
+  ApplySuiteVariant(entry.variant, &render);
   render.quick = options.quick;
   render.out_dir = dir;
   render.seed = options.scene_seed;

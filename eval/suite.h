@@ -31,6 +31,26 @@
 
 namespace rovo {
 
+// A suite entry is a scene preset, optionally with a variant of its render: "cloudy_urban+blur". The
+// dataset, the runs and the table row carry the whole entry. Variants (values in docs/results.md):
+//   ideal      --sensor ideal (HDR sun, auto-exposure and gain, no noise)
+//   realistic  --sensor realistic (noise, 12-bit ADC, BT.709 response, per-camera sensitivity spread)
+//   gray       realistic, grayscale
+//   blur       motion blur over a 10 ms shutter (8 samples per pixel)
+//   rolling    rolling shutter, 30 ms readout
+//   trigger    per-camera trigger offsets, standard deviation 1 ms
+//   all        realistic with blur, rolling and trigger
+struct SuiteEntry {
+  std::string preset;   // a scene preset (scenes/city.h)
+  std::string variant;  // "" or one of SuiteVariantNames()
+};
+// Throws std::invalid_argument naming the entry and the valid variants.
+SuiteEntry ParseSuiteEntry(const std::string& entry);
+const std::vector<std::string>& SuiteVariantNames();
+// `rovo suite --robustness`: every preset of `presets` (default cloudy_urban) plain and with each
+// variant, then the harder worlds (HarderScenePresets) plain.
+std::vector<std::string> RobustnessEntries(const std::vector<std::string>& presets);
+
 struct SuiteOptions {
   std::vector<std::string> presets;  // empty = all presets (ScenePresets order)
   bool quick = false;                // the presets' quick forms

@@ -1,4 +1,5 @@
 #include "vo/frontend.h"
+#include "vo/opencv_threads.h"
 
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
@@ -41,44 +42,6 @@ cv::Mat ToGray(const cv::Mat& image, int camera) {
   }
   return gray;
 }
-
-// Makes OpenCV serial (cv::setNumThreads(1), process-wide) while any front-end call runs and restores
-// the caller's setting when the last one returns. The front-end runs its views in parallel under TBB;
-// OpenCV's own parallel loops nested in them (remap, KLT, pyramids) ran on OpenCV's TBB arena with
-// task overhead and without gain (measured: 4 x 5 remaps on 2 threads took ~20 % more wall and CPU
-// time than with OpenCV serial inside each view). Counted across threads: with several front-ends
-// at once (`rovo suite --jobs 2` runs two VO runs in one process) a per-call set-and-restore changed
-// OpenCV's thread pool while another call's KLT was inside it, which crashed.
-class ScopedOpenCvThreads {
- public:
-  ScopedOpenCvThreads() {
-    const std::lock_guard<std::mutex> lock(Mutex());
-    if (Count()++ == 0) {
-      Saved() = cv::getNumThreads();
-      if (Saved() != 1) cv::setNumThreads(1);
-    }
-  }
-  ~ScopedOpenCvThreads() {
-    const std::lock_guard<std::mutex> lock(Mutex());
-    if (--Count() == 0 && Saved() != 1) cv::setNumThreads(Saved());
-  }
-  ScopedOpenCvThreads(const ScopedOpenCvThreads&) = delete;
-  ScopedOpenCvThreads& operator=(const ScopedOpenCvThreads&) = delete;
-
- private:
-  static std::mutex& Mutex() {
-    static std::mutex mutex;
-    return mutex;
-  }
-  static int& Count() {
-    static int count = 0;
-    return count;
-  }
-  static int& Saved() {
-    static int saved = 0;
-    return saved;
-  }
-};
 
 }  // namespace
 

@@ -3,6 +3,7 @@
 #include "vo/extrinsic_bootstrap.h"
 #include "vo/frontend.h"
 #include "vo/local_ba.h"
+#include "vo/opencv_threads.h"
 
 #include <algorithm>
 #include <cmath>
@@ -145,6 +146,7 @@ StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Ri
                                             const std::function<LoadedFrame(int)>& load, int first_frame,
                                             int end_frame, const std::vector<cv::Mat>& static_masks,
                                             const StartupCalibrationOptions& options, bool quiet) {
+  const ScopedOpenCvThreads serial_opencv;  // another run's front-end may be in the same process
   StartupCalibrationReport report;
   report.cam_from_rig = cam_from_rig;
   std::vector<std::vector<cv::Mat>> shots;

@@ -2,6 +2,7 @@
 // without Slurm; tests/eval/integration/slurm_batch_test.sh runs it on a real Slurm.
 #include "eval/batch.h"
 #include "eval/suite.h"
+#include "scenes/city.h"
 
 #include "datasets/io.h"
 #include "datasets/run.h"
@@ -99,6 +100,35 @@ TEST(SuitePlan, ListsEveryRunOnceWithItsSettings) {
   bad = SmallSuite(TempDir("plan"));
   bad.presets = {"atlantis"};
   EXPECT_THROW(PlanSuite(bad), std::invalid_argument);
+}
+
+// Preset entries with a render variant ("cloudy_urban+blur") plan their own dataset and runs; an unknown
+// variant is an error naming the entry; --robustness lists every variant and the harder worlds.
+TEST(SuitePlan, VariantEntriesAndTheRobustnessList) {
+  EXPECT_EQ(ParseSuiteEntry("cloudy_urban").variant, "");
+  const SuiteEntry blur = ParseSuiteEntry("cloudy_urban+blur");
+  EXPECT_EQ(blur.preset, "cloudy_urban");
+  EXPECT_EQ(blur.variant, "blur");
+  try {
+    ParseSuiteEntry("cloudy_urban+fog");
+    FAIL() << "an unknown variant was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("cloudy_urban+fog"), std::string::npos) << e.what();
+  }
+  SuiteOptions options = SmallSuite(TempDir("variant"));
+  options.presets = {"cloudy_urban+realistic"};
+  const SuitePlan plan = PlanSuite(options);
+  ASSERT_EQ(plan.dataset_dirs.size(), 1u);
+  EXPECT_NE(plan.dataset_dirs[0].find("cloudy_urban+realistic"), std::string::npos) << plan.dataset_dirs[0];
+  EXPECT_NE(plan.runs[0].run_dir.find("cloudy_urban+realistic"), std::string::npos) << plan.runs[0].run_dir;
+  options.presets = {"atlantis+blur"};
+  EXPECT_THROW(PlanSuite(options), std::invalid_argument);
+
+  const std::vector<std::string> entries = RobustnessEntries({});
+  ASSERT_EQ(entries.size(), 1 + SuiteVariantNames().size() + HarderScenePresets().size());
+  EXPECT_EQ(entries.front(), "cloudy_urban");
+  EXPECT_EQ(entries[1], "cloudy_urban+" + SuiteVariantNames().front());
+  EXPECT_EQ(entries.back(), HarderScenePresets().back().name);
 }
 
 TEST(SuitePlan, OptionsRoundTripThroughJsonAndBadFieldsAreNamed) {
