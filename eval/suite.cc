@@ -8,6 +8,7 @@
 #include "eval/plots.h"
 #include "eval/report.h"
 #include "render/render.h"
+#include "render/timing.h"
 #include "rovo/version.h"
 #include "scenes/city.h"
 #include "scenes/rng.h"
@@ -404,7 +405,7 @@ SuiteOptions SuiteOptionsFromJson(const nlohmann::json& j, const std::string& so
 }
 
 const std::vector<std::string>& SuiteVariantNames() {
-  static const std::vector<std::string> names = {"ideal", "realistic", "gray", "blur", "rolling", "trigger", "all"};
+  static const std::vector<std::string> names = {"ideal", "sensor", "gray", "blur", "rolling", "trigger", "realistic"};
   return names;
 }
 
@@ -440,16 +441,17 @@ namespace {
 // The render settings of a variant (ParseSuiteEntry), on top of the preset's.
 void ApplySuiteVariant(const std::string& variant, RenderOptions* render) {
   if (variant.empty()) return;
-  const bool sensor = variant == "realistic" || variant == "gray" || variant == "all";
+  const bool sensor = variant == "sensor" || variant == "gray" || variant == "realistic";
   if (variant == "ideal") render->sensor = MakeSensorSettings("ideal", {});
   if (sensor) {
     SensorOverrides overrides;
     if (variant == "gray") overrides.grayscale = true;
     render->sensor = MakeSensorSettings("realistic", overrides);
   }
-  if (variant == "blur" || variant == "all") render->timing.shutter_ms = 10.0;
-  if (variant == "rolling" || variant == "all") render->timing.rolling_shutter_ms = 30.0;
-  if (variant == "trigger" || variant == "all") render->timing.trigger_offset_std_ms = 1.0;
+  if (variant == "realistic") render->timing = RealisticTiming();
+  if (variant == "blur") render->timing.shutter_ms = 10.0;
+  if (variant == "rolling") render->timing.rolling_shutter_ms = 30.0;
+  if (variant == "trigger") render->timing.trigger_offset_std_ms = 1.0;
 }
 
 std::string DatasetDirFor(const std::string& data_dir, const std::string& preset, const SuiteOptions& options) {

@@ -34,12 +34,13 @@ namespace rovo {
 // A suite entry is a scene preset, optionally with a variant of its render: "cloudy_urban+blur". The
 // dataset, the runs and the table row carry the whole entry. Variants (values in docs/results.md):
 //   ideal      --sensor ideal (HDR sun, auto-exposure and gain, no noise)
-//   realistic  --sensor realistic (noise, 12-bit ADC, BT.709 response, per-camera sensitivity spread)
-//   gray       realistic, grayscale
-//   blur       motion blur over a 10 ms shutter (8 samples per pixel)
+//   sensor     --sensor realistic (noise, 12-bit ADC, BT.709 response, per-camera sensitivity spread)
+//   gray       the realistic sensor, grayscale
+//   blur       motion blur over a fixed 10 ms shutter (8 samples per pixel)
 //   rolling    rolling shutter, 30 ms readout
 //   trigger    per-camera trigger offsets, standard deviation 1 ms
-//   all        realistic with blur, rolling and trigger
+//   realistic  the realistic profile, `rovo render --realistic`: the realistic sensor, motion blur over
+//              its exposure, 20 ms rolling shutter, trigger offsets of 0.5 ms standard deviation
 struct SuiteEntry {
   std::string preset;   // a scene preset (scenes/city.h)
   std::string variant;  // "" or one of SuiteVariantNames()

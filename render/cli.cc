@@ -1,6 +1,7 @@
 // `rovo` subcommands of render/: `rovo render`, `rovo scene preview`, `rovo bench render`.
 #include "datasets/cli_groups.h"
 #include "render/render.h"
+#include "render/timing.h"
 
 #include <CLI/CLI.hpp>
 
@@ -49,11 +50,12 @@ struct SensorArgs {
   float removed_noise = 0;
   CLI::Option *o_exposure = nullptr, *o_gain = nullptr, *o_target = nullptr, *o_sensitivity = nullptr,
               *o_spread = nullptr, *o_full_well = nullptr, *o_read = nullptr, *o_dark = nullptr, *o_ae = nullptr,
-              *o_shot = nullptr, *o_response = nullptr, *o_bits = nullptr, *o_gray = nullptr, *o_noise = nullptr;
+              *o_shot = nullptr, *o_response = nullptr, *o_bits = nullptr, *o_gray = nullptr, *o_noise = nullptr,
+              *o_profile = nullptr;
 
   void Add(CLI::App* cmd) {
     const std::string g = "Sensor model (render/README.md; off by default: the scene's exposure and sRGB)";
-    cmd->add_option("--sensor", profile,
+    o_profile = cmd->add_option("--sensor", profile,
                     "off | ideal (HDR sun, auto-exposure, sRGB response, no noise) | realistic (automotive fisheye "
                     "camera: 12-bit ADC, 10 ke- full well, 3 e- read noise, shot noise, dark current, BT.709 "
                     "response, 5 % per-camera sensitivity spread); exposure.csv records every exposure")
@@ -119,12 +121,25 @@ struct SensorArgs {
   }
 };
 
+// `--realistic`: the realistic sensor and timing (RealisticTiming) where no option of the command
+// line sets them.
+void ApplyRealisticProfile(const CLI::App& cmd, SensorArgs* sensor, TimingSettings* timing) {
+  const TimingSettings realistic = RealisticTiming();
+  if (sensor->o_profile->count() == 0) sensor->profile = "realistic";
+  if (cmd.count("--shutter-ms") == 0 && cmd.count("--motion-blur") == 0)
+    timing->shutter_from_sensor = realistic.shutter_from_sensor;
+  if (cmd.count("--rolling-shutter-ms") == 0) timing->rolling_shutter_ms = realistic.rolling_shutter_ms;
+  if (cmd.count("--trigger-offset-ms") == 0 && cmd.count("--trigger-offsets-ms") == 0)
+    timing->trigger_offset_std_ms = realistic.trigger_offset_std_ms;
+}
+
 // `rovo render`.
 void AddRenderCommand(CliGroups& groups) {
   struct Args {
     RenderOptions options;
     std::string frames, shard;
     SensorArgs sensor;
+    bool realistic = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = groups.root->add_subcommand(
@@ -176,11 +191,16 @@ void AddRenderCommand(CliGroups& groups) {
         ->delimiter(',')
         ->group(g);
   }
+  cmd->add_flag("--realistic", args->realistic,
+                "The realistic profile of an automotive fisheye camera (render/README.md): --sensor realistic "
+                "--motion-blur --rolling-shutter-ms 20 --trigger-offset-ms 0.5; options given beside it override "
+                "these");
   cmd->add_flag("--quiet", args->options.quiet, "No progress output");
-  cmd->callback([args] {
+  cmd->callback([args, cmd] {
     RenderOptions options = args->options;
     if (!args->frames.empty()) ParseFrameRange(args->frames, &options.frame_begin, &options.frame_end);
     if (!args->shard.empty()) ParseShard(args->shard, &options.shard_index, &options.shard_count);
+    if (args->realistic) ApplyRealisticProfile(*cmd, &args->sensor, &options.timing);
     options.sensor = args->sensor.Resolve();
     const RenderSummary s = RenderDataset(options);
     std::printf("rendered %d frames, skipped %d complete, %d in this shard, %.1f s\n%s\n", s.frames_rendered,

@@ -289,6 +289,7 @@ std::vector<std::vector<double>> MeterFrames(const RenderOptions& options, const
   settings.vignetting = options.vignetting;
   settings.linear_output = true;
   settings.sun_disc = true;
+  settings.sun_aureole = true;
   std::vector<std::vector<double>> meter(count, std::vector<double>(rig.NumCameras(), 0.0));
   Progress progress("meter " + options.out_dir, count, "frames", options.quiet);
   CameraImage image;
@@ -298,7 +299,7 @@ std::vector<std::vector<double>> MeterFrames(const RenderOptions& options, const
       tracer.SetFrame(begin + f);
       for (int c = 0; c < rig.NumCameras(); ++c) {
         tracer.Render(rays[c], world_from_rig * rig.cameras[c].cam_from_rig.Inverse(), settings, &image);
-        meter[f][c] = MeterLuminance(image.linear, rays[c].bearing, rays[c].valid);
+        meter[f][c] = MeterLuminance(image.linear, rays[c].bearing, rays[c].valid, options.sensor.ae_target);
       }
     });
     progress.Add(1);
@@ -455,6 +456,7 @@ void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& r
   const bool sensor = options.sensor.enabled;
   settings.linear_output = sensor;
   settings.sun_disc = sensor;
+  settings.sun_aureole = sensor;
   std::optional<SensorPipeline> pipeline;
   if (sensor) pipeline.emplace(options.sensor);
   std::vector<float> linear;  // reused between images

@@ -209,15 +209,32 @@ std::vector<double> CameraSensitivities(const SensorSettings& settings, int num_
 // ---- auto-exposure ---------------------------------------------------------------------------------
 
 double MeterLuminance(const std::vector<float>& linear, const std::vector<Eigen::Vector3f>& bearing,
-                      const std::vector<uint8_t>& valid) {
-  double sum = 0.0, weight = 0.0;
+                      const std::vector<uint8_t>& valid, double ae_target) {
+  // (luminance, weight) of the valid pixels, brightest first.
+  std::vector<std::pair<double, double>> pixels;
+  double weight = 0.0, sum = 0.0;
   for (size_t i = 0; i < valid.size(); ++i) {
     if (!valid[i]) continue;
     const double w = 0.5 * (1.0 + bearing[i].z());
-    sum += w * Luminance(linear[3 * i], linear[3 * i + 1], linear[3 * i + 2]);
+    const double y = Luminance(linear[3 * i], linear[3 * i + 1], linear[3 * i + 2]);
+    pixels.emplace_back(y, w);
     weight += w;
+    sum += w * y;
   }
-  return weight > 0.0 ? sum / weight : 0.0;
+  if (!(weight > 0.0)) return 0.0;
+  std::sort(pixels.begin(), pixels.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  // With the k brightest pixels clipped, sum_w min(s Y, 1) / W = target is linear in s:
+  // s = (target W - W_k) / S_k (W_k their weight, S_k the weighted luminance of the rest); the
+  // first k whose next pixel stays below full scale is the solution.
+  double clipped_weight = 0.0;
+  for (size_t k = 0; k <= pixels.size(); ++k) {
+    if (!(sum > 0.0) || ae_target * weight <= clipped_weight) return 0.0;  // unreachable: the longest exposure
+    const double s = (ae_target * weight - clipped_weight) / sum;
+    if (k == pixels.size() || s * pixels[k].first < 1.0) return ae_target / s;
+    clipped_weight += pixels[k].second;
+    sum -= pixels[k].second * pixels[k].first;
+  }
+  return 0.0;
 }
 
 namespace {

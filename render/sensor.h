@@ -111,10 +111,14 @@ struct CameraExposure {
   double gain = 1.0;
 };
 
-// The meter: centre-weighted mean luminance of a linear image (3 floats per pixel), weight
-// (1 + b.z) / 2 for the unit bearing b of every valid pixel. 0 when no pixel is valid.
+// The meter, output-referred: the luminance M whose exposure x = log2(ae_target / M) (in units of
+// full scale per unit radiance) puts the centre-weighted mean of the clipped signal,
+// sum_i w_i min(2^x Y_i, 1) / sum_i w_i, at ae_target; w_i = (1 + b_z) / 2 for the unit bearing b of
+// every valid pixel of `linear` (3 floats per pixel). Without clipping M is the centre-weighted mean
+// luminance; saturated highlights (lamps, the sun disc) count as full scale, not by their radiance.
+// 0 when no pixel is valid or the target cannot be reached (too few lit pixels).
 double MeterLuminance(const std::vector<float>& linear, const std::vector<Eigen::Vector3f>& bearing,
-                      const std::vector<uint8_t>& valid);
+                      const std::vector<uint8_t>& valid, double ae_target);
 
 // log2 of the exposure (ms x gain) that puts a meter value at the target:
 // log2(ae_target * full_well / (sensitivity * meter)); for meter <= 0 the largest exposure.

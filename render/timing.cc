@@ -14,6 +14,14 @@ bool TimingSettings::Enabled() const {
          !trigger_offset_ms.empty();
 }
 
+TimingSettings RealisticTiming() {
+  TimingSettings t;
+  t.shutter_from_sensor = true;
+  t.rolling_shutter_ms = 20.0;
+  t.trigger_offset_std_ms = 0.5;
+  return t;
+}
+
 void TimingSettings::Check(int num_cameras, bool sensor_on) const {
   auto range = [](double v, double hi, const std::string& option) {
     if (!(v >= 0.0 && v <= hi))

@@ -33,6 +33,11 @@ struct TimingSettings {
   void Check(int num_cameras, bool sensor_on) const;
 };
 
+// The timing of the realistic profile (`rovo render --realistic`, render/README.md gives the sources):
+// motion blur over the sensor's exposure, a 20 ms rolling-shutter readout, per-camera trigger offsets
+// drawn with a standard deviation of 0.5 ms.
+TimingSettings RealisticTiming();
+
 // Pose at time t (seconds) of a sampled motion: the samples' times are the trajectory's
 // timestamps, the poses `poses` (one per trajectory frame; nullptr: the trajectory's
 // world_from_rig). Between samples k and k + 1 (t_k <= t <= t_k+1): rotation slerp and linear

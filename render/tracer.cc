@@ -801,6 +801,8 @@ struct RenderJob {
   // ShadeSettings::sun_disc with a sun: misses see it; sun_var = r^2 / 4 (r: angular radius, radians).
   bool sun_disc = false;
   float sun_var = 0.0f;
+  // ShadeSettings::sun_aureole with a sun: k of the aureole (render/tracer.h), else 0.
+  float aureole_k = 0.0f;
   // exposure / (samples of a pixel): a pixel has at most spp samples.
   std::vector<float> exposure_over_count;
   std::array<Eigen::Vector2f, 64> offsets{};
@@ -909,6 +911,11 @@ void GatherHits(const RenderJob& job, const TileRect& t, int n, TileBuffers& tb,
         __m128 sky = dir.z() >= 0.0f
                          ? _mm_add_ps(job.sky_horizon, _mm_mul_ps(_mm_set1_ps(std::sqrt(dir.z())), job.sky_delta))
                          : job.sky_ground;
+        if (job.aureole_k > 0.0f && dir.z() >= 0.0f) {
+          // The circumsolar aureole: gamma = 2 asin(|d - s_dir| / 2).
+          const float gamma = 2.0f * std::asin(std::min(1.0f, 0.5f * (dir - d.sun_dir).norm()));
+          sky = _mm_mul_ps(sky, _mm_set1_ps(1.0f + job.aureole_k * std::exp(-3.0f * gamma)));
+        }
         if (job.sun_disc) {
           // The HDR sun through the pixel footprint (render/tracer.h): E_sun exp(-c2 / 2s2) / (2 pi s2).
           const float c2 = (dir - d.sun_dir).squaredNorm();
@@ -1307,6 +1314,11 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
   job.sun_disc = settings.sun_disc && light.sun_radiance.maxCoeff() > 0.0f;
   const float sun_radius = static_cast<float>(0.5 * light.sun_angular_diameter_deg * M_PI / 180.0);
   job.sun_var = 0.25f * sun_radius * sun_radius;
+  if (settings.sun_aureole && light.sun_radiance.maxCoeff() > 0.0f) {
+    auto luminance = [](const Eigen::Vector3f& c) { return 0.2126f * c.x() + 0.7152f * c.y() + 0.0722f * c.z(); };
+    const float sky = static_cast<float>(M_PI) * luminance(light.sky_horizon);
+    job.aureole_k = 10.0f * (sky > 0.0f ? std::min(1.0f, luminance(light.sun_radiance) / sky) : 1.0f);
+  }
   job.exposure_over_count.assign(spp + 1, 0.0f);
   for (int c = 1; c <= spp; ++c) job.exposure_over_count[c] = light.exposure / static_cast<float>(c);
   for (int s = 0; s < std::min(spp, 64); ++s) job.offsets[s] = CameraRays::SampleOffset(s, spp);

@@ -48,7 +48,13 @@
 //   L_sun(d) = E_sun / (2 pi s^2) * exp(-|d - s_dir|^2 / (2 s^2)),  s^2 = r^2 / 4 + f^2,
 // zero where |d - s_dir|^2 >= 50 s^2 (d unit ray direction, s_dir unit direction to the sun). Over
 // the sphere it integrates to E_sun (the sun's irradiance) at any image size and sample count, so
-// the small auto-exposure meter render sees the same sun as the image.
+// the small auto-exposure meter render sees the same sun as the image. With ShadeSettings::
+// sun_aureole the sky above the horizon also brightens around the sun, after the forward term of
+// the CIE standard clear sky's scattering indicatrix (ISO 15469 / CIE S 011, c = 10, d = -3):
+//   L_sky'(d) = L_sky(d) * (1 + k * exp(-3 gamma)),  k = 10 * min(1, Y(E_sun) / (pi * Y(sky_horizon))),
+// gamma the angle from d to the sun (radians) and Y the luminance: 11x the sky's radiance at the
+// sun, 2.5x at 20 deg; k shrinks when the sky outshines the sun (overcast presets). It is seen, it
+// lights no surface.
 // Texture level of detail: ray-cone footprint f = t * pixel_angle / max(|cos|, 0.1) / sqrt(spp)
 // in metres, times texels per metre of the triangle, sqrt(A_uv / A_world) * sqrt(W * H).
 //
@@ -125,6 +131,8 @@ struct ShadeSettings {
   bool linear_output = false;
   // Misses see the sun as well as the sky (the HDR sun of the sensor model, formula above).
   bool sun_disc = false;
+  // Misses above the horizon see the circumsolar aureole (formula above); needs a sun.
+  bool sun_aureole = false;
   int max_shadowed_lights = 2;  // point/spot lights per hit with a shadow ray, in [0, kMaxShadowedLights]
 };
 

@@ -6,6 +6,7 @@
 #include "datasets/dataset.h"
 #include "datasets/io.h"
 #include "render/render.h"
+#include "render/timing.h"
 #include "render/tracer.h"
 #include "tests/render/box_scene.h"
 #include "tests/render/open_scene.h"
@@ -345,7 +346,31 @@ TEST(AutoExposureTest, MeterIsCentreWeighted) {
                                                 Eigen::Vector3f(0, 1, 0)};
   const std::vector<uint8_t> valid = {1, 1, 0};
   const std::vector<float> linear = {1, 1, 1, 4, 4, 4, 100, 100, 100};
-  EXPECT_NEAR(MeterLuminance(linear, bearing, valid), (1.0 * 1.0 + 0.5 * 4.0) / 1.5, 1e-9);
+  // Nothing saturates at the target: the centre-weighted mean luminance.
+  EXPECT_NEAR(MeterLuminance(linear, bearing, valid, 0.18), (1.0 * 1.0 + 0.5 * 4.0) / 1.5, 1e-9);
+  EXPECT_EQ(MeterLuminance(linear, bearing, {0, 0, 0}, 0.18), 0.0);
+}
+
+// A small highlight (a lamp, the sun disc) saturates and counts as full scale, not by its radiance:
+// 99 pixels of luminance 1 and one of 10^6 meter about 1, not 10^4, and the exposure the meter asks
+// for puts the mean of the clipped signal at the target.
+TEST(AutoExposureTest, SaturatedHighlightsCountAsFullScale) {
+  const int n = 100;
+  std::vector<Eigen::Vector3f> bearing(n, Eigen::Vector3f(0, 0, 1));
+  std::vector<uint8_t> valid(n, 1);
+  std::vector<float> linear(3 * n, 1.0f);
+  for (int k = 0; k < 3; ++k) linear[k] = 1e6f;
+  const double target = 0.18;
+  const double m = MeterLuminance(linear, bearing, valid, target);
+  const double s = target / m;  // full scale per unit luminance
+  double clipped = 0.0;
+  for (int i = 0; i < n; ++i) clipped += std::min(1.0, s * linear[3 * i]) / n;
+  EXPECT_NEAR(clipped, target, 1e-12);
+  EXPECT_NEAR(m, 0.18 * 99.0 / 17.0, 1e-9);  // (1 + 99 s) / 100 = 0.18
+  // Mostly black with a few lit pixels: the target is out of reach, the longest exposure.
+  std::vector<float> dark(3 * n, 0.0f);
+  for (int k = 0; k < 30; ++k) dark[k] = 5.0f;  // 10 lit pixels: at most 10 % of full scale
+  EXPECT_EQ(MeterLuminance(dark, bearing, valid, target), 0.0);
 }
 
 // ---- the tracer's HDR sun and linear output -------------------------------------------------------
@@ -603,6 +628,24 @@ TEST_F(SensorDatasetTest, CommandLineNamesTheSensorOptions) {
   EXPECT_NE(status, 0);
   EXPECT_NE(text.find("--adc-bits"), std::string::npos) << text;
   EXPECT_FALSE(fs::exists(root_ / "cli" / "dataset.json"));
+}
+
+// --realistic turns on the realistic sensor and timing; an option given beside it wins.
+TEST_F(SensorDatasetTest, RealisticProfileSetsSensorAndTimingUnlessOverridden) {
+  const std::string out = (root_ / "realistic").string();
+  const std::string command = std::string(ROVO_BINARY) + " render --scene " + scene_dir_ + " --out " + out +
+                              " --rig omnimvs4 --scale 0.1 --spp 1 --frames 0:2 --quiet --realistic "
+                              "--rolling-shutter-ms 5 > " + (root_ / "log.txt").string() + " 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << ReadFile((root_ / "log.txt").string());
+  const DatasetInfo info = ReadDatasetInfo(out);
+  ASSERT_TRUE(info.sensor.has_value());
+  EXPECT_EQ(info.sensor->profile, "realistic");
+  ASSERT_TRUE(info.timing.has_value());
+  EXPECT_EQ(info.timing->exposure, "sensor");
+  EXPECT_EQ(info.timing->rolling_shutter_ms, 5.0);  // the override
+  EXPECT_EQ(info.timing->trigger_offset_std_ms, RealisticTiming().trigger_offset_std_ms);
+  EXPECT_EQ(info.timing->trigger_offset_ms.size(), 4u);
+  ExpectValid(out);
 }
 
 }  // namespace
