@@ -83,14 +83,28 @@ std::string FmtStat(const std::optional<Stat>& stat, int runs, const char* forma
   return s + ShortCount(stat, runs);
 }
 
-// Complete: the first `max_frames` frames (all when <= 0) have every camera's image.
-bool DatasetComplete(const std::string& dataset_dir, int max_frames) {
+// Whether the dataset's sensor and timing records are the ones `render` would write (a variant's
+// dataset rendered with other effects is not reused).
+bool EffectsMatch(const DatasetInfo& info, const RenderOptions& render) {
+  const int n = info.rig.NumCameras();
+  if (render.sensor.enabled != info.sensor.has_value() || render.timing.Enabled() != info.timing.has_value())
+    return false;
+  if (info.sensor && *info.sensor != MakeSensorRecord(render.sensor, CameraSensitivities(render.sensor, n, render.seed)))
+    return false;
+  return !info.timing ||
+         *info.timing == MakeTimingRecord(render.timing, TriggerOffsetsMs(render.timing, n, render.seed));
+}
+
+// Complete: the first `max_frames` frames (all when <= 0) have every camera's image, and the effects
+// match `render`'s.
+bool DatasetComplete(const std::string& dataset_dir, int max_frames, const RenderOptions& render) {
   std::error_code ec;
   if (!fs::is_regular_file(DatasetJsonPath(dataset_dir), ec) || !fs::is_regular_file(GroundTruthPath(dataset_dir), ec)) {
     return false;
   }
   try {
     const DatasetInfo info = ReadDatasetInfo(dataset_dir);
+    if (!EffectsMatch(info, render)) return false;
     const int frames = max_frames > 0 ? std::min(max_frames, info.frame_count) : info.frame_count;
     for (int f = 0; f < frames; ++f) {
       for (const RigCamera& cam : info.rig.cameras) {
@@ -641,7 +655,12 @@ void RenderSuiteDataset(const SuitePlan& plan, size_t preset_index, int shard, i
   const SuiteOptions& options = plan.options;
   const std::string& dir = plan.dataset_dirs.at(preset_index);
   const std::string& preset = options.presets[preset_index];
-  if (DatasetComplete(dir, plan.frame_ends[preset_index])) {
+  RenderOptions render;
+  const SuiteEntry entry = ParseSuiteEntry(preset);
+  render.preset = entry.preset;
+  ApplySuiteVariant(entry.variant, &render);
+  render.seed = options.scene_seed;
+  if (DatasetComplete(dir, plan.frame_ends[preset_index], render)) {
     if (!options.quiet) std::fprintf(stderr, "rovo suite: dataset %s is complete, not rendering\n", dir.c_str());
     return;
   }
@@ -651,13 +670,8 @@ void RenderSuiteDataset(const SuitePlan& plan, size_t preset_index, int shard, i
                  shards > 1 ? (" (shard " + std::to_string(shard) + "/" + std::to_string(shards) + ")").c_str() : "");
   }
   EnsureWritableDir(plan.data_dir);
-  RenderOptions render;
-  const SuiteEntry entry = ParseSuiteEntry(preset);
-  render.preset = entry.preset;
-  ApplySuiteVariant(entry.variant, &render);
   render.quick = options.quick;
   render.out_dir = dir;
-  render.seed = options.scene_seed;
   if (options.frames > 0) render.frame_end = plan.frame_ends[preset_index];
   render.shard_index = shard;
   render.shard_count = shards;

@@ -104,6 +104,30 @@ TEST(SuitePlan, ListsEveryRunOnceWithItsSettings) {
 
 // Preset entries with a render variant ("cloudy_urban+blur") plan their own dataset and runs; an unknown
 // variant is an error naming the entry; --robustness lists every variant and the harder worlds.
+// A variant's dataset made with other effects (an earlier definition of the variant) is not taken as
+// complete: the render refuses the folder, naming the difference, instead of the suite reusing it.
+TEST(SuitePlan, AVariantDatasetWithOtherEffectsIsNotReused) {
+  const fs::path out = TempDir("variant_reuse");
+  SuiteOptions options = SmallSuite(out);
+  options.frames = 2;
+  options.quiet = true;
+  options.presets = {"cloudy_urban+trigger"};
+  const SuitePlan trigger = PlanSuite(options);
+  RenderSuiteDataset(trigger, 0, 0, 1, 2);
+  RenderSuiteDataset(trigger, 0, 0, 1, 2);  // complete: not rendered again
+  options.presets = {"cloudy_urban+rolling"};
+  const SuitePlan rolling = PlanSuite(options);
+  fs::create_directories(fs::path(rolling.dataset_dirs[0]).parent_path());
+  fs::rename(trigger.dataset_dirs[0], rolling.dataset_dirs[0]);
+  try {
+    RenderSuiteDataset(rolling, 0, 0, 1, 2);
+    ADD_FAILURE() << "a dataset rendered with trigger offsets was reused for the rolling-shutter variant";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find(rolling.dataset_dirs[0]), std::string::npos) << e.what();
+  }
+  fs::remove_all(out);
+}
+
 TEST(SuitePlan, VariantEntriesAndTheRobustnessList) {
   EXPECT_EQ(ParseSuiteEntry("cloudy_urban").variant, "");
   const SuiteEntry blur = ParseSuiteEntry("cloudy_urban+blur");
