@@ -97,7 +97,7 @@ void AddSuiteOptions(CLI::App* cmd, SuiteCliArgs* args) {
                   "sensor or timing effects (" + variants + "; eval/suite.h)");
   cmd->add_flag("--robustness", args->robustness,
                 "Robustness table: each preset (default cloudy_urban) plain and with every variant, then the harder "
-                "worlds (indoor_hall, suburban_road, night_street)");
+                "worlds (indoor_hall, suburban_road, night_street) plain and +realistic");
   cmd->add_flag("--quick", options->quick, "Use the presets' quick forms (fewer frames, smaller images)");
   cmd->add_option("--frames", options->frames,
                   "Only the first N frames of each preset: rendered, run and scored on that span (0: all; e.g. a "

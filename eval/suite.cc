@@ -445,7 +445,8 @@ std::vector<std::string> RobustnessEntries(const std::vector<std::string>& prese
     for (const std::string& v : SuiteVariantNames()) out.push_back(p + "+" + v);
   }
   for (const ScenePreset& p : HarderScenePresets()) {
-    if (std::find(out.begin(), out.end(), p.name) == out.end()) out.push_back(p.name);
+    for (const std::string& entry : {p.name, p.name + "+realistic"})
+      if (std::find(out.begin(), out.end(), entry) == out.end()) out.push_back(entry);
   }
   return out;
 }

@@ -49,7 +49,7 @@ struct SuiteEntry {
 SuiteEntry ParseSuiteEntry(const std::string& entry);
 const std::vector<std::string>& SuiteVariantNames();
 // `rovo suite --robustness`: every preset of `presets` (default cloudy_urban) plain and with each
-// variant, then the harder worlds (HarderScenePresets) plain.
+// variant, then the harder worlds (HarderScenePresets) plain and with the realistic profile.
 std::vector<std::string> RobustnessEntries(const std::vector<std::string>& presets);
 
 struct SuiteOptions {

@@ -149,10 +149,11 @@ TEST(SuitePlan, VariantEntriesAndTheRobustnessList) {
   EXPECT_THROW(PlanSuite(options), std::invalid_argument);
 
   const std::vector<std::string> entries = RobustnessEntries({});
-  ASSERT_EQ(entries.size(), 1 + SuiteVariantNames().size() + HarderScenePresets().size());
+  ASSERT_EQ(entries.size(), 1 + SuiteVariantNames().size() + 2 * HarderScenePresets().size());
   EXPECT_EQ(entries.front(), "cloudy_urban");
   EXPECT_EQ(entries[1], "cloudy_urban+" + SuiteVariantNames().front());
-  EXPECT_EQ(entries.back(), HarderScenePresets().back().name);
+  EXPECT_EQ(entries[entries.size() - 2], HarderScenePresets().back().name);
+  EXPECT_EQ(entries.back(), HarderScenePresets().back().name + "+realistic");
 }
 
 TEST(SuitePlan, OptionsRoundTripThroughJsonAndBadFieldsAreNamed) {
