@@ -498,6 +498,15 @@ void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& r
 
 }  // namespace
 
+int DefaultSpp(const TimingSettings& timing, const std::vector<std::vector<CameraExposure>>& exposure) {
+  if (timing.shutter_ms > 0.0) return kDefaultBlurSpp;
+  if (!timing.shutter_from_sensor) return kDefaultSpp;
+  for (const auto& frame : exposure)
+    for (const CameraExposure& e : frame)
+      if (e.exposure_ms >= kBlurSppMinExposureMs) return kDefaultBlurSpp;
+  return kDefaultSpp;
+}
+
 RenderSummary RenderDataset(const RenderOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   // ---- Validate everything before writing anything.
@@ -533,8 +542,6 @@ RenderSummary RenderDataset(const RenderOptions& options) {
   if (options.timing.Enabled() && count < 2)
     throw std::invalid_argument("--frames " + std::to_string(begin) + ":" + std::to_string(end) +
                                 ": timing needs at least 2 frames (the rig between frames comes from groundtruth.tum)");
-  const bool blur = options.timing.shutter_ms > 0.0 || options.timing.shutter_from_sensor;
-  const int spp = options.spp > 0 ? options.spp : blur ? kDefaultBlurSpp : kDefaultSpp;
 
   // The build of the tracer validates the scene's indices (before any output).
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
@@ -547,6 +554,7 @@ RenderSummary RenderDataset(const RenderOptions& options) {
     plan.groundtruth = groundtruth;
     CheckTimingWindows(options, scene, begin, count, plan, rig.NumCameras());
   }
+  const int spp = options.spp > 0 ? options.spp : DefaultSpp(options.timing, plan.exposure);
   const DatasetInfo info = MakeDatasetInfo(options, scene, rig, count, plan);
 
   PrepareOutput(options, info, groundtruth, plan);

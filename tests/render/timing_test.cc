@@ -10,6 +10,8 @@
 #include <fstream>
 
 #include "datasets/dataset.h"
+#include "render/render.h"
+#include "render/sensor.h"
 #include "render/tracer.h"
 #include "tests/render/box_scene.h"
 
@@ -156,6 +158,21 @@ TEST(TriggerOffsets, SeededDrawAndExplicitValues) {
   TimingSettings blur;
   blur.shutter_from_sensor = true;
   EXPECT_THROW(blur.Check(4, false), std::invalid_argument);
+}
+
+// Blur samples only where there is blur: a fixed shutter always, the sensor's exposure only when some
+// exposure of the schedule is long enough to move an edge by most of a pixel.
+TEST(Timing, DefaultSppFollowsTheBlur) {
+  TimingSettings none, fixed, sensor;
+  fixed.shutter_ms = 0.2;
+  sensor.shutter_from_sensor = true;
+  std::vector<std::vector<CameraExposure>> day(10, std::vector<CameraExposure>(4, CameraExposure{0.2, 1.0}));
+  EXPECT_EQ(DefaultSpp(none, day), kDefaultSpp);
+  EXPECT_EQ(DefaultSpp(fixed, day), kDefaultBlurSpp);
+  EXPECT_EQ(DefaultSpp(sensor, day), kDefaultSpp);
+  EXPECT_EQ(DefaultSpp(sensor, {}), kDefaultSpp);
+  day[9][3].exposure_ms = kBlurSppMinExposureMs;  // one long exposure anywhere in the range
+  EXPECT_EQ(DefaultSpp(sensor, day), kDefaultBlurSpp);
 }
 
 // A camera triggered o ms late sees exactly what a camera at the rig's pose at t + o sees.
