@@ -178,7 +178,9 @@ void AddRenderCommand(CliGroups& groups) {
                     "(default spp " + std::to_string(kDefaultBlurSpp) + " when blurring)")
         ->group(g);
     cmd->add_flag("--motion-blur", t.shutter_from_sensor,
-                  "Motion blur over the sensor model's exposure time of each frame and camera (exposure.csv)")
+                  "Motion blur over the sensor model's exposure time of each frame and camera (exposure.csv; default "
+                  "spp " + std::to_string(kDefaultBlurSpp) + " when some exposure reaches " +
+                      std::to_string(kBlurSppMinExposureMs).substr(0, 3) + " ms, else " + std::to_string(kDefaultSpp) + ")")
         ->group(g);
     cmd->add_option("--rolling-shutter-ms", t.rolling_shutter_ms,
                     "Rolling shutter: readout time of the whole image in ms, top row first")
