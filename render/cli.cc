@@ -193,10 +193,16 @@ void AddRenderCommand(CliGroups& groups) {
         ->delimiter(',')
         ->group(g);
   }
-  cmd->add_flag("--realistic", args->realistic,
-                "The realistic profile of an automotive fisheye camera (render/README.md): --sensor realistic "
-                "--motion-blur --rolling-shutter-ms 20 --trigger-offset-ms 0.5; options given beside it override "
-                "these");
+  {
+    const TimingSettings realistic = RealisticTiming();
+    char values[160];
+    std::snprintf(values, sizeof(values), "--rolling-shutter-ms %g --trigger-offset-ms %g", realistic.rolling_shutter_ms,
+                  realistic.trigger_offset_std_ms);
+    cmd->add_flag("--realistic", args->realistic,
+                  std::string("The realistic profile of an automotive fisheye camera (render/README.md): --sensor "
+                              "realistic --motion-blur ") +
+                      values + "; options given beside it override these");
+  }
   cmd->add_flag("--quiet", args->options.quiet, "No progress output");
   cmd->callback([args, cmd] {
     RenderOptions options = args->options;
