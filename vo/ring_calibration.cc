@@ -427,22 +427,52 @@ RingPairEstimate EstimatePair(const PairState& p, const Rig& rig, const RingCali
   return e;
 }
 
+// A camera-frame bearing with its angle off the optical axis (+z) scaled by 1 + kappa: the lens model's
+// error that the ring can see (a lens calibrated with angles too small near the rim).
+template <typename T>
+Eigen::Matrix<T, 3, 1> ScaleOffAxisAngle(const Eigen::Vector3d& bearing, const T& kappa) {
+  const double r = std::hypot(bearing.x(), bearing.y());
+  if (r < 1e-12) return bearing.cast<T>();
+  const T theta = T(std::atan2(r, bearing.z())) * (T(1.0) + kappa);
+  using std::cos;
+  using std::sin;
+  return Eigen::Matrix<T, 3, 1>(sin(theta) * T(bearing.x() / r), sin(theta) * T(bearing.y() / r), cos(theta));
+}
+
 // The ring's epipolar residuals with each baseline direction following its camera:
-//   e = (b_a x t_a) . (R_a R_b^T b_b) / |b_a x t_a|,   t_a = R_a (c_b - c_a),   R_j = rotation of cam_j_from_rig.
+//   e = (b_a x t_a) . (R_a R_b^T b_b) / |b_a x t_a|,   t_a = R_a (c_b - c_a),   R_j = rotation of cam_j_from_rig,
+// with both bearings' off-axis angles scaled by 1 + kappa (ScaleOffAxisAngle).
 struct RingEpipolarError {
   RingEpipolarError(const Eigen::Vector3d& bearing_a, const Eigen::Vector3d& bearing_b, const Eigen::Vector3d& baseline_in_rig)
       : bearing_a(bearing_a), bearing_b(bearing_b), baseline_in_rig(baseline_in_rig) {}
   template <typename T>
-  bool operator()(const T* q_a, const T* q_b, T* residual) const {
+  bool operator()(const T* q_a, const T* q_b, const T* kappa, T* residual) const {
     const Eigen::Quaternion<T> qa(q_a[3], q_a[0], q_a[1], q_a[2]);
     const Eigen::Quaternion<T> qb(q_b[3], q_b[0], q_b[1], q_b[2]);
     const Eigen::Matrix<T, 3, 1> t_a = qa * baseline_in_rig.cast<T>();
-    const Eigen::Matrix<T, 3, 1> n = bearing_a.cast<T>().cross(t_a);
-    const Eigen::Matrix<T, 3, 1> r = qa * (qb.conjugate() * bearing_b.cast<T>());
+    const Eigen::Matrix<T, 3, 1> n = ScaleOffAxisAngle(bearing_a, kappa[0]).cross(t_a);
+    const Eigen::Matrix<T, 3, 1> r = qa * (qb.conjugate() * ScaleOffAxisAngle(bearing_b, kappa[0]));
     residual[0] = n.dot(r) / (n.norm() + T(1e-12));
     return true;
   }
+  double operator()(const Eigen::Quaterniond& qa, const Eigen::Quaterniond& qb, double kappa) const {
+    double r = 0.0;
+    (*this)(qa.coeffs().data(), qb.coeffs().data(), &kappa, &r);
+    return r;
+  }
   Eigen::Vector3d bearing_a, bearing_b, baseline_in_rig;
+};
+
+// kappa near 0 (a weak prior of standard deviation `sigma`, as strong as ten matches at the Cauchy
+// scale `scale_rad` for an error of sigma).
+struct AngleScalePrior {
+  explicit AngleScalePrior(double weight) : weight(weight) {}
+  template <typename T>
+  bool operator()(const T* kappa, T* residual) const {
+    residual[0] = T(weight) * kappa[0];
+    return true;
+  }
+  double weight;
 };
 
 // Camera 0's rotation stays near its given value (a weak prior: the common rotation of the cameras
@@ -461,61 +491,79 @@ struct RotationPrior {
   double weight;
 };
 
-// Refines every cam_j_from_rig rotation on all pairs' inlier matches at once (RingEpipolarError,
-// Cauchy at `scale_rad`), camera 0 held near `rotations[0]` by RotationPrior.
-std::vector<Eigen::Quaterniond> RefineRing(const std::vector<PairState>& pairs, const std::vector<std::vector<int>>& inliers,
-                                           const Rig& rig, std::vector<Eigen::Quaterniond> rotations, double scale_rad,
-                                           double prior_sigma_deg) {
-  ceres::Problem problem;
-  for (auto& q : rotations) problem.AddParameterBlock(q.coeffs().data(), 4, new ceres::EigenQuaternionManifold);
+// The joint unknowns: every camera's rotation and the lenses' common angle scale.
+struct RingModel {
+  std::vector<Eigen::Quaterniond> rotations;  // cam_j_from_rig
+  double kappa = 0.0;                         // off-axis angles scaled by 1 + kappa
+};
+
+Eigen::Vector3d PairBaselineInRig(const PairState& p, const Rig& rig) {
+  return CameraPositionInRig(rig.cameras[p.b].cam_from_rig) - CameraPositionInRig(rig.cameras[p.a].cam_from_rig);
+}
+
+// The ring's epipolar residuals of the `inliers` (per pair) as blocks of `problem` on `model`'s
+// parameters (Cauchy at `scale_rad`; plain least squares when scale_rad <= 0). Returns |residuals|.
+std::vector<double> AddRingResiduals(const std::vector<PairState>& pairs, const std::vector<std::vector<int>>& inliers,
+                                     const Rig& rig, double scale_rad, RingModel* model, ceres::Problem* problem) {
+  std::vector<double> residuals;
   for (size_t k = 0; k < pairs.size(); ++k) {
     const PairState& p = pairs[k];
-    const Eigen::Vector3d baseline = CameraPositionInRig(rig.cameras[p.b].cam_from_rig) -
-                                     CameraPositionInRig(rig.cameras[p.a].cam_from_rig);
+    const Eigen::Vector3d baseline = PairBaselineInRig(p, rig);
     for (int i : inliers[k]) {
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<RingEpipolarError, 1, 4, 4>(
-                                   new RingEpipolarError(p.bearings_a[i], p.bearings_b[i], baseline)),
-                               new ceres::CauchyLoss(scale_rad), rotations[p.a].coeffs().data(),
-                               rotations[p.b].coeffs().data());
+      auto* error = new RingEpipolarError(p.bearings_a[i], p.bearings_b[i], baseline);
+      residuals.push_back(std::abs((*error)(model->rotations[p.a], model->rotations[p.b], model->kappa)));
+      problem->AddResidualBlock(new ceres::AutoDiffCostFunction<RingEpipolarError, 1, 4, 4, 1>(error),
+                                scale_rad > 0.0 ? new ceres::CauchyLoss(scale_rad) : nullptr,
+                                model->rotations[p.a].coeffs().data(), model->rotations[p.b].coeffs().data(),
+                                &model->kappa);
     }
   }
-  // As strong as ten matches at the Cauchy scale for an error of prior_sigma_deg.
+  return residuals;
+}
+
+// Refines every cam_j_from_rig rotation on all pairs' inlier matches at once (RingEpipolarError,
+// Cauchy at `scale_rad`), camera 0 held near its start by RotationPrior; the angle scale too when
+// `angle_scale_sigma` > 0 (AngleScalePrior), else it stays at its start.
+RingModel RefineRing(const std::vector<PairState>& pairs, const std::vector<std::vector<int>>& inliers, const Rig& rig,
+                     RingModel model, double scale_rad, double prior_sigma_deg, double angle_scale_sigma) {
+  ceres::Problem problem;
+  for (auto& q : model.rotations) problem.AddParameterBlock(q.coeffs().data(), 4, new ceres::EigenQuaternionManifold);
+  problem.AddParameterBlock(&model.kappa, 1);
+  AddRingResiduals(pairs, inliers, rig, scale_rad, &model, &problem);
+  // Priors as strong as ten matches at the Cauchy scale for an error of one sigma.
   const double weight = std::sqrt(10.0) * scale_rad / (prior_sigma_deg * kDeg);
-  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<RotationPrior, 3, 4>(new RotationPrior(rotations[0], weight)),
-                           nullptr, rotations[0].coeffs().data());
+  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<RotationPrior, 3, 4>(new RotationPrior(model.rotations[0], weight)),
+                           nullptr, model.rotations[0].coeffs().data());
+  if (angle_scale_sigma > 0.0) {
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<AngleScalePrior, 1, 1>(
+                                 new AngleScalePrior(std::sqrt(10.0) * scale_rad / angle_scale_sigma)),
+                             nullptr, &model.kappa);
+  } else {
+    problem.SetParameterBlockConstant(&model.kappa);
+  }
   ceres::Solver::Options options;
   options.max_num_iterations = 100;
   options.num_threads = 1;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
-  for (auto& q : rotations) q.normalize();
-  return rotations;
+  for (auto& q : model.rotations) q.normalize();
+  return model;
 }
 
 // One-sigma uncertainty (degrees) of the worst-determined camera's rotation relative to camera 0 at
 // the joint solution: the covariance of the epipolar least-squares problem on the inliers with
-// camera 0 held, scaled by the residuals' robust variance, largest eigenvalue over cameras 1..N-1.
-// A near-field overlap leaves the rotation about the epipolar planes' normal (roughly the yaw of a
-// pair) nearly free, because depth absorbs it: this is where that shows. -1: not computable.
+// camera 0 held (and the angle scale free when it is estimated), scaled by the residuals' robust
+// variance, largest eigenvalue over cameras 1..N-1. A near-field overlap leaves the rotation about
+// the epipolar planes' normal (roughly the yaw of a pair) nearly free, because depth absorbs it:
+// this is where that shows. -1: not computable.
 double RingUncertaintyDeg(const std::vector<PairState>& pairs, const std::vector<std::vector<int>>& inliers,
-                          const Rig& rig, std::vector<Eigen::Quaterniond> rotations) {
+                          const Rig& rig, RingModel model, bool angle_scale_free) {
   ceres::Problem problem;
-  for (auto& q : rotations) problem.AddParameterBlock(q.coeffs().data(), 4, new ceres::EigenQuaternionManifold);
-  problem.SetParameterBlockConstant(rotations[0].coeffs().data());
-  std::vector<double> residuals;
-  for (size_t k = 0; k < pairs.size(); ++k) {
-    const PairState& p = pairs[k];
-    const Eigen::Vector3d baseline = CameraPositionInRig(rig.cameras[p.b].cam_from_rig) -
-                                     CameraPositionInRig(rig.cameras[p.a].cam_from_rig);
-    for (int i : inliers[k]) {
-      const RingEpipolarError e(p.bearings_a[i], p.bearings_b[i], baseline);
-      double r = 0.0;
-      e(rotations[p.a].coeffs().data(), rotations[p.b].coeffs().data(), &r);
-      residuals.push_back(std::abs(r));
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<RingEpipolarError, 1, 4, 4>(new RingEpipolarError(e)),
-                               nullptr, rotations[p.a].coeffs().data(), rotations[p.b].coeffs().data());
-    }
-  }
+  for (auto& q : model.rotations) problem.AddParameterBlock(q.coeffs().data(), 4, new ceres::EigenQuaternionManifold);
+  problem.SetParameterBlockConstant(model.rotations[0].coeffs().data());
+  problem.AddParameterBlock(&model.kappa, 1);
+  if (!angle_scale_free) problem.SetParameterBlockConstant(&model.kappa);
+  std::vector<double> residuals = AddRingResiduals(pairs, inliers, rig, 0.0, &model, &problem);
   if (residuals.size() < 10) return -1.0;
   std::nth_element(residuals.begin(), residuals.begin() + residuals.size() / 2, residuals.end());
   const double sigma = 1.4826 * residuals[residuals.size() / 2];
@@ -524,12 +572,14 @@ double RingUncertaintyDeg(const std::vector<PairState>& pairs, const std::vector
   options.null_space_rank = -1;
   ceres::Covariance covariance(options);
   std::vector<std::pair<const double*, const double*>> blocks;
-  for (size_t j = 1; j < rotations.size(); ++j) blocks.emplace_back(rotations[j].coeffs().data(), rotations[j].coeffs().data());
+  for (size_t j = 1; j < model.rotations.size(); ++j) {
+    blocks.emplace_back(model.rotations[j].coeffs().data(), model.rotations[j].coeffs().data());
+  }
   if (!covariance.Compute(blocks, &problem)) return -1.0;
   double worst = 0.0;
-  for (size_t j = 1; j < rotations.size(); ++j) {
+  for (size_t j = 1; j < model.rotations.size(); ++j) {
     Eigen::Matrix3d c;
-    covariance.GetCovarianceMatrixInTangentSpace({rotations[j].coeffs().data()}, c.data());
+    covariance.GetCovarianceMatrixInTangentSpace({model.rotations[j].coeffs().data()}, c.data());
     const double largest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(c).eigenvalues().maxCoeff();
     // Ceres' quaternion tangent is half the rotation vector.
     worst = std::max(worst, 2.0 * std::sqrt(std::max(0.0, largest)) * sigma / kDeg);
@@ -537,23 +587,22 @@ double RingUncertaintyDeg(const std::vector<PairState>& pairs, const std::vector
   return worst;
 }
 
-// Per pair, the indices of the matches that the joint rotations (cam_j_from_rig) explain: epipolar
-// residual (RingEpipolarError) below `threshold_rad` and the rays meeting in front of both cameras.
+// Per pair, the indices of the matches that the joint model explains: epipolar residual
+// (RingEpipolarError) below `threshold_rad` and the rays meeting in front of both cameras.
 std::vector<std::vector<int>> ReselectInliers(const std::vector<PairState>& pairs, const Rig& rig,
-                                              const std::vector<Eigen::Quaterniond>& rotations, double threshold_rad) {
+                                              const RingModel& model, double threshold_rad) {
   std::vector<std::vector<int>> out(pairs.size());
   for (size_t k = 0; k < pairs.size(); ++k) {
     const PairState& p = pairs[k];
-    const Eigen::Quaterniond& qa = rotations[p.a];
-    const Eigen::Quaterniond a_from_b = qa * rotations[p.b].conjugate();
-    const Eigen::Vector3d baseline_in_rig =
-        CameraPositionInRig(rig.cameras[p.b].cam_from_rig) - CameraPositionInRig(rig.cameras[p.a].cam_from_rig);
+    const Eigen::Quaterniond& qa = model.rotations[p.a];
+    const Eigen::Quaterniond a_from_b = qa * model.rotations[p.b].conjugate();
+    const Eigen::Vector3d baseline_in_rig = PairBaselineInRig(p, rig);
     const Eigen::Vector3d baseline_in_a = (qa * baseline_in_rig).normalized();
     for (size_t i = 0; i < p.bearings_a.size(); ++i) {
       const RingEpipolarError e(p.bearings_a[i], p.bearings_b[i], baseline_in_rig);
-      double r = 0.0;
-      e(qa.coeffs().data(), rotations[p.b].coeffs().data(), &r);
-      if (std::abs(r) < threshold_rad && InFrontOfBoth(p.bearings_a[i], a_from_b * p.bearings_b[i], baseline_in_a)) {
+      if (std::abs(e(qa, model.rotations[p.b], model.kappa)) < threshold_rad &&
+          InFrontOfBoth(ScaleOffAxisAngle(p.bearings_a[i], model.kappa),
+                        a_from_b * ScaleOffAxisAngle(p.bearings_b[i], model.kappa), baseline_in_a)) {
         out[k].push_back(static_cast<int>(i));
       }
     }
@@ -561,33 +610,33 @@ std::vector<std::vector<int>> ReselectInliers(const std::vector<PairState>& pair
   return out;
 }
 
-// Median |RingEpipolarError| over `indices` of pair `p` under the cam_j_from_rig `rotations`, degrees.
-double MedianResidualDeg(const PairState& p, const std::vector<int>& indices, const Rig& rig,
-                         const std::vector<Eigen::Quaterniond>& rotations) {
+// Median |RingEpipolarError| over `indices` of pair `p` under `model`, degrees.
+double MedianResidualDeg(const PairState& p, const std::vector<int>& indices, const Rig& rig, const RingModel& model) {
   if (indices.empty()) return -1.0;
-  const Eigen::Vector3d baseline_in_rig =
-      CameraPositionInRig(rig.cameras[p.b].cam_from_rig) - CameraPositionInRig(rig.cameras[p.a].cam_from_rig);
+  const Eigen::Vector3d baseline_in_rig = PairBaselineInRig(p, rig);
   std::vector<double> residuals;
   for (int i : indices) {
-    double r = 0.0;
-    RingEpipolarError(p.bearings_a[i], p.bearings_b[i], baseline_in_rig)(rotations[p.a].coeffs().data(),
-                                                                           rotations[p.b].coeffs().data(), &r);
-    residuals.push_back(std::abs(r));
+    const RingEpipolarError e(p.bearings_a[i], p.bearings_b[i], baseline_in_rig);
+    residuals.push_back(std::abs(e(model.rotations[p.a], model.rotations[p.b], model.kappa)));
   }
   std::nth_element(residuals.begin(), residuals.begin() + residuals.size() / 2, residuals.end());
   return std::asin(std::min(1.0, residuals[residuals.size() / 2])) / kDeg;
 }
 
 // Angle between the joint rotation of a pair and the pair's own rotation refined on its inliers alone
-// with the joint baseline direction: how far the pair's matches pull away from the ring solution.
-double PairDisagreementDeg(const PairState& p, const std::vector<int>& inliers, const Rig& rig,
-                           const std::vector<Eigen::Quaterniond>& rotations, double scale_rad) {
-  const Eigen::Quaterniond& qa = rotations[p.a];
-  const Eigen::Quaterniond joint_a_from_b = qa * rotations[p.b].conjugate();
-  const Eigen::Vector3d baseline_in_a =
-      (qa * (CameraPositionInRig(rig.cameras[p.b].cam_from_rig) - CameraPositionInRig(rig.cameras[p.a].cam_from_rig)))
-          .normalized();
-  const Eigen::Quaterniond own = RefineWithBaseline(p.bearings_a, p.bearings_b, inliers, baseline_in_a, joint_a_from_b, scale_rad);
+// with the joint baseline direction and angle scale: how far the pair's matches pull away from the
+// ring solution.
+double PairDisagreementDeg(const PairState& p, const std::vector<int>& inliers, const Rig& rig, const RingModel& model,
+                           double scale_rad) {
+  const Eigen::Quaterniond& qa = model.rotations[p.a];
+  const Eigen::Quaterniond joint_a_from_b = qa * model.rotations[p.b].conjugate();
+  const Eigen::Vector3d baseline_in_a = (qa * PairBaselineInRig(p, rig)).normalized();
+  opengv::bearingVectors_t scaled_a(p.bearings_a.size()), scaled_b(p.bearings_b.size());
+  for (int i : inliers) {
+    scaled_a[i] = ScaleOffAxisAngle(p.bearings_a[i], model.kappa);
+    scaled_b[i] = ScaleOffAxisAngle(p.bearings_b[i], model.kappa);
+  }
+  const Eigen::Quaterniond own = RefineWithBaseline(scaled_a, scaled_b, inliers, baseline_in_a, joint_a_from_b, scale_rad);
   return RotationDistanceDeg(own, joint_a_from_b);
 }
 
@@ -641,24 +690,28 @@ std::string PairCounts(const std::vector<RingPairEstimate>& pairs) {
 }
 
 struct JointSolution {
-  std::vector<Eigen::Quaterniond> rotations;  // cam_j_from_rig
+  RingModel model;
   std::vector<std::vector<int>> inliers;      // per pair
   int total_inliers = -1;
 };
 
-// The joint refinement (RefineRing) from `start` (cam_j_from_rig) on the pairs' own inliers, then
-// `joint_rounds` times: inliers re-selected from every match by the joint solution, refined again.
+// The joint refinement (RefineRing) from `start` (cam_j_from_rig, kappa 0) on the pairs' own inliers
+// (the angle scale estimated only around a closed ring),
+// then `joint_rounds` times: inliers re-selected from every match by the joint solution, refined again.
 JointSolution SolveJoint(const std::vector<PairState>& pairs, const std::vector<std::vector<int>>& pair_inliers,
-                         const Rig& rig, const std::vector<Eigen::Quaterniond>& start, const RingCalibrationOptions& o) {
+                         const Rig& rig, const std::vector<Eigen::Quaterniond>& start, const RingCalibrationOptions& o,
+                         bool closed_ring) {
   const double scale = o.inlier_threshold_deg * kDeg;
+  const double angle_scale_sigma = closed_ring ? o.angle_scale_sigma : 0.0;  // an open ring does not see it
   JointSolution s;
   s.inliers = pair_inliers;
-  s.rotations = RefineRing(pairs, s.inliers, rig, start, scale, o.prior_sigma_deg);
+  s.model.rotations = start;
+  s.model = RefineRing(pairs, s.inliers, rig, s.model, scale, o.prior_sigma_deg, angle_scale_sigma);
   for (int round = 0; round < o.joint_rounds; ++round) {
-    s.inliers = ReselectInliers(pairs, rig, s.rotations, scale);
-    s.rotations = RefineRing(pairs, s.inliers, rig, s.rotations, scale, o.prior_sigma_deg);
+    s.inliers = ReselectInliers(pairs, rig, s.model, scale);
+    s.model = RefineRing(pairs, s.inliers, rig, s.model, scale, o.prior_sigma_deg, angle_scale_sigma);
   }
-  s.inliers = ReselectInliers(pairs, rig, s.rotations, scale);
+  s.inliers = ReselectInliers(pairs, rig, s.model, scale);
   s.total_inliers = 0;
   for (const auto& v : s.inliers) s.total_inliers += static_cast<int>(v.size());
   return s;
@@ -713,23 +766,25 @@ RingCalibrationReport RingCalibrator::Solve() const {
   for (const std::vector<Eigen::Quaterniond>& start : JointStarts(report.pairs, n, rotations)) {
     std::vector<Eigen::Quaterniond> start_from_rig = start;
     for (auto& q : start_from_rig) q = (q * cam0_from_rig).normalized();  // cam_j_from_rig
-    JointSolution candidate = SolveJoint(impl_->pairs, inliers, rig, start_from_rig, o);
+    JointSolution candidate = SolveJoint(impl_->pairs, inliers, rig, start_from_rig, o, report.loop_error_deg >= 0.0);
     if (candidate.total_inliers > best.total_inliers) best = std::move(candidate);
   }
-  rotations = best.rotations;
+  const RingModel& model = best.model;
   inliers = best.inliers;
+  report.angle_scale = 1.0 + model.kappa;
   const double scale = o.inlier_threshold_deg * kDeg;
-  std::vector<Eigen::Quaterniond> given;
-  for (const RigCamera& c : rig.cameras) given.push_back(c.cam_from_rig.rotation);
-  report.uncertainty_deg = RingUncertaintyDeg(impl_->pairs, inliers, rig, rotations);
+  RingModel given;
+  for (const RigCamera& c : rig.cameras) given.rotations.push_back(c.cam_from_rig.rotation);
+  report.uncertainty_deg =
+      RingUncertaintyDeg(impl_->pairs, inliers, rig, model, o.angle_scale_sigma > 0.0 && report.loop_error_deg >= 0.0);
   for (size_t k = 0; k < impl_->pairs.size(); ++k) {
     RingPairEstimate& p = report.pairs[k];
     if (!p.usable) continue;
     p.inliers = static_cast<int>(inliers[k].size());
     p.median_residual_deg_given = MedianResidualDeg(impl_->pairs[k], inliers[k], rig, given);
-    p.median_residual_deg_result = MedianResidualDeg(impl_->pairs[k], inliers[k], rig, rotations);
+    p.median_residual_deg_result = MedianResidualDeg(impl_->pairs[k], inliers[k], rig, model);
     report.max_pair_disagreement_deg =
-        std::max(report.max_pair_disagreement_deg, PairDisagreementDeg(impl_->pairs[k], inliers[k], rig, rotations, scale));
+        std::max(report.max_pair_disagreement_deg, PairDisagreementDeg(impl_->pairs[k], inliers[k], rig, model, scale));
   }
   if (report.uncertainty_deg < 0.0 || report.uncertainty_deg > o.max_uncertainty_deg) {
     report.reason = "the overlaps leave a camera's rotation uncertain (one sigma " + std::to_string(report.uncertainty_deg) +
@@ -743,7 +798,8 @@ RingCalibrationReport RingCalibrator::Solve() const {
   }
   for (int j = 1; j < n; ++j) {
     const Eigen::Vector3d centre = CameraPositionInRig(rig.cameras[j].cam_from_rig);
-    const Eigen::Quaterniond camj_from_rig = (rotations[j] * rotations[0].inverse() * cam0_from_rig).normalized();
+    const Eigen::Quaterniond camj_from_rig =
+        (model.rotations[j] * model.rotations[0].inverse() * cam0_from_rig).normalized();
     report.cam_from_rig[j] = Rigid3(camj_from_rig, -(camj_from_rig * centre));
   }
   report.converged = true;

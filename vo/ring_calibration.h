@@ -58,6 +58,10 @@ struct RingCalibrationOptions {
   double max_uncertainty_deg = 0.25;   // one sigma of the worst camera (RingUncertaintyDeg) above: not converged
   int joint_rounds = 2;                // inliers re-selected by the joint solution, then refined again
   double prior_sigma_deg = 5.0;        // joint refinement: camera 0's prior (the common rotation)
+  // > 0: the joint refinement also estimates one angle scale 1 + kappa of every lens's off-axis angle
+  // around a closed ring, kappa with this prior standard deviation (a real lens calibration that
+  // understates angles near the rim leaves the ring open by degrees); 0: the lenses as given.
+  double angle_scale_sigma = 0.03;
   void Check() const;
 };
 
@@ -81,6 +85,7 @@ struct RingCalibrationReport {
   double loop_error_deg = -1.0;        // < 0: the ring is not closed (a pair missing, or N < 3)
   double max_pair_disagreement_deg = 0.0;  // largest angle between a pair's own and the joint rotation
   double uncertainty_deg = -1.0;       // one sigma of the worst-determined camera (RingUncertaintyDeg)
+  double angle_scale = 1.0;            // the lenses' off-axis angle scale of the joint solution
   std::vector<Rigid3> cam_from_rig;    // calibrated (camera 0 and every centre unchanged)
 };
 

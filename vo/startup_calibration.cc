@@ -68,8 +68,9 @@ void PrintRing(const RingCalibrationReport& ring) {
     std::fprintf(stderr, " %d-%d %d/%d inliers, moved %.2f deg;", p.camera_a, p.camera_b, p.inliers, p.matches,
                  p.change_deg);
   }
-  std::fprintf(stderr, " loop error %.3f deg%s%s\n", ring.loop_error_deg, ring.converged ? "" : ": FAILED, ",
-               ring.reason.c_str());
+  std::fprintf(stderr, " loop error %.3f deg", ring.loop_error_deg);
+  if (ring.angle_scale != 1.0) std::fprintf(stderr, ", lens angle scale %.4f", ring.angle_scale);
+  std::fprintf(stderr, "%s%s\n", ring.converged ? "" : ": FAILED, ", ring.reason.c_str());
 }
 
 RingCalibrationReport RunRingPass(const Rig& rig, const std::vector<Rigid3>& cam_from_rig,
@@ -80,30 +81,47 @@ RingCalibrationReport RunRingPass(const Rig& rig, const std::vector<Rigid3>& cam
   return ring.Solve();
 }
 
-// The ring stage, then again with the overlap views placed by its result: where the given
-// extrinsics were far off, the first pass saw the overlaps off-centre and rotated. The second pass
-// must confirm the first (max_pass_change_deg), else the result depends on where the views were
-// placed and is not trusted.
+// The ring stage, then again with the overlap views placed by the previous result: where the given
+// extrinsics were far off, the first pass saw the overlaps off-centre and rotated. Each later pass
+// must confirm the one before it (max_pass_change_deg), else the result depends on where the views
+// were placed and is not trusted.
 RingCalibrationReport RunRingPasses(const Rig& rig, const std::vector<Rigid3>& cam_from_rig,
                                     const std::vector<std::vector<cv::Mat>>& shots,
                                     const std::vector<cv::Mat>& static_masks, const StartupCalibrationOptions& options,
                                     bool quiet) {
-  RingCalibrationReport first = RunRingPass(rig, cam_from_rig, shots, static_masks, options.ring);
-  if (!quiet) PrintRing(first);
-  if (!first.converged || options.ring_passes < 2) return first;
+  RingCalibrationReport last = RunRingPass(rig, cam_from_rig, shots, static_masks, options.ring);
+  if (!quiet) PrintRing(last);
   RingCalibrationOptions aligned = options.ring;
   aligned.refine_matches = options.refine_second_pass;
-  RingCalibrationReport second = RunRingPass(rig, first.cam_from_rig, shots, static_masks, aligned);
-  if (!quiet) PrintRing(second);
-  if (!second.converged) return second;
-  const double change = LargestChangeDeg(first.cam_from_rig, second.cam_from_rig);
-  if (change > options.max_pass_change_deg) {
-    second.converged = false;
-    second.reason = "the second pass, with the overlap views placed by the first, moved a camera " +
+  for (int pass = 2; pass <= options.ring_passes && last.converged; ++pass) {
+    RingCalibrationReport next = RunRingPass(rig, last.cam_from_rig, shots, static_masks, aligned);
+    if (!quiet) PrintRing(next);
+    if (!next.converged) return next;
+    const double change = LargestChangeDeg(last.cam_from_rig, next.cam_from_rig);
+    if (change > options.max_pass_change_deg) {
+      next.converged = false;
+      next.reason = "pass " + std::to_string(pass) + ", with the overlap views placed by the pass before, moved a camera " +
                     std::to_string(change) + " deg (> " + std::to_string(options.max_pass_change_deg) +
                     "): the overlaps do not determine the extrinsics";
+    }
+    last = std::move(next);
   }
-  return second;
+  return last;
+}
+
+// The ring passes, and when they fail and options.rescue is set, the rescue passes.
+RingCalibrationReport RunRingStage(const Rig& rig, const std::vector<Rigid3>& cam_from_rig,
+                                   const std::vector<std::vector<cv::Mat>>& shots, const std::vector<cv::Mat>& static_masks,
+                                   const StartupCalibrationOptions& options, bool quiet, StartupCalibrationReport* report) {
+  RingCalibrationReport ring = RunRingPasses(rig, cam_from_rig, shots, static_masks, options, quiet);
+  if (ring.converged || !options.rescue) return ring;
+  if (!quiet) std::fprintf(stderr, "vo online: start-up ring calibration failed; rescue with more and weaker features\n");
+  StartupCalibrationOptions rescue = options;
+  rescue.ring.orb_features = options.rescue_orb_features;
+  rescue.ring.orb_fast_threshold = options.rescue_orb_fast_threshold;
+  report->rescued = true;
+  report->ring_failure = ring.reason;
+  return RunRingPasses(rig, cam_from_rig, shots, static_masks, rescue, quiet);
 }
 
 }  // namespace
@@ -137,6 +155,10 @@ nlohmann::json StartupCalibrationReport::ToJson() const {
           {"ring", {{"converged", ring.converged},
                     {"reason", ring.reason},
                     {"loop_error_deg", ring.loop_error_deg},
+                    {"angle_scale", ring.angle_scale},
+                    {"uncertainty_deg", ring.uncertainty_deg},
+                    {"rescued", rescued},
+                    {"failure_before_rescue", ring_failure},
                     {"pairs", pairs}}},
           {"refinement_rounds", round_list},
           {"cam_from_rig", extrinsics}};
@@ -165,7 +187,7 @@ StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Ri
     report.status = "no shot with every camera's image";
     return report;
   }
-  report.ring = RunRingPasses(rig, cam_from_rig, shots, static_masks, options, quiet);
+  report.ring = RunRingStage(rig, cam_from_rig, shots, static_masks, options, quiet, &report);
   const std::vector<cv::Mat>& first_images = shots.front();
   const std::vector<Rigid3> start = report.ring.converged ? report.ring.cam_from_rig : cam_from_rig;
   const double uncertainty = report.ring.converged ? options.refine_start_deg : options.fallback_prior_deg;

@@ -5,6 +5,9 @@
 //   1. Ring stage (ring_calibration.h), no extrinsic prior: the rotation of each ring pair from
 //      descriptor matches over its whole overlap (5-point RANSAC on bearings), pooled over `shots`
 //      synchronous shots, averaged around the ring into cam_j_from_cam0.
+//      The joint refinement also estimates one angle scale of every lens (a real lens calibration
+//      that understates angles near the rim). When this fails, it runs once more as a rescue
+//      (StartupCalibrationOptions::rescue) with more and weaker features.
 //   2. Refinement (extrinsic_bootstrap.h): rounds of the front-end's inter-view matching at the first
 //      shot with filters loosened to the current uncertainty and a one-pose BA with the rig's
 //      baseline lengths, the uncertainty shrinking with the change of each round.
@@ -30,9 +33,14 @@ struct StartupCalibrationOptions {
   int shots = 1;                      // synchronous shots pooled by the ring stage
   int shot_spacing = 10;              // frames between two shots
   RingCalibrationOptions ring;
-  int ring_passes = 2;                // 2: the ring stage again with views placed by its first result
+  int ring_passes = 2;                // > 1: the ring stage again with views placed by the previous result
   bool refine_second_pass = true;     // KLT sub-pixel matches in the second pass (its views are aligned)
-  double max_pass_change_deg = 0.5;   // the second pass moving a camera further: not converged
+  double max_pass_change_deg = 0.5;   // a later pass moving a camera further: not converged
+  // When the ring passes fail, once more with more and weaker features (an overlap with little
+  // texture, a real camera's low contrast).
+  bool rescue = true;
+  int rescue_orb_features = 6000;
+  int rescue_orb_fast_threshold = 5;
   bool refine = false;                // stage 2 (off: measured worse than the ring stage alone)
   double refine_start_deg = 2.0;      // stage 2's first uncertainty after a converged ring stage
   double fallback_prior_deg = 15.0;   // stage 2's first uncertainty when the ring stage fails
@@ -55,7 +63,9 @@ struct StartupCalibrationReport {
   bool converged = false;
   std::string status;                 // "converged", or why not
   std::vector<int> shots;             // frames used by the ring stage
-  RingCalibrationReport ring;
+  RingCalibrationReport ring;         // the ring passes' result (of the rescue when it ran)
+  bool rescued = false;               // the ring passes failed and the rescue ran
+  std::string ring_failure;           // why the ring passes failed, when the rescue ran
   std::vector<StartupRound> rounds;   // stage 2
   std::vector<Rigid3> cam_from_rig;   // the result (the start when nothing could be done)
   nlohmann::json ToJson() const;
