@@ -83,6 +83,7 @@ CalibrationDraw RunDraw(const CalibrationStudyOptions& o, const DatasetInfo& inf
     d.startup_deg = ExtrinsicErrorDeg(r.cam_from_rig, truth);
     d.startup_converged = r.converged;
     d.startup_status = r.status;
+    d.lens_angle_scale = r.ring.angle_scale;
     d.converged = d.startup_deg < Bound(o);
     return d;
   }
@@ -110,6 +111,7 @@ CalibrationDraw RunDraw(const CalibrationStudyOptions& o, const DatasetInfo& inf
   d.startup_deg = ExtrinsicErrorDeg(after, truth);
   d.startup_converged = startup.at("converged").get<bool>();
   d.startup_status = startup.at("status").get<std::string>();
+  d.lens_angle_scale = startup.at("ring").value("angle_scale", 1.0);
   std::map<int, std::vector<Rigid3>> by_frame;
   for (const ExtrinsicsRecord& r : run.extrinsics) {
     auto& v = by_frame[r.frame];
@@ -127,6 +129,12 @@ std::string Deg(double v) {
   if (v < 0.0) return "-";
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3f", v);
+  return buf;
+}
+
+std::string Scale(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4f", v);
   return buf;
 }
 
@@ -149,16 +157,17 @@ std::string ReproduceCommand(const CalibrationStudyOptions& o) {
 
 void WriteOutputs(const CalibrationStudyOptions& o, const DatasetInfo& info, const CalibrationStudyResult& result) {
   std::ostringstream csv;
-  csv << "seed,before_deg,startup_deg,at50_deg,at100_deg,end_deg,startup_converged,converged\n";
+  csv << "seed,before_deg,startup_deg,at50_deg,at100_deg,end_deg,startup_converged,converged,lens_angle_scale\n";
   nlohmann::json rows = nlohmann::json::array();
   std::vector<uint64_t> failures;
   for (const CalibrationDraw& d : result.draws) {
     csv << d.seed << ',' << d.before_deg << ',' << d.startup_deg << ',' << d.at50_deg << ',' << d.at100_deg << ','
-        << d.end_deg << ',' << (d.startup_converged ? 1 : 0) << ',' << (d.converged ? 1 : 0) << '\n';
+        << d.end_deg << ',' << (d.startup_converged ? 1 : 0) << ',' << (d.converged ? 1 : 0) << ',' << d.lens_angle_scale
+        << '\n';
     rows.push_back({{"seed", d.seed}, {"before_deg", d.before_deg}, {"startup_deg", d.startup_deg},
                     {"at50_deg", d.at50_deg}, {"at100_deg", d.at100_deg}, {"end_deg", d.end_deg},
                     {"startup_converged", d.startup_converged}, {"startup_status", d.startup_status},
-                    {"converged", d.converged}});
+                    {"lens_angle_scale", d.lens_angle_scale}, {"converged", d.converged}});
     if (!d.converged) failures.push_back(d.seed);
   }
   const double bound = Bound(o);
@@ -178,15 +187,17 @@ void WriteOutputs(const CalibrationStudyOptions& o, const DatasetInfo& info, con
 
 std::string Table(const CalibrationStudyOptions& o, const CalibrationStudyResult& result) {
   std::ostringstream s;
-  s << "| draw seed | before | after start-up | frame 50 | frame 100 | end | start-up verdict |\n"
-    << "|---|---|---|---|---|---|---|\n";
+  s << "| draw seed | before | after start-up | frame 50 | frame 100 | end | lens angle scale | start-up verdict |\n"
+    << "|---|---|---|---|---|---|---|---|\n";
   for (const CalibrationDraw& d : result.draws) {
     s << "| " << d.seed << " | " << Deg(d.before_deg) << " | " << Deg(d.startup_deg) << " | " << Deg(d.at50_deg)
-      << " | " << Deg(d.at100_deg) << " | " << Deg(d.end_deg) << " | " << (d.startup_converged ? "converged" : d.startup_status)
+      << " | " << Deg(d.at100_deg) << " | " << Deg(d.end_deg) << " | " << Scale(d.lens_angle_scale) << " | "
+      << (d.startup_converged ? "converged" : d.startup_status)
       << " |\n";
   }
   s << "\nExtrinsic error: largest over cameras i >= 1 of the rotation angle of est(cam_i_from_cam0) "
-       "true(cam_i_from_cam0)^-1, degrees.\n";
+       "true(cam_i_from_cam0)^-1, degrees. Lens angle scale: the start-up's estimate of every lens's off-axis "
+       "angle scale (1: the lenses as given).\n";
   s << "Converged (" << (o.shot_only ? "start-up" : "end of run") << " < " << Bound(o) << " deg): " << result.converged
     << " of " << result.draws.size() << ".\n";
   s << "Start-up calibration converged by its own verdict: " << result.startup_converged << " of " << result.draws.size()

@@ -48,6 +48,7 @@ struct CalibrationDraw {
   double at50_deg = -1.0, at100_deg = -1.0, end_deg = -1.0;  // < 0: the run is shorter / shot only
   bool startup_converged = false;   // the start-up calibration's own verdict
   std::string startup_status;
+  double lens_angle_scale = 1.0;    // the start-up's estimate of the lenses' off-axis angle scale
   bool converged = false;           // the study's verdict (error below the bound)
   std::vector<Rigid3> startup_cam_from_rig;  // the start-up calibration's result
 };
