@@ -427,40 +427,66 @@ RingPairEstimate EstimatePair(const PairState& p, const Rig& rig, const RingCali
   return e;
 }
 
-// A camera-frame bearing with its angle off the optical axis (+z) scaled by 1 + kappa: the lens model's
-// error that the ring can see (a lens calibrated with angles too small near the rim).
-template <typename T>
-Eigen::Matrix<T, 3, 1> ScaleOffAxisAngle(const Eigen::Vector3d& bearing, const T& kappa) {
-  const double r = std::hypot(bearing.x(), bearing.y());
-  if (r < 1e-12) return bearing.cast<T>();
-  const T theta = T(std::atan2(r, bearing.z())) * (T(1.0) + kappa);
-  using std::cos;
-  using std::sin;
-  return Eigen::Matrix<T, 3, 1>(sin(theta) * T(bearing.x() / r), sin(theta) * T(bearing.y() / r), cos(theta));
+// A camera-frame bearing whose angle off the optical axis (+z) can be scaled by 1 + kappa: the lens
+// model's error that the ring can see (a lens calibrated with angles too small near the rim). The
+// angle and the length of the bearing's xy part are computed once.
+struct OffAxisBearing {
+  explicit OffAxisBearing(const Eigen::Vector3d& b)
+      : bearing(b), r(std::hypot(b.x(), b.y())), theta(std::atan2(r, b.z())) {}
+  template <typename T>
+  Eigen::Matrix<T, 3, 1> Scaled(const T& kappa) const {
+    if (r < 1e-12) return bearing.cast<T>();
+    using std::cos;
+    using std::sin;
+    const T angle = T(theta) * (T(1.0) + kappa);
+    const T s = sin(angle) / T(r);
+    return Eigen::Matrix<T, 3, 1>(s * T(bearing.x()), s * T(bearing.y()), cos(angle));
+  }
+  Eigen::Vector3d bearing;
+  double r, theta;
+};
+
+Eigen::Vector3d ScaledBearing(const Eigen::Vector3d& bearing, double kappa) {
+  return kappa == 0.0 ? bearing : OffAxisBearing(bearing).Scaled<double>(kappa);
 }
 
-// The ring's epipolar residuals with each baseline direction following its camera:
-//   e = (b_a x t_a) . (R_a R_b^T b_b) / |b_a x t_a|,   t_a = R_a (c_b - c_a),   R_j = rotation of cam_j_from_rig,
-// with both bearings' off-axis angles scaled by 1 + kappa (ScaleOffAxisAngle).
+// The ring's epipolar residual with each baseline direction following its camera:
+//   e = (b_a x t_a) . (R_a R_b^T b_b) / |b_a x t_a|,   t_a = R_a (c_b - c_a),   R_j = rotation of cam_j_from_rig.
+template <typename T>
+T RingEpipolarResidual(const T* q_a, const T* q_b, const Eigen::Matrix<T, 3, 1>& bearing_a,
+                       const Eigen::Matrix<T, 3, 1>& bearing_b, const Eigen::Vector3d& baseline_in_rig) {
+  const Eigen::Quaternion<T> qa(q_a[3], q_a[0], q_a[1], q_a[2]);
+  const Eigen::Quaternion<T> qb(q_b[3], q_b[0], q_b[1], q_b[2]);
+  const Eigen::Matrix<T, 3, 1> t_a = qa * baseline_in_rig.cast<T>();
+  const Eigen::Matrix<T, 3, 1> n = bearing_a.cross(t_a);
+  const Eigen::Matrix<T, 3, 1> r = qa * (qb.conjugate() * bearing_b);
+  return n.dot(r) / (n.norm() + T(1e-12));
+}
+
+// RingEpipolarResidual with the lenses as given.
 struct RingEpipolarError {
   RingEpipolarError(const Eigen::Vector3d& bearing_a, const Eigen::Vector3d& bearing_b, const Eigen::Vector3d& baseline_in_rig)
       : bearing_a(bearing_a), bearing_b(bearing_b), baseline_in_rig(baseline_in_rig) {}
   template <typename T>
-  bool operator()(const T* q_a, const T* q_b, const T* kappa, T* residual) const {
-    const Eigen::Quaternion<T> qa(q_a[3], q_a[0], q_a[1], q_a[2]);
-    const Eigen::Quaternion<T> qb(q_b[3], q_b[0], q_b[1], q_b[2]);
-    const Eigen::Matrix<T, 3, 1> t_a = qa * baseline_in_rig.cast<T>();
-    const Eigen::Matrix<T, 3, 1> n = ScaleOffAxisAngle(bearing_a, kappa[0]).cross(t_a);
-    const Eigen::Matrix<T, 3, 1> r = qa * (qb.conjugate() * ScaleOffAxisAngle(bearing_b, kappa[0]));
-    residual[0] = n.dot(r) / (n.norm() + T(1e-12));
+  bool operator()(const T* q_a, const T* q_b, T* residual) const {
+    residual[0] = RingEpipolarResidual<T>(q_a, q_b, bearing_a.cast<T>(), bearing_b.cast<T>(), baseline_in_rig);
     return true;
   }
-  double operator()(const Eigen::Quaterniond& qa, const Eigen::Quaterniond& qb, double kappa) const {
-    double r = 0.0;
-    (*this)(qa.coeffs().data(), qb.coeffs().data(), &kappa, &r);
-    return r;
-  }
   Eigen::Vector3d bearing_a, bearing_b, baseline_in_rig;
+};
+
+// RingEpipolarResidual with both bearings' off-axis angles scaled by 1 + kappa (a parameter).
+struct ScaledRingEpipolarError {
+  ScaledRingEpipolarError(const Eigen::Vector3d& bearing_a, const Eigen::Vector3d& bearing_b,
+                          const Eigen::Vector3d& baseline_in_rig)
+      : bearing_a(bearing_a), bearing_b(bearing_b), baseline_in_rig(baseline_in_rig) {}
+  template <typename T>
+  bool operator()(const T* q_a, const T* q_b, const T* kappa, T* residual) const {
+    residual[0] = RingEpipolarResidual<T>(q_a, q_b, bearing_a.Scaled(kappa[0]), bearing_b.Scaled(kappa[0]), baseline_in_rig);
+    return true;
+  }
+  OffAxisBearing bearing_a, bearing_b;
+  Eigen::Vector3d baseline_in_rig;
 };
 
 // kappa near 0 (a weak prior of standard deviation `sigma`, as strong as ten matches at the Cauchy
@@ -501,23 +527,42 @@ Eigen::Vector3d PairBaselineInRig(const PairState& p, const Rig& rig) {
   return CameraPositionInRig(rig.cameras[p.b].cam_from_rig) - CameraPositionInRig(rig.cameras[p.a].cam_from_rig);
 }
 
+// |RingEpipolarResidual| of match `i` of pair `p` under `model`.
+double RingResidual(const PairState& p, int i, const Eigen::Vector3d& baseline_in_rig, const RingModel& model) {
+  const Eigen::Vector3d b_a = ScaledBearing(p.bearings_a[i], model.kappa);
+  const Eigen::Vector3d b_b = ScaledBearing(p.bearings_b[i], model.kappa);
+  return std::abs(RingEpipolarResidual<double>(model.rotations[p.a].coeffs().data(), model.rotations[p.b].coeffs().data(),
+                                               b_a, b_b, baseline_in_rig));
+}
+
 // The ring's epipolar residuals of the `inliers` (per pair) as blocks of `problem` on `model`'s
-// parameters (Cauchy at `scale_rad`; plain least squares when scale_rad <= 0). Returns |residuals|.
+// rotations, and on its angle scale when that is free or not 0 (Cauchy at `scale_rad`; plain least
+// squares when scale_rad <= 0). Returns the |residuals| at `model`.
 std::vector<double> AddRingResiduals(const std::vector<PairState>& pairs, const std::vector<std::vector<int>>& inliers,
-                                     const Rig& rig, double scale_rad, RingModel* model, ceres::Problem* problem) {
+                                     const Rig& rig, double scale_rad, bool scale_free, RingModel* model,
+                                     ceres::Problem* problem) {
+  const bool scaled = scale_free || model->kappa != 0.0;
   std::vector<double> residuals;
   for (size_t k = 0; k < pairs.size(); ++k) {
     const PairState& p = pairs[k];
     const Eigen::Vector3d baseline = PairBaselineInRig(p, rig);
+    double* q_a = model->rotations[p.a].coeffs().data();
+    double* q_b = model->rotations[p.b].coeffs().data();
     for (int i : inliers[k]) {
-      auto* error = new RingEpipolarError(p.bearings_a[i], p.bearings_b[i], baseline);
-      residuals.push_back(std::abs((*error)(model->rotations[p.a], model->rotations[p.b], model->kappa)));
-      problem->AddResidualBlock(new ceres::AutoDiffCostFunction<RingEpipolarError, 1, 4, 4, 1>(error),
-                                scale_rad > 0.0 ? new ceres::CauchyLoss(scale_rad) : nullptr,
-                                model->rotations[p.a].coeffs().data(), model->rotations[p.b].coeffs().data(),
-                                &model->kappa);
+      residuals.push_back(RingResidual(p, i, baseline, *model));
+      ceres::LossFunction* loss = scale_rad > 0.0 ? new ceres::CauchyLoss(scale_rad) : nullptr;
+      if (scaled) {
+        problem->AddResidualBlock(new ceres::AutoDiffCostFunction<ScaledRingEpipolarError, 1, 4, 4, 1>(
+                                      new ScaledRingEpipolarError(p.bearings_a[i], p.bearings_b[i], baseline)),
+                                  loss, q_a, q_b, &model->kappa);
+      } else {
+        problem->AddResidualBlock(new ceres::AutoDiffCostFunction<RingEpipolarError, 1, 4, 4>(
+                                      new RingEpipolarError(p.bearings_a[i], p.bearings_b[i], baseline)),
+                                  loss, q_a, q_b);
+      }
     }
   }
+  if (scaled && !scale_free) problem->SetParameterBlockConstant(&model->kappa);
   return residuals;
 }
 
@@ -528,8 +573,7 @@ RingModel RefineRing(const std::vector<PairState>& pairs, const std::vector<std:
                      RingModel model, double scale_rad, double prior_sigma_deg, double angle_scale_sigma) {
   ceres::Problem problem;
   for (auto& q : model.rotations) problem.AddParameterBlock(q.coeffs().data(), 4, new ceres::EigenQuaternionManifold);
-  problem.AddParameterBlock(&model.kappa, 1);
-  AddRingResiduals(pairs, inliers, rig, scale_rad, &model, &problem);
+  AddRingResiduals(pairs, inliers, rig, scale_rad, angle_scale_sigma > 0.0, &model, &problem);
   // Priors as strong as ten matches at the Cauchy scale for an error of one sigma.
   const double weight = std::sqrt(10.0) * scale_rad / (prior_sigma_deg * kDeg);
   problem.AddResidualBlock(new ceres::AutoDiffCostFunction<RotationPrior, 3, 4>(new RotationPrior(model.rotations[0], weight)),
@@ -538,8 +582,6 @@ RingModel RefineRing(const std::vector<PairState>& pairs, const std::vector<std:
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<AngleScalePrior, 1, 1>(
                                  new AngleScalePrior(std::sqrt(10.0) * scale_rad / angle_scale_sigma)),
                              nullptr, &model.kappa);
-  } else {
-    problem.SetParameterBlockConstant(&model.kappa);
   }
   ceres::Solver::Options options;
   options.max_num_iterations = 100;
@@ -561,9 +603,7 @@ double RingUncertaintyDeg(const std::vector<PairState>& pairs, const std::vector
   ceres::Problem problem;
   for (auto& q : model.rotations) problem.AddParameterBlock(q.coeffs().data(), 4, new ceres::EigenQuaternionManifold);
   problem.SetParameterBlockConstant(model.rotations[0].coeffs().data());
-  problem.AddParameterBlock(&model.kappa, 1);
-  if (!angle_scale_free) problem.SetParameterBlockConstant(&model.kappa);
-  std::vector<double> residuals = AddRingResiduals(pairs, inliers, rig, 0.0, &model, &problem);
+  std::vector<double> residuals = AddRingResiduals(pairs, inliers, rig, 0.0, angle_scale_free, &model, &problem);
   if (residuals.size() < 10) return -1.0;
   std::nth_element(residuals.begin(), residuals.begin() + residuals.size() / 2, residuals.end());
   const double sigma = 1.4826 * residuals[residuals.size() / 2];
@@ -599,10 +639,10 @@ std::vector<std::vector<int>> ReselectInliers(const std::vector<PairState>& pair
     const Eigen::Vector3d baseline_in_rig = PairBaselineInRig(p, rig);
     const Eigen::Vector3d baseline_in_a = (qa * baseline_in_rig).normalized();
     for (size_t i = 0; i < p.bearings_a.size(); ++i) {
-      const RingEpipolarError e(p.bearings_a[i], p.bearings_b[i], baseline_in_rig);
-      if (std::abs(e(qa, model.rotations[p.b], model.kappa)) < threshold_rad &&
-          InFrontOfBoth(ScaleOffAxisAngle(p.bearings_a[i], model.kappa),
-                        a_from_b * ScaleOffAxisAngle(p.bearings_b[i], model.kappa), baseline_in_a)) {
+      const int m = static_cast<int>(i);
+      if (RingResidual(p, m, baseline_in_rig, model) < threshold_rad &&
+          InFrontOfBoth(ScaledBearing(p.bearings_a[i], model.kappa),
+                        a_from_b * ScaledBearing(p.bearings_b[i], model.kappa), baseline_in_a)) {
         out[k].push_back(static_cast<int>(i));
       }
     }
@@ -615,10 +655,7 @@ double MedianResidualDeg(const PairState& p, const std::vector<int>& indices, co
   if (indices.empty()) return -1.0;
   const Eigen::Vector3d baseline_in_rig = PairBaselineInRig(p, rig);
   std::vector<double> residuals;
-  for (int i : indices) {
-    const RingEpipolarError e(p.bearings_a[i], p.bearings_b[i], baseline_in_rig);
-    residuals.push_back(std::abs(e(model.rotations[p.a], model.rotations[p.b], model.kappa)));
-  }
+  for (int i : indices) residuals.push_back(RingResidual(p, i, baseline_in_rig, model));
   std::nth_element(residuals.begin(), residuals.begin() + residuals.size() / 2, residuals.end());
   return std::asin(std::min(1.0, residuals[residuals.size() / 2])) / kDeg;
 }
@@ -633,8 +670,8 @@ double PairDisagreementDeg(const PairState& p, const std::vector<int>& inliers, 
   const Eigen::Vector3d baseline_in_a = (qa * PairBaselineInRig(p, rig)).normalized();
   opengv::bearingVectors_t scaled_a(p.bearings_a.size()), scaled_b(p.bearings_b.size());
   for (int i : inliers) {
-    scaled_a[i] = ScaleOffAxisAngle(p.bearings_a[i], model.kappa);
-    scaled_b[i] = ScaleOffAxisAngle(p.bearings_b[i], model.kappa);
+    scaled_a[i] = ScaledBearing(p.bearings_a[i], model.kappa);
+    scaled_b[i] = ScaledBearing(p.bearings_b[i], model.kappa);
   }
   const Eigen::Quaterniond own = RefineWithBaseline(scaled_a, scaled_b, inliers, baseline_in_a, joint_a_from_b, scale_rad);
   return RotationDistanceDeg(own, joint_a_from_b);
@@ -696,13 +733,13 @@ struct JointSolution {
 };
 
 // The joint refinement (RefineRing) from `start` (cam_j_from_rig, kappa 0) on the pairs' own inliers
-// (the angle scale estimated only around a closed ring),
+// (the angle scale estimated when `estimate_scale`),
 // then `joint_rounds` times: inliers re-selected from every match by the joint solution, refined again.
 JointSolution SolveJoint(const std::vector<PairState>& pairs, const std::vector<std::vector<int>>& pair_inliers,
                          const Rig& rig, const std::vector<Eigen::Quaterniond>& start, const RingCalibrationOptions& o,
-                         bool closed_ring) {
+                         bool estimate_scale) {
   const double scale = o.inlier_threshold_deg * kDeg;
-  const double angle_scale_sigma = closed_ring ? o.angle_scale_sigma : 0.0;  // an open ring does not see it
+  const double angle_scale_sigma = estimate_scale ? o.angle_scale_sigma : 0.0;
   JointSolution s;
   s.inliers = pair_inliers;
   s.model.rotations = start;
@@ -715,6 +752,19 @@ JointSolution SolveJoint(const std::vector<PairState>& pairs, const std::vector<
   s.total_inliers = 0;
   for (const auto& v : s.inliers) s.total_inliers += static_cast<int>(v.size());
   return s;
+}
+
+// The joint solution from each of `starts` (cam_j_from_rig) with the most inliers, the angle scale
+// estimated when `estimate_scale`.
+JointSolution BestJointSolution(const std::vector<PairState>& pairs, const std::vector<std::vector<int>>& pair_inliers,
+                                const Rig& rig, const std::vector<std::vector<Eigen::Quaterniond>>& starts,
+                                const RingCalibrationOptions& o, bool estimate_scale) {
+  JointSolution best;
+  for (const auto& start : starts) {
+    JointSolution candidate = SolveJoint(pairs, pair_inliers, rig, start, o, estimate_scale);
+    if (candidate.total_inliers > best.total_inliers) best = std::move(candidate);
+  }
+  return best;
 }
 
 // Starting points (cam_j_from_cam0) of the joint refinement: the pairs averaged around the ring
@@ -762,12 +812,13 @@ RingCalibrationReport RingCalibrator::Solve() const {
     return report;
   }
   const Eigen::Quaterniond cam0_from_rig = rig.cameras[0].cam_from_rig.rotation;
-  JointSolution best;
-  for (const std::vector<Eigen::Quaterniond>& start : JointStarts(report.pairs, n, rotations)) {
-    std::vector<Eigen::Quaterniond> start_from_rig = start;
-    for (auto& q : start_from_rig) q = (q * cam0_from_rig).normalized();  // cam_j_from_rig
-    JointSolution candidate = SolveJoint(impl_->pairs, inliers, rig, start_from_rig, o, report.loop_error_deg >= 0.0);
-    if (candidate.total_inliers > best.total_inliers) best = std::move(candidate);
+  std::vector<std::vector<Eigen::Quaterniond>> starts = JointStarts(report.pairs, n, rotations);
+  for (auto& start : starts) {
+    for (auto& q : start) q = (q * cam0_from_rig).normalized();  // cam_j_from_rig
+  }
+  JointSolution best = BestJointSolution(impl_->pairs, inliers, rig, starts, o, report.loop_error_deg >= 0.0);
+  if (std::abs(best.model.kappa) < o.min_angle_scale_change) {
+    best = BestJointSolution(impl_->pairs, inliers, rig, starts, o, false);  // the lenses as given
   }
   const RingModel& model = best.model;
   inliers = best.inliers;
@@ -775,8 +826,7 @@ RingCalibrationReport RingCalibrator::Solve() const {
   const double scale = o.inlier_threshold_deg * kDeg;
   RingModel given;
   for (const RigCamera& c : rig.cameras) given.rotations.push_back(c.cam_from_rig.rotation);
-  report.uncertainty_deg =
-      RingUncertaintyDeg(impl_->pairs, inliers, rig, model, o.angle_scale_sigma > 0.0 && report.loop_error_deg >= 0.0);
+  report.uncertainty_deg = RingUncertaintyDeg(impl_->pairs, inliers, rig, model, model.kappa != 0.0);
   for (size_t k = 0; k < impl_->pairs.size(); ++k) {
     RingPairEstimate& p = report.pairs[k];
     if (!p.usable) continue;

@@ -53,7 +53,7 @@ struct RingCalibrationOptions {
   int ransac_iterations = 2000;
   int min_inliers = 25;                // fewer: the pair is not estimated
   double max_loop_error_deg = 12.0;    // larger loop-closure error of the pairs: not converged
-  double max_pair_disagreement_deg = 1.0;  // a pair further from the joint ring solution: not converged
+  double max_pair_disagreement_deg = 0.5;  // a pair further from the joint ring solution: not converged
   bool require_closed_ring = true;     // every ring pair estimated (the loop checks them), else not converged
   double max_uncertainty_deg = 0.25;   // one sigma of the worst camera (RingUncertaintyDeg) above: not converged
   int joint_rounds = 2;                // inliers re-selected by the joint solution, then refined again
@@ -62,6 +62,7 @@ struct RingCalibrationOptions {
   // around a closed ring, kappa with this prior standard deviation (a real lens calibration that
   // understates angles near the rim leaves the ring open by degrees); 0: the lenses as given.
   double angle_scale_sigma = 0.03;
+  double min_angle_scale_change = 0.005;  // a smaller estimate of |kappa|: the lenses stay as given
   void Check() const;
 };
 
