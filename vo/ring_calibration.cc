@@ -816,9 +816,15 @@ RingCalibrationReport RingCalibrator::Solve() const {
   for (auto& start : starts) {
     for (auto& q : start) q = (q * cam0_from_rig).normalized();  // cam_j_from_rig
   }
-  JointSolution best = BestJointSolution(impl_->pairs, inliers, rig, starts, o, report.loop_error_deg >= 0.0);
-  if (std::abs(best.model.kappa) < o.min_angle_scale_change) {
-    best = BestJointSolution(impl_->pairs, inliers, rig, starts, o, false);  // the lenses as given
+  JointSolution best = BestJointSolution(impl_->pairs, inliers, rig, starts, o, false);  // the lenses as given
+  if (o.angle_scale_sigma > 0.0 && report.loop_error_deg >= 0.0) {  // an open ring does not see the scale
+    // The scale refined from that solution says whether it matters; only then are all starts solved
+    // again with it free (refined from one solution alone, the draws of real shots agree less).
+    const JointSolution probe = SolveJoint(impl_->pairs, inliers, rig, best.model.rotations, o, true);
+    if (std::abs(probe.model.kappa) >= o.min_angle_scale_change) {
+      JointSolution scaled = BestJointSolution(impl_->pairs, inliers, rig, starts, o, true);
+      if (std::abs(scaled.model.kappa) >= o.min_angle_scale_change) best = std::move(scaled);
+    }
   }
   const RingModel& model = best.model;
   inliers = best.inliers;
