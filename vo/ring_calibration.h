@@ -15,14 +15,17 @@
 //      differ by more than max_prior_angle_deg is dropped: a gross-outlier bound, above any error of
 //      a sigma = 5 deg draw.
 //   3. The matches of every frame given (AddFrame) are pooled: the cameras' relative pose is the
-//      same in every synchronous shot. A 5-point relative-pose RANSAC on the bearings (OpenGV,
-//      Stewenius) and a non-linear refinement on its inliers give
+//      same in every synchronous shot. A rotation-only RANSAC on the bearings (OpenGV) removes gross
+//      mismatches, and the epipolar residuals with the baseline direction held at its nominal value
+//      refine
 //          R_ba = rotation of cam_b_from_cam_a   (x_in_b = R_ba x_in_a + t_ba).
 // Ring: with R_j = rotation of cam_j_from_cam0 (camera 0 is the gauge, R_0 = I), the pair rotations
 // are averaged by
 //     min over R_1..R_{N-1} of  sum_(a,b) w_ab |Log(R_b R_a^T R_ba^T)|^2,   w_ab = inliers of (a, b)
-// (Ceres), started by chaining the pairs from camera 0. Loop closure, |Log(prod of R_ba around the
-// ring)|, checks the pairs' consistency. The result keeps every camera's centre in the rig frame
+// (Ceres), started by chaining the pairs from camera 0, then refined jointly on every pair's epipolar
+// residuals, each baseline direction following its camera, with one angle scale of every lens's
+// off-axis angle (angle_scale_sigma). Loop closure, |Log(prod of R_ba around the ring)|, checks the
+// pairs' consistency. The result keeps every camera's centre in the rig frame
 // (the perturbation protocol turns cameras about their centres).
 
 #include "datasets/rig.h"

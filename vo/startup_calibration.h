@@ -3,8 +3,9 @@
 // within a fraction of a degree, before the local BA takes over (local_ba.h).
 //
 //   1. Ring stage (ring_calibration.h), no extrinsic prior: the rotation of each ring pair from
-//      descriptor matches over its whole overlap (5-point RANSAC on bearings), pooled over `shots`
-//      synchronous shots, averaged around the ring into cam_j_from_cam0.
+//      descriptor matches over its whole overlap (rotation-only RANSAC on bearings, then epipolar
+//      residuals with the known baseline), pooled over `shots` synchronous shots, averaged around the
+//      ring into cam_j_from_cam0 and refined jointly.
 //      The joint refinement also estimates one angle scale of every lens (a real lens calibration
 //      that understates angles near the rim). When this fails, it runs once more as a rescue
 //      (StartupCalibrationOptions::rescue) with more and weaker features.
@@ -34,7 +35,7 @@ struct StartupCalibrationOptions {
   int shot_spacing = 10;              // frames between two shots
   RingCalibrationOptions ring;
   int ring_passes = 2;                // > 1: the ring stage again with views placed by the previous result
-  bool refine_second_pass = true;     // KLT sub-pixel matches in the second pass (its views are aligned)
+  bool refine_second_pass = true;     // KLT sub-pixel matches in the later passes (their views are aligned)
   double max_pass_change_deg = 0.5;   // a later pass moving a camera further: not converged
   // When the ring passes fail, once more with more and weaker features (an overlap with little
   // texture, a real camera's low contrast).
