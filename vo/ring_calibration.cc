@@ -527,29 +527,33 @@ Eigen::Vector3d PairBaselineInRig(const PairState& p, const Rig& rig) {
   return CameraPositionInRig(rig.cameras[p.b].cam_from_rig) - CameraPositionInRig(rig.cameras[p.a].cam_from_rig);
 }
 
-// |RingEpipolarResidual| of match `i` of pair `p` under `model`.
-double RingResidual(const PairState& p, int i, const Eigen::Vector3d& baseline_in_rig, const RingModel& model) {
-  const Eigen::Vector3d b_a = ScaledBearing(p.bearings_a[i], model.kappa);
-  const Eigen::Vector3d b_b = ScaledBearing(p.bearings_b[i], model.kappa);
+// |RingEpipolarResidual| of bearings `b_a`, `b_b` (already scaled) of pair `p` under `model`.
+double RingResidual(const PairState& p, const Eigen::Vector3d& b_a, const Eigen::Vector3d& b_b,
+                    const Eigen::Vector3d& baseline_in_rig, const RingModel& model) {
   return std::abs(RingEpipolarResidual<double>(model.rotations[p.a].coeffs().data(), model.rotations[p.b].coeffs().data(),
                                                b_a, b_b, baseline_in_rig));
 }
 
+// |RingEpipolarResidual| of match `i` of pair `p` under `model`.
+double RingResidual(const PairState& p, int i, const Eigen::Vector3d& baseline_in_rig, const RingModel& model) {
+  return RingResidual(p, ScaledBearing(p.bearings_a[i], model.kappa), ScaledBearing(p.bearings_b[i], model.kappa),
+                      baseline_in_rig, model);
+}
+
 // The ring's epipolar residuals of the `inliers` (per pair) as blocks of `problem` on `model`'s
 // rotations, and on its angle scale when that is free or not 0 (Cauchy at `scale_rad`; plain least
-// squares when scale_rad <= 0). Returns the |residuals| at `model`.
-std::vector<double> AddRingResiduals(const std::vector<PairState>& pairs, const std::vector<std::vector<int>>& inliers,
-                                     const Rig& rig, double scale_rad, bool scale_free, RingModel* model,
-                                     ceres::Problem* problem) {
+// squares when scale_rad <= 0). `residuals`, when given, receives their |values| at `model`.
+void AddRingResiduals(const std::vector<PairState>& pairs, const std::vector<std::vector<int>>& inliers, const Rig& rig,
+                      double scale_rad, bool scale_free, RingModel* model, ceres::Problem* problem,
+                      std::vector<double>* residuals = nullptr) {
   const bool scaled = scale_free || model->kappa != 0.0;
-  std::vector<double> residuals;
   for (size_t k = 0; k < pairs.size(); ++k) {
     const PairState& p = pairs[k];
     const Eigen::Vector3d baseline = PairBaselineInRig(p, rig);
     double* q_a = model->rotations[p.a].coeffs().data();
     double* q_b = model->rotations[p.b].coeffs().data();
     for (int i : inliers[k]) {
-      residuals.push_back(RingResidual(p, i, baseline, *model));
+      if (residuals) residuals->push_back(RingResidual(p, i, baseline, *model));
       ceres::LossFunction* loss = scale_rad > 0.0 ? new ceres::CauchyLoss(scale_rad) : nullptr;
       if (scaled) {
         problem->AddResidualBlock(new ceres::AutoDiffCostFunction<ScaledRingEpipolarError, 1, 4, 4, 1>(
@@ -563,7 +567,6 @@ std::vector<double> AddRingResiduals(const std::vector<PairState>& pairs, const 
     }
   }
   if (scaled && !scale_free) problem->SetParameterBlockConstant(&model->kappa);
-  return residuals;
 }
 
 // Refines every cam_j_from_rig rotation on all pairs' inlier matches at once (RingEpipolarError,
@@ -603,7 +606,8 @@ double RingUncertaintyDeg(const std::vector<PairState>& pairs, const std::vector
   ceres::Problem problem;
   for (auto& q : model.rotations) problem.AddParameterBlock(q.coeffs().data(), 4, new ceres::EigenQuaternionManifold);
   problem.SetParameterBlockConstant(model.rotations[0].coeffs().data());
-  std::vector<double> residuals = AddRingResiduals(pairs, inliers, rig, 0.0, angle_scale_free, &model, &problem);
+  std::vector<double> residuals;
+  AddRingResiduals(pairs, inliers, rig, 0.0, angle_scale_free, &model, &problem, &residuals);
   if (residuals.size() < 10) return -1.0;
   std::nth_element(residuals.begin(), residuals.begin() + residuals.size() / 2, residuals.end());
   const double sigma = 1.4826 * residuals[residuals.size() / 2];
@@ -639,10 +643,10 @@ std::vector<std::vector<int>> ReselectInliers(const std::vector<PairState>& pair
     const Eigen::Vector3d baseline_in_rig = PairBaselineInRig(p, rig);
     const Eigen::Vector3d baseline_in_a = (qa * baseline_in_rig).normalized();
     for (size_t i = 0; i < p.bearings_a.size(); ++i) {
-      const int m = static_cast<int>(i);
-      if (RingResidual(p, m, baseline_in_rig, model) < threshold_rad &&
-          InFrontOfBoth(ScaledBearing(p.bearings_a[i], model.kappa),
-                        a_from_b * ScaledBearing(p.bearings_b[i], model.kappa), baseline_in_a)) {
+      const Eigen::Vector3d b_a = ScaledBearing(p.bearings_a[i], model.kappa);
+      const Eigen::Vector3d b_b = ScaledBearing(p.bearings_b[i], model.kappa);
+      if (RingResidual(p, b_a, b_b, baseline_in_rig, model) < threshold_rad &&
+          InFrontOfBoth(b_a, a_from_b * b_b, baseline_in_a)) {
         out[k].push_back(static_cast<int>(i));
       }
     }

@@ -2,6 +2,7 @@
 // calibration as the reference), from seeded sigma = 5 deg draws not used for tuning.
 #include "datasets/dataset.h"
 #include "datasets/omnimvs.h"
+#include "tests/vo/extrinsic_error.h"
 #include "vo/image_loader.h"
 #include "vo/startup_calibration.h"
 
@@ -13,15 +14,6 @@
 namespace rovo {
 namespace {
 namespace fs = std::filesystem;
-
-double ErrorDeg(const std::vector<Rigid3>& est, const std::vector<Rigid3>& truth) {
-  double worst = 0.0;
-  for (size_t i = 1; i < est.size(); ++i) {
-    worst = std::max(worst, RotationDistanceDeg(est[i].rotation * est[0].rotation.inverse(),
-                                                truth[i].rotation * truth[0].rotation.inverse()));
-  }
-  return worst;
-}
 
 class RealRigCalibration : public ::testing::Test {
  protected:
@@ -55,11 +47,11 @@ class RealRigCalibration : public ::testing::Test {
                              LoadStaticMasks(dir_, info.rig, info.has_static_masks), options, true);
       if (!r.converged) continue;
       ++out.converged;
-      const double error = ErrorDeg(r.cam_from_rig, info.rig.Extrinsics());
+      const double error = RelativeExtrinsicErrorDeg(r.cam_from_rig, info.rig.Extrinsics());
       out.close += error < bound_deg ? 1 : 0;
       out.min_angle_scale = std::min(out.min_angle_scale, r.ring.angle_scale);
       out.max_angle_scale = std::max(out.max_angle_scale, r.ring.angle_scale);
-      for (const auto& other : results) out.agreement_deg = std::max(out.agreement_deg, ErrorDeg(r.cam_from_rig, other));
+      for (const auto& other : results) out.agreement_deg = std::max(out.agreement_deg, RelativeExtrinsicErrorDeg(r.cam_from_rig, other));
       results.push_back(r.cam_from_rig);
       std::fprintf(stderr, "frame %d shots %d draw %d: %.3f deg from the file's calibration, lens angle scale %.4f\n",
                    frame, shots, static_cast<int>(first_seed + k), error, r.ring.angle_scale);

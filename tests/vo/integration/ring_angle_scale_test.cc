@@ -4,6 +4,7 @@
 // large (the equidistant focal lengths divided by 1.015) it finds the scale that undoes that and
 // still calibrates the extrinsics from a sigma = 5 deg draw.
 #include "datasets/dataset.h"
+#include "tests/vo/extrinsic_error.h"
 #include "vo/image_loader.h"
 #include "vo/ring_calibration.h"
 
@@ -16,15 +17,6 @@
 
 namespace rovo {
 namespace {
-
-double RelativeErrorDeg(const std::vector<Rigid3>& est, const std::vector<Rigid3>& truth) {
-  double worst = 0.0;
-  for (size_t i = 1; i < est.size(); ++i) {
-    worst = std::max(worst, RotationDistanceDeg(est[i].rotation * est[0].rotation.inverse(),
-                                                truth[i].rotation * truth[0].rotation.inverse()));
-  }
-  return worst;
-}
 
 class RingAngleScale : public ::testing::Test {
  protected:
@@ -61,23 +53,23 @@ TEST_F(RingAngleScale, ExactLensesKeepScaleOne) {
   const RingCalibrationReport r = Calibrate(1.0, 0.03, 8101);
   ASSERT_TRUE(r.converged) << r.reason;
   EXPECT_NEAR(r.angle_scale, 1.0, 0.003);
-  EXPECT_LT(RelativeErrorDeg(r.cam_from_rig, Truth()), 0.5);
+  EXPECT_LT(RelativeExtrinsicErrorDeg(r.cam_from_rig, Truth()), 0.5);
 }
 
 TEST_F(RingAngleScale, FindsTheScaleOfLensesThatOverstateAngles) {
   const RingCalibrationReport r = Calibrate(1.015, 0.03, 8101);
   ASSERT_TRUE(r.converged) << r.reason;
   EXPECT_NEAR(r.angle_scale, 1.0 / 1.015, 0.004);
-  const double with_scale = RelativeErrorDeg(r.cam_from_rig, Truth());
+  const double with_scale = RelativeExtrinsicErrorDeg(r.cam_from_rig, Truth());
   EXPECT_LT(with_scale, 0.5);
   // The lenses as given leave the ring open by degrees: the result is worse, or refused.
   const RingCalibrationReport fixed = Calibrate(1.015, 0.0, 8101);
   if (fixed.converged) {
-    EXPECT_GT(RelativeErrorDeg(fixed.cam_from_rig, Truth()), with_scale);
+    EXPECT_GT(RelativeExtrinsicErrorDeg(fixed.cam_from_rig, Truth()), with_scale);
   }
   std::fprintf(stderr, "declared 1.015: scale %.4f, error %.3f deg; lenses as given: %s, error %.3f deg\n",
                r.angle_scale, with_scale, fixed.converged ? "converged" : fixed.reason.c_str(),
-               RelativeErrorDeg(fixed.cam_from_rig, Truth()));
+               RelativeExtrinsicErrorDeg(fixed.cam_from_rig, Truth()));
 }
 
 }  // namespace

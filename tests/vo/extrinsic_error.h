@@ -1,0 +1,20 @@
+#pragma once
+// Test helper: the largest, over cameras i >= 1, of the rotation angle between est(cam_i_from_cam0)
+// and truth(cam_i_from_cam0), degrees (eval's ExtrinsicErrorDeg, for tests that link vo only).
+#include "datasets/rigid3.h"
+
+#include <algorithm>
+#include <vector>
+
+namespace rovo {
+
+inline double RelativeExtrinsicErrorDeg(const std::vector<Rigid3>& est, const std::vector<Rigid3>& truth) {
+  double worst = 0.0;
+  for (size_t i = 1; i < est.size(); ++i) {
+    worst = std::max(worst, RotationDistanceDeg(est[i].rotation * est[0].rotation.inverse(),
+                                                truth[i].rotation * truth[0].rotation.inverse()));
+  }
+  return worst;
+}
+
+}  // namespace rovo
