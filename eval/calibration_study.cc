@@ -155,6 +155,24 @@ std::string ReproduceCommand(const CalibrationStudyOptions& o) {
   return s.str();
 }
 
+nlohmann::json StartupExtrinsicsJson(const std::vector<Rigid3>& cam_from_rig) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const Rigid3& t : cam_from_rig) out.push_back(Rigid3ToJson(t));
+  return out;
+}
+
+nlohmann::json FitScoreJson(const FitScore& s) { return {{"inliers", s.inliers}, {"median_deg", s.median_deg}}; }
+
+nlohmann::json OverlapFitJson(const OverlapFit& fit) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const OverlapFitRow& r : fit.rows) {
+    rows.push_back({{"frame", r.frame}, {"camera_a", r.camera_a}, {"camera_b", r.camera_b}, {"matches", r.matches},
+                    {"given", FitScoreJson(r.given)}, {"given_scaled", FitScoreJson(r.given_scaled)},
+                    {"results", FitScoreJson(r.results)}});
+  }
+  return {{"results", fit.results}, {"angle_scale", fit.angle_scale}, {"rows", rows}};
+}
+
 void WriteOutputs(const CalibrationStudyOptions& o, const DatasetInfo& info, const CalibrationStudyResult& result) {
   std::ostringstream csv;
   csv << "seed,before_deg,startup_deg,at50_deg,at100_deg,end_deg,startup_converged,converged,lens_angle_scale\n";
@@ -167,7 +185,8 @@ void WriteOutputs(const CalibrationStudyOptions& o, const DatasetInfo& info, con
     rows.push_back({{"seed", d.seed}, {"before_deg", d.before_deg}, {"startup_deg", d.startup_deg},
                     {"at50_deg", d.at50_deg}, {"at100_deg", d.at100_deg}, {"end_deg", d.end_deg},
                     {"startup_converged", d.startup_converged}, {"startup_status", d.startup_status},
-                    {"lens_angle_scale", d.lens_angle_scale}, {"converged", d.converged}});
+                    {"lens_angle_scale", d.lens_angle_scale}, {"converged", d.converged},
+                    {"startup_cam_from_rig", StartupExtrinsicsJson(d.startup_cam_from_rig)}});
     if (!d.converged) failures.push_back(d.seed);
   }
   const double bound = Bound(o);
@@ -180,7 +199,8 @@ void WriteOutputs(const CalibrationStudyOptions& o, const DatasetInfo& info, con
       {"startup_agreement_deg", result.startup_agreement_deg},
       {"converged_below_deg", bound}, {"converged", result.converged},
       {"rate", result.draws.empty() ? 0.0 : static_cast<double>(result.converged) / result.draws.size()},
-      {"failed_seeds", failures}, {"reproduce", result.reproduce}, {"per_draw", rows}};
+      {"failed_seeds", failures}, {"reproduce", result.reproduce}, {"per_draw", rows},
+      {"overlap_fit", OverlapFitJson(result.overlap_fit)}};
   WriteFileAtomic((fs::path(o.out_dir) / "calibration.csv").string(), csv.str());
   WriteJsonFileAtomic((fs::path(o.out_dir) / "calibration.json").string(), j);
 }
@@ -209,6 +229,7 @@ std::string Table(const CalibrationStudyOptions& o, const CalibrationStudyResult
     }
     s << "\n";
   }
+  if (!result.overlap_fit.rows.empty()) s << "\n" << OverlapFitTable(result.overlap_fit);
   return s.str();
 }
 
@@ -267,6 +288,11 @@ CalibrationStudyResult RunCalibrationStudy(const CalibrationStudyOptions& option
           result.startup_agreement_deg, ExtrinsicErrorDeg(agreeing[i]->startup_cam_from_rig, agreeing[j]->startup_cam_from_rig));
     }
   }
+  if (!o.fit_frames.empty()) {
+    std::vector<FitCalibration> converged;
+    for (const CalibrationDraw* d : agreeing) converged.push_back({d->startup_cam_from_rig, d->lens_angle_scale});
+    result.overlap_fit = FitOverlaps(o.dataset_dir, info, o.fit_frames, converged);
+  }
   WriteOutputs(o, info, result);
   const std::string table = Table(o, result);
   WriteFileAtomic((fs::path(o.out_dir) / "calibration.md").string(), table);
@@ -307,6 +333,10 @@ void AddCalibrationStudyCommand(CLI::App* study) {
                   "A draw converged when its error ends below this (degrees; default 0.5 with --shot-only, else 0.1)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--threads", options->threads, "Threads of each run (0: all cores)")->capture_default_str();
+  cmd->add_option("--fit-frames", options->fit_frames,
+                  "Frames whose own overlap matches judge the dataset's calibration against the converged start-up "
+                  "results (inliers and residuals per ring pair)")
+      ->delimiter(',');
   cmd->add_flag("--quiet", options->quiet, "No progress output");
   cmd->callback([options] {
     const CalibrationStudyResult result = RunCalibrationStudy(*options);

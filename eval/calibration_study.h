@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "datasets/rigid3.h"
+#include "eval/overlap_fit.h"
 
 namespace CLI {
 class App;
@@ -39,6 +40,9 @@ struct CalibrationStudyOptions {
   double shot_converged_deg = 0.5;  // shot_only: the start-up error below: converged
   double bound_deg = -1.0;       // > 0: replaces converged_deg / shot_converged_deg
   bool quiet = false;
+  // Frames whose own overlap matches judge the dataset's calibration against the converged start-up
+  // results (eval/overlap_fit.h); empty: none.
+  std::vector<int> fit_frames;
 };
 
 struct CalibrationDraw {
@@ -61,6 +65,7 @@ struct CalibrationStudyResult {
   double startup_agreement_deg = -1.0;
   int startup_converged = 0;
   std::string reproduce;            // command template for one draw ("{seed}" replaced)
+  OverlapFit overlap_fit;           // with fit_frames
 };
 
 // The extrinsic error in degrees (above) of `est` against `truth` (cam_from_rig per camera).

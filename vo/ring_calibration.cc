@@ -631,6 +631,52 @@ double RingUncertaintyDeg(const std::vector<PairState>& pairs, const std::vector
   return worst;
 }
 
+// RingEpipolarResidual of `model`'s cameras all turned by one rig-frame rotation (the parameter).
+struct CommonRotationError {
+  CommonRotationError(const Eigen::Quaterniond& cam_a_from_rig, const Eigen::Quaterniond& cam_b_from_rig,
+                      const Eigen::Vector3d& bearing_a, const Eigen::Vector3d& bearing_b,
+                      const Eigen::Vector3d& baseline_in_rig)
+      : qa(cam_a_from_rig), qb(cam_b_from_rig), bearing_a(bearing_a), bearing_b(bearing_b),
+        baseline_in_rig(baseline_in_rig) {}
+  template <typename T>
+  bool operator()(const T* q_turn, T* residual) const {
+    const Eigen::Quaternion<T> turn(q_turn[3], q_turn[0], q_turn[1], q_turn[2]);
+    const Eigen::Quaternion<T> a = qa.cast<T>() * turn, b = qb.cast<T>() * turn;
+    residual[0] = RingEpipolarResidual<T>(a.coeffs().data(), b.coeffs().data(), bearing_a.cast<T>(),
+                                          bearing_b.cast<T>(), baseline_in_rig);
+    return true;
+  }
+  Eigen::Quaterniond qa, qb;
+  Eigen::Vector3d bearing_a, bearing_b, baseline_in_rig;
+};
+
+// `model` with every camera turned by the rig-frame rotation that best explains all the pairs'
+// matches (Cauchy at `scale_rad`): the relative rotations and the angle scale stay.
+RingModel FitCommonRotation(const std::vector<PairState>& pairs, const Rig& rig, RingModel model, double scale_rad) {
+  Eigen::Quaterniond turn = Eigen::Quaterniond::Identity();
+  ceres::Problem problem;
+  problem.AddParameterBlock(turn.coeffs().data(), 4, new ceres::EigenQuaternionManifold);
+  int residuals = 0;
+  for (const PairState& p : pairs) {
+    const Eigen::Vector3d baseline = PairBaselineInRig(p, rig);
+    for (size_t i = 0; i < p.bearings_a.size(); ++i) {
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<CommonRotationError, 1, 4>(new CommonRotationError(
+                                   model.rotations[p.a], model.rotations[p.b], ScaledBearing(p.bearings_a[i], model.kappa),
+                                   ScaledBearing(p.bearings_b[i], model.kappa), baseline)),
+                               new ceres::CauchyLoss(scale_rad), turn.coeffs().data());
+      ++residuals;
+    }
+  }
+  if (residuals < 3) return model;
+  ceres::Solver::Options options;
+  options.max_num_iterations = 50;
+  options.num_threads = 1;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  for (auto& q : model.rotations) q = (q * turn).normalized();
+  return model;
+}
+
 // Per pair, the indices of the matches that the joint model explains: epipolar residual
 // (RingEpipolarError) below `threshold_rad` and the rays meeting in front of both cameras.
 std::vector<std::vector<int>> ReselectInliers(const std::vector<PairState>& pairs, const Rig& rig,
@@ -789,6 +835,37 @@ std::vector<std::vector<Eigen::Quaterniond>> JointStarts(const std::vector<RingP
 }
 
 }  // namespace
+
+std::vector<RingPairFit> RingCalibrator::Fit(const std::vector<Rigid3>& cam_from_rig, double angle_scale) const {
+  const Rig& rig = impl_->rig;
+  if (static_cast<int>(cam_from_rig.size()) != rig.NumCameras()) {
+    throw std::invalid_argument("RingCalibrator::Fit: " + std::to_string(cam_from_rig.size()) + " extrinsics for " +
+                                std::to_string(rig.NumCameras()) + " cameras");
+  }
+  RingModel model;
+  for (const Rigid3& t : cam_from_rig) model.rotations.push_back(t.rotation.normalized());
+  model.kappa = angle_scale - 1.0;
+  model = FitCommonRotation(impl_->pairs, rig, model, impl_->options.inlier_threshold_deg * kDeg);
+  const std::vector<std::vector<int>> inliers =
+      ReselectInliers(impl_->pairs, rig, model, impl_->options.inlier_threshold_deg * kDeg);
+  std::vector<RingPairFit> fits;
+  for (size_t k = 0; k < impl_->pairs.size(); ++k) {
+    const PairState& p = impl_->pairs[k];
+    RingPairFit f;
+    f.camera_a = p.a;
+    f.camera_b = p.b;
+    f.matches = static_cast<int>(p.bearings_a.size());
+    f.inliers = static_cast<int>(inliers[k].size());
+    f.median_residual_deg = MedianResidualDeg(p, inliers[k], rig, model);
+    const Eigen::Vector3d baseline_in_rig = PairBaselineInRig(p, rig);
+    for (size_t i = 0; i < p.bearings_a.size(); ++i) {
+      const double r = RingResidual(p, static_cast<int>(i), baseline_in_rig, model);
+      f.residuals_deg.push_back(std::asin(std::min(1.0, r)) / kDeg);
+    }
+    fits.push_back(f);
+  }
+  return fits;
+}
 
 RingCalibrationReport RingCalibrator::Solve() const {
   const Rig& rig = impl_->rig;

@@ -93,6 +93,15 @@ struct RingCalibrationReport {
   std::vector<Rigid3> cam_from_rig;    // calibrated (camera 0 and every centre unchanged)
 };
 
+// How well one calibration explains a ring pair's overlap matches (RingCalibrator::Fit).
+struct RingPairFit {
+  int camera_a = 0, camera_b = 0;
+  int matches = 0;                     // pooled over frames, after the ratio, mutual and prior checks
+  int inliers = 0;                     // epipolar residual below the inlier threshold, in front of both
+  double median_residual_deg = -1.0;   // median |epipolar residual| of those inliers; -1: none
+  std::vector<double> residuals_deg;   // |epipolar residual| of every match
+};
+
 // Ring neighbours: the cameras sorted by the yaw of their nominal optical axis, each paired with the
 // next (and the last with the first when N >= 3). Pairs whose axes are further apart than the
 // lenses' field of view allows an overlap are left out.
@@ -109,6 +118,13 @@ class RingCalibrator {
   // One synchronous shot (8-bit gray or BGR, one image per camera): its overlap matches are pooled.
   void AddFrame(const std::vector<cv::Mat>& images);
   RingCalibrationReport Solve() const;
+  // The pooled overlap matches judged by a given calibration: `cam_from_rig` (rotations used; every
+  // centre stays the rig's) and the lenses' off-axis angle scale (RingCalibrationReport::angle_scale).
+  // The cameras' common rotation against their centres (which the start-up leaves at the given camera
+  // 0's) is first fitted to the matches (Cauchy at the inlier threshold), so only the relative
+  // rotations and the lenses are judged. Two calibrations compared on the same matches: the one that
+  // explains more of them, with smaller residuals, fits the images better.
+  std::vector<RingPairFit> Fit(const std::vector<Rigid3>& cam_from_rig, double angle_scale = 1.0) const;
 
   // The overlap view of pair `pair_index` for camera `side` (0 = a, 1 = b) at the last AddFrame, for
   // drawing and tests.

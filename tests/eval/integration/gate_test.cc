@@ -127,11 +127,21 @@ TEST_F(GateTest, CalibrationConvergesOnFreshDraws) {
   ASSERT_FALSE(dataset.empty()) << data_dir_;
   const std::string shot_dir = suite_dir_ + "/calibration_shot";
   const CommandResult shot = RunShell(std::string(ROVO_BINARY) + " study calibration " + dataset +
-                                      " --shot-only --draws 10 --seed 5000 --threads 2 --quiet --out " + shot_dir);
+                                      " --shot-only --draws 10 --seed 5000 --threads 2 --quiet --fit-frames 0 --out " +
+                                      shot_dir);
   ASSERT_EQ(shot.status, 0) << shot.output;
   const nlohmann::json s = ReadJsonFile(shot_dir + "/calibration.json");
   EXPECT_GE(s.at("converged").get<int>(), 9) << shot.output;
   EXPECT_TRUE(fs::is_regular_file(shot_dir + "/calibration.csv"));
+  // The rendered rig is the truth: the converged results explain frame 0's overlap matches as well as it.
+  const nlohmann::json& fit = s.at("overlap_fit");
+  EXPECT_GE(fit.at("results").get<int>(), 9);
+  EXPECT_NEAR(fit.at("angle_scale").get<double>(), 1.0, 0.005);
+  const nlohmann::json& total = fit.at("rows").back();
+  ASSERT_EQ(total.at("camera_a").get<int>(), -1) << fit.dump();
+  EXPECT_GE(total.at("results").at("inliers").get<int>(), 0.98 * total.at("given").at("inliers").get<int>()) << fit.dump();
+  EXPECT_LT(total.at("results").at("median_deg").get<double>(), total.at("given").at("median_deg").get<double>() + 0.02)
+      << fit.dump();
   const std::string run_dir = suite_dir_ + "/calibration_run";
   const CommandResult run = RunShell(std::string(ROVO_BINARY) + " study calibration " + dataset +
                                      " --draws 3 --seed 6000 --threads 2 --quiet --out " + run_dir);
