@@ -1,5 +1,7 @@
 #include "vo/ring_calibration.h"
 
+#include "vo/orb_matching.h"
+
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 #include <opencv2/features2d.hpp>
@@ -114,22 +116,7 @@ cv::Mat Gray(const cv::Mat& image) {
 // Matches (index in a, index in b) passing the ratio test both ways and the mutual check.
 std::vector<std::pair<int, int>> MutualRatioMatches(const cv::Mat& desc_a, const cv::Mat& desc_b,
                                                     const RingCalibrationOptions& options) {
-  std::vector<std::pair<int, int>> out;
-  if (desc_a.rows < 2 || desc_b.rows < 2) return out;
-  cv::BFMatcher matcher(cv::NORM_HAMMING);
-  std::vector<std::vector<cv::DMatch>> ab, ba;
-  matcher.knnMatch(desc_a, desc_b, ab, 2);
-  matcher.knnMatch(desc_b, desc_a, ba, 2);
-  auto best = [&](const std::vector<cv::DMatch>& m) {
-    if (m.empty() || m[0].distance > options.max_descriptor_distance) return -1;
-    if (m.size() > 1 && m[0].distance > options.max_ratio * m[1].distance) return -1;
-    return m[0].trainIdx;
-  };
-  for (int i = 0; i < static_cast<int>(ab.size()); ++i) {
-    const int j = best(ab[i]);
-    if (j >= 0 && best(ba[j]) == i) out.emplace_back(i, j);
-  }
-  return out;
+  return MutualRatioOrbMatches(desc_a, desc_b, options.max_ratio, options.max_descriptor_distance);
 }
 
 // Local contrast normalisation for KLT: (v - mean) / std over a Gaussian window of `sigma_px`,

@@ -5,7 +5,9 @@
 //   1. Ring stage (ring_calibration.h), no extrinsic prior: the rotation of each ring pair from
 //      descriptor matches over its whole overlap (rotation-only RANSAC on bearings, then epipolar
 //      residuals with the known baseline), pooled over `shots` synchronous shots, averaged around the
-//      ring into cam_j_from_cam0 and refined jointly.
+//      ring into cam_j_from_cam0 and refined jointly. Later passes (ring_passes) place the overlap
+//      views by the previous result, refine the matches by KLT and detect more, weaker corners on
+//      denser views; each must confirm the pass before it.
 //      The joint refinement also estimates one angle scale of every lens (a real lens calibration
 //      that understates angles near the rim). When this fails, it runs once more as a rescue
 //      (StartupCalibrationOptions::rescue) with more and weaker features.
@@ -36,6 +38,11 @@ struct StartupCalibrationOptions {
   RingCalibrationOptions ring;
   int ring_passes = 2;                // > 1: the ring stage again with views placed by the previous result
   bool refine_second_pass = true;     // KLT sub-pixel matches in the later passes (their views are aligned)
+  // The later passes detect more and weaker corners on denser views (at least these): with the views
+  // aligned, more matches make the result depend less on which corners were found.
+  int later_orb_features = 6000;
+  int later_orb_fast_threshold = 5;
+  double later_min_view_focal_px = 450.0;
   double max_pass_change_deg = 0.5;   // a later pass moving a camera further: not converged
   // When the ring passes fail, once more with more and weaker features (an overlap with little
   // texture, a real camera's low contrast).
