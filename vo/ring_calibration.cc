@@ -56,8 +56,11 @@ ViewGeometry MakeViewGeometry(const Rig& rig, int a, int b, const RingCalibratio
   g.rig_from_view.col(0) = m;
   g.rig_from_view.col(2) = Eigen::Vector3d::UnitZ();
   g.rig_from_view.col(1) = Eigen::Vector3d::UnitZ().cross(m);
-  g.focal = std::max(options.min_view_focal_px,
-                     std::min(PixelsPerRadianAt90(rig.cameras[a].camera), PixelsPerRadianAt90(rig.cameras[b].camera)));
+  const double native = std::min(PixelsPerRadianAt90(rig.cameras[a].camera), PixelsPerRadianAt90(rig.cameras[b].camera));
+  g.focal = std::max(options.min_view_focal_px, native);
+  if (options.dense_view_focal_px > 0.0) {
+    g.focal = std::max(g.focal, std::min(options.dense_view_focal_px, options.dense_view_max_upsampling * native));
+  }
   g.width = static_cast<int>(std::lround(2.0 * options.view_half_width_deg * kDeg * g.focal));
   g.height = static_cast<int>(std::lround(2.0 * options.view_half_height_deg * kDeg * g.focal));
   return g;

@@ -43,6 +43,10 @@ struct RingCalibrationOptions {
   double view_half_width_deg = 65.0;   // longitude extent of an overlap view (each side of m)
   double view_half_height_deg = 60.0;  // latitude extent (each side of the horizon)
   double min_view_focal_px = 300.0;    // overlap views sample at least this density (pixels per radian)
+  // > 0: denser views still, up to this density but at most dense_view_max_upsampling times the
+  // lenses' own (the start-up's later passes: more corners where the lens holds them).
+  double dense_view_focal_px = 0.0;
+  double dense_view_max_upsampling = 1.25;
   int orb_features = 3000;             // per overlap view
   int orb_fast_threshold = 10;
   bool refine_matches = false;         // KLT sub-pixel refinement of the matches (aligned views only)

@@ -95,7 +95,7 @@ RingCalibrationReport RunRingPasses(const Rig& rig, const std::vector<Rigid3>& c
   aligned.refine_matches = options.refine_second_pass;
   aligned.orb_features = std::max(aligned.orb_features, options.later_orb_features);
   aligned.orb_fast_threshold = std::min(aligned.orb_fast_threshold, options.later_orb_fast_threshold);
-  aligned.min_view_focal_px = std::max(aligned.min_view_focal_px, options.later_min_view_focal_px);
+  aligned.dense_view_focal_px = std::max(aligned.dense_view_focal_px, options.later_view_focal_px);
   for (int pass = 2; pass <= options.ring_passes && last.converged; ++pass) {
     RingCalibrationReport next = RunRingPass(rig, last.cam_from_rig, shots, static_masks, aligned);
     if (!quiet) PrintRing(next);

@@ -38,11 +38,12 @@ struct StartupCalibrationOptions {
   RingCalibrationOptions ring;
   int ring_passes = 2;                // > 1: the ring stage again with views placed by the previous result
   bool refine_second_pass = true;     // KLT sub-pixel matches in the later passes (their views are aligned)
-  // The later passes detect more and weaker corners on denser views (at least these): with the views
-  // aligned, more matches make the result depend less on which corners were found.
+  // The later passes detect more and weaker corners (at least these) on denser views (up to
+  // later_view_focal_px where the lenses hold it: RingCalibrationOptions::dense_view_focal_px): with
+  // the views aligned, more matches make the result depend less on which corners were found.
   int later_orb_features = 6000;
   int later_orb_fast_threshold = 5;
-  double later_min_view_focal_px = 450.0;
+  double later_view_focal_px = 450.0;
   double max_pass_change_deg = 0.5;   // a later pass moving a camera further: not converged
   // When the ring passes fail, once more with more and weaker features (an overlap with little
   // texture, a real camera's low contrast).
