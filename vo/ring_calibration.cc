@@ -116,12 +116,6 @@ cv::Mat Gray(const cv::Mat& image) {
   return gray;
 }
 
-// Matches (index in a, index in b) passing the ratio test both ways and the mutual check.
-std::vector<std::pair<int, int>> MutualRatioMatches(const cv::Mat& desc_a, const cv::Mat& desc_b,
-                                                    const RingCalibrationOptions& options) {
-  return MutualRatioOrbMatches(desc_a, desc_b, options.max_ratio, options.max_descriptor_distance);
-}
-
 // Local contrast normalisation for KLT: (v - mean) / std over a Gaussian window of `sigma_px`,
 // mapped to 8 bits. Two cameras of a real rig see a surface with different exposure, gain and
 // vignetting, which biases KLT's brightness-constancy fit; ORB's descriptors are invariant to both.
@@ -293,7 +287,7 @@ void RingCalibrator::AddFrame(const std::vector<cv::Mat>& images) {
     }
     const double max_prior = std::cos(o.max_prior_angle_deg * kDeg);
     std::vector<cv::Point2f> points_a, points_b;
-    for (const auto& [i, j] : MutualRatioMatches(descriptors[0], descriptors[1], o)) {
+    for (const auto& [i, j] : MutualRatioOrbMatches(descriptors[0], descriptors[1], o.max_ratio, o.max_descriptor_distance)) {
       points_a.push_back(keypoints[0][i].pt);
       points_b.push_back(keypoints[1][j].pt);
     }
