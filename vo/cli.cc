@@ -109,6 +109,13 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
                   "converged start-up calibration's result; 0: none")
       ->check(CLI::Range(0.0, 45.0))
       ->capture_default_str();
+  cmd->add_option_function<std::string>(
+         "--online-lens-scale",
+         [args](const std::string& v) { args->options.online_apply_lens_scale = v == "apply"; },
+         "OnlineExt: apply (default) | report. apply: when the start-up calibration converges with an angle scale of "
+         "the lenses (a lens calibration that misjudges angles near the rim), the VO sees through lenses scaled by "
+         "it; report: the dataset's lenses, the scale only in run.json")
+      ->check(CLI::IsMember({"apply", "report"}));
   cmd->add_option("--online-startup-spacing", args->options.online_startup_spacing,
                   "OnlineExt: frames between two shots of --online-startup-shots")
       ->check(CLI::Range(1, 100000))

@@ -2,6 +2,7 @@
 
 #include "datasets/dataset.h"
 #include "datasets/io.h"
+#include "datasets/lens_angle_scale.h"
 #include "datasets/progress.h"
 #include "vo/image_loader.h"
 #include "vo/startup_calibration.h"
@@ -127,6 +128,30 @@ StartupCalibrationReport RunStartupCalibration(const VoOptions& options, const D
   return startup;
 }
 
+// The lenses the VO sees through: the dataset's, or scaled by the converged start-up's angle scale
+// (VoOptions::online_apply_lens_scale); `applied` receives the scale used (1: the dataset's).
+Rig LensesForVo(const VoOptions& options, const Rig& rig, const StartupCalibrationReport& startup, double* applied) {
+  *applied = 1.0;
+  const double scale = startup.ring.angle_scale;
+  if (!RunsStartupCalibration(options) || !options.online_apply_lens_scale || !startup.converged || scale == 1.0) {
+    return rig;
+  }
+  try {
+    double error_deg = 0.0;
+    Rig scaled = WithLensAngleScale(rig, scale, &error_deg);
+    *applied = scale;
+    if (!options.quiet) {
+      std::fprintf(stderr, "vo online: lenses' off-axis angles scaled by the start-up's %.4f (refit within %.3f deg)\n",
+                   scale, error_deg);
+    }
+    return scaled;
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "vo online: WARNING: lenses kept as given, the start-up's angle scale %.4f not applied: %s\n",
+                 scale, e.what());
+    return rig;
+  }
+}
+
 // Sums of per-frame stage times -> means per frame.
 void AverageStageTimes(int frames, int total_hypotheses, VoStageTimes* ms) {
   const double n = std::max(1, frames);
@@ -247,6 +272,8 @@ nlohmann::json RunInfoJson(const VoOptions& options, const DatasetInfo& info, co
   j["online_startup_shots"] = options.online_startup_shots;
   j["online_startup_spacing"] = options.online_startup_spacing;
   j["online_anchor_deg"] = options.online_anchor_deg;
+  j["online_apply_lens_scale"] = options.online_apply_lens_scale;
+  j["lens_angle_scale_applied"] = summary.lens_angle_scale;
   j["max_new_features"] = options.max_new_features;
   j["warp_below_deg"] = options.warp_below_deg;
   if (RunsStartupCalibration(options)) j["startup_calibration"] = startup.ToJson();
@@ -316,12 +343,13 @@ VoSummary RunVo(const VoOptions& options) {
       backend_options.ba.extrinsic_anchor_deg = options.online_anchor_deg;
     }
   }
-  Frontend frontend(info.rig.WithExtrinsics(cam_from_rig), MakeFrontendOptions(options));
+  VoSummary summary;
+  const Rig lenses = LensesForVo(options, info.rig, startup, &summary.lens_angle_scale);
+  Frontend frontend(lenses.WithExtrinsics(cam_from_rig), MakeFrontendOptions(options));
   frontend.SetStaticMasks(LoadStaticMasks(options.dataset_dir, info.rig, info.has_static_masks));
   VoBackend backend(cam_from_rig, world_from_rig0, backend_options);
 
   RunData run;
-  VoSummary summary;
   VoStageTimes& ms = summary.stage_ms;
   int total_hypotheses = 0;
   double ok_ratio_sum = 0.0, ok_error_sum = 0.0;

@@ -49,6 +49,10 @@ struct VoOptions {
   // OnlineExt: every keyframe BA pulls the extrinsics towards a converged start-up calibration's result
   // with this rotation sigma in degrees (LocalBaOptions::extrinsic_anchor_deg); 0: no anchor.
   double online_anchor_deg = 0.02;
+  // OnlineExt: the VO sees through lenses whose off-axis angles are scaled by the start-up's estimate
+  // (RingCalibrationReport::angle_scale, datasets/lens_angle_scale.h) when it converged with one;
+  // false: the dataset's lenses (the scale is only reported).
+  bool online_apply_lens_scale = true;
   // RANSAC inlier threshold (MultiViewRansacOptions::tau_rad) in degrees: one angle for every rig,
   // as the paper's cost is angular (max(0, tau - angle)). Until 2026-11-21 it was 2 pixels at the
   // image centre: 0.29 deg on the full-size rovo4 lenses but 0.60 deg on canyon_multifov's, whose
@@ -99,6 +103,7 @@ struct VoSummary {
   int missing_images = 0;                // (frame, camera) images missing or unreadable
   double mean_inlier_ratio = 0.0;        // over "ok" frames
   double mean_reproj_error_deg = 0.0;    // over "ok" frames
+  double lens_angle_scale = 1.0;         // applied to the dataset's lenses (VoOptions::online_apply_lens_scale)
   VoStageTimes stage_ms;
 };
 
