@@ -39,9 +39,10 @@ struct ViewGeometry {
   Eigen::Matrix3d rig_from_view = Eigen::Matrix3d::Identity();
   double focal = 1.0;  // pixels per radian
   int width = 0, height = 0;
+  double Longitude(double u) const { return -(u - 0.5 * (width - 1)) / focal; }
+  double Latitude(double v) const { return -(v - 0.5 * (height - 1)) / focal; }
   Eigen::Vector3d DirectionInRig(double u, double v) const {
-    const double lon = -(u - 0.5 * (width - 1)) / focal;
-    const double lat = -(v - 0.5 * (height - 1)) / focal;
+    const double lon = Longitude(u), lat = Latitude(v);
     return rig_from_view * Eigen::Vector3d(std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon), std::sin(lat));
   }
 };
@@ -81,10 +82,18 @@ ViewSide MakeViewSide(const RigCamera& cam, int camera, const ViewGeometry& g, c
   s.map_x.create(g.height, g.width, CV_32F);
   s.map_y.create(g.height, g.width, CV_32F);
   s.valid = cv::Mat::zeros(g.height, g.width, CV_8U);
+  // DirectionInRig with the sines and cosines of every column's longitude computed once.
+  std::vector<double> cos_lon(g.width), sin_lon(g.width);
+  for (int u = 0; u < g.width; ++u) {
+    cos_lon[u] = std::cos(g.Longitude(u));
+    sin_lon[u] = std::sin(g.Longitude(u));
+  }
+  const Eigen::Matrix3d cam_from_view = s.cam_from_rig_nominal * g.rig_from_view;
   for (int v = 0; v < g.height; ++v) {
+    const double lat = g.Latitude(v), cos_lat = std::cos(lat), sin_lat = std::sin(lat);
     for (int u = 0; u < g.width; ++u) {
-      const Eigen::Vector3d d_cam = s.cam_from_rig_nominal * g.DirectionInRig(u, v);
-      const auto px = cam.camera.InFov(d_cam) ? cam.camera.Project(d_cam) : std::nullopt;
+      const Eigen::Vector3d d_cam = cam_from_view * Eigen::Vector3d(cos_lat * cos_lon[u], cos_lat * sin_lon[u], sin_lat);
+      const auto px = cam.camera.Project(d_cam);  // nullopt outside the field of view
       const bool inside = px && px->x() >= 1.0 && px->y() >= 1.0 && px->x() <= cam.camera.width - 2.0 &&
                           px->y() <= cam.camera.height - 2.0;
       s.map_x.at<float>(v, u) = inside ? static_cast<float>(px->x()) : -1.0f;
