@@ -5,6 +5,8 @@
 #include "vo/local_ba.h"
 #include "vo/opencv_threads.h"
 
+#include <Eigen/SVD>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -81,6 +83,71 @@ RingCalibrationReport RunRingPass(const Rig& rig, const std::vector<Rigid3>& cam
   return ring.Solve();
 }
 
+// The ring options of the passes after the first (their views are placed by a previous result).
+RingCalibrationOptions LaterPassOptions(const StartupCalibrationOptions& options) {
+  RingCalibrationOptions aligned = options.ring;
+  aligned.refine_matches = options.refine_second_pass;
+  aligned.orb_features = std::max(aligned.orb_features, options.later_orb_features);
+  aligned.orb_fast_threshold = std::min(aligned.orb_fast_threshold, options.later_orb_fast_threshold);
+  aligned.dense_view_focal_px = std::max(aligned.dense_view_focal_px, options.later_view_focal_px);
+  return aligned;
+}
+
+// Placement k's turn of camera j's view placement: placement_jitter_deg about a fixed axis.
+Eigen::Quaterniond PlacementTurn(int k, int j, double angle_deg) {
+  const double a = 2.399963 * (7 * k + 3 * j + 1);  // golden-angle steps: axes spread over the sphere
+  const Eigen::Vector3d axis = Eigen::Vector3d(std::cos(a), std::sin(a), std::cos(1.7 * a)).normalized();
+  return Eigen::Quaterniond(Eigen::AngleAxisd(angle_deg * M_PI / 180.0, axis));
+}
+
+// Rotation nearest (Frobenius) to a sum of rotation matrices: their chordal mean.
+Eigen::Quaterniond ChordalMean(const Eigen::Matrix3d& sum) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(sum, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d u = svd.matrixU();
+  if ((u * svd.matrixV().transpose()).determinant() < 0.0) u.col(2) *= -1.0;
+  return Eigen::Quaterniond(u * svd.matrixV().transpose()).normalized();
+}
+
+// The last ring pass (`last`, converged) again from options.placements - 1 view placements turned by
+// placement_jitter_deg, and the converged results averaged: cam_j_from_cam0 by their chordal mean
+// (camera 0 kept), the angle scale by its mean. `spread_deg` receives the largest angle of a
+// placement's cam_j_from_cam0 from the mean.
+RingCalibrationReport AverageOverPlacements(const Rig& rig, RingCalibrationReport last,
+                                            const std::vector<std::vector<cv::Mat>>& shots,
+                                            const std::vector<cv::Mat>& static_masks,
+                                            const StartupCalibrationOptions& options, int* averaged, double* spread_deg) {
+  const RingCalibrationOptions pass_options = options.ring_passes > 1 ? LaterPassOptions(options) : options.ring;
+  const size_t n = last.cam_from_rig.size();
+  std::vector<RingCalibrationReport> results = {last};
+  for (int k = 1; k < options.placements; ++k) {
+    std::vector<Rigid3> placed = last.cam_from_rig;
+    for (size_t j = 0; j < n; ++j) {
+      placed[j].rotation = PlacementTurn(k, static_cast<int>(j), options.placement_jitter_deg) * placed[j].rotation;
+    }
+    RingCalibrationReport r = RunRingPass(rig, placed, shots, static_masks, pass_options);
+    if (r.converged) results.push_back(std::move(r));
+  }
+  auto camj_from_cam0 = [](const RingCalibrationReport& r, size_t j) {
+    return r.cam_from_rig[j].rotation * r.cam_from_rig[0].rotation.inverse();
+  };
+  double scale_sum = 0.0;
+  for (const RingCalibrationReport& r : results) scale_sum += r.angle_scale;
+  last.angle_scale = scale_sum / static_cast<double>(results.size());
+  *spread_deg = 0.0;
+  for (size_t j = 1; j < n; ++j) {
+    Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+    for (const RingCalibrationReport& r : results) sum += camj_from_cam0(r, j).toRotationMatrix();
+    const Eigen::Quaterniond mean = ChordalMean(sum);
+    for (const RingCalibrationReport& r : results) {
+      *spread_deg = std::max(*spread_deg, RotationDistanceDeg(camj_from_cam0(r, j), mean));
+    }
+    const Eigen::Quaterniond camj_from_rig = (mean * last.cam_from_rig[0].rotation).normalized();
+    last.cam_from_rig[j] = Rigid3(camj_from_rig, -(camj_from_rig * CameraPositionInRig(last.cam_from_rig[j])));
+  }
+  *averaged = static_cast<int>(results.size());
+  return last;
+}
+
 // The ring stage, then again with the overlap views placed by the previous result: where the given
 // extrinsics were far off, the first pass saw the overlaps off-centre and rotated. Each later pass
 // must confirm the one before it (max_pass_change_deg), else the result depends on where the views
@@ -91,11 +158,7 @@ RingCalibrationReport RunRingPasses(const Rig& rig, const std::vector<Rigid3>& c
                                     bool quiet) {
   RingCalibrationReport last = RunRingPass(rig, cam_from_rig, shots, static_masks, options.ring);
   if (!quiet) PrintRing(last);
-  RingCalibrationOptions aligned = options.ring;
-  aligned.refine_matches = options.refine_second_pass;
-  aligned.orb_features = std::max(aligned.orb_features, options.later_orb_features);
-  aligned.orb_fast_threshold = std::min(aligned.orb_fast_threshold, options.later_orb_fast_threshold);
-  aligned.dense_view_focal_px = std::max(aligned.dense_view_focal_px, options.later_view_focal_px);
+  const RingCalibrationOptions aligned = LaterPassOptions(options);
   for (int pass = 2; pass <= options.ring_passes && last.converged; ++pass) {
     RingCalibrationReport next = RunRingPass(rig, last.cam_from_rig, shots, static_masks, aligned);
     if (!quiet) PrintRing(next);
@@ -112,19 +175,30 @@ RingCalibrationReport RunRingPasses(const Rig& rig, const std::vector<Rigid3>& c
   return last;
 }
 
-// The ring passes, and when they fail and options.rescue is set, the rescue passes.
+// The ring passes, and when they fail and options.rescue is set, the rescue passes; a converged last
+// pass is averaged over options.placements view placements.
 RingCalibrationReport RunRingStage(const Rig& rig, const std::vector<Rigid3>& cam_from_rig,
                                    const std::vector<std::vector<cv::Mat>>& shots, const std::vector<cv::Mat>& static_masks,
                                    const StartupCalibrationOptions& options, bool quiet, StartupCalibrationReport* report) {
-  RingCalibrationReport ring = RunRingPasses(rig, cam_from_rig, shots, static_masks, options, quiet);
-  if (ring.converged || !options.rescue) return ring;
-  if (!quiet) std::fprintf(stderr, "vo online: start-up ring calibration failed; rescue with more and weaker features\n");
-  StartupCalibrationOptions rescue = options;
-  rescue.ring.orb_features = options.rescue_orb_features;
-  rescue.ring.orb_fast_threshold = options.rescue_orb_fast_threshold;
-  report->rescued = true;
-  report->ring_failure = ring.reason;
-  return RunRingPasses(rig, cam_from_rig, shots, static_masks, rescue, quiet);
+  StartupCalibrationOptions used = options;
+  RingCalibrationReport ring = RunRingPasses(rig, cam_from_rig, shots, static_masks, used, quiet);
+  if (!ring.converged && options.rescue) {
+    if (!quiet) std::fprintf(stderr, "vo online: start-up ring calibration failed; rescue with more and weaker features\n");
+    used.ring.orb_features = options.rescue_orb_features;
+    used.ring.orb_fast_threshold = options.rescue_orb_fast_threshold;
+    report->rescued = true;
+    report->ring_failure = ring.reason;
+    ring = RunRingPasses(rig, cam_from_rig, shots, static_masks, used, quiet);
+  }
+  if (ring.converged && options.placements > 1) {
+    ring = AverageOverPlacements(rig, std::move(ring), shots, static_masks, used, &report->placements_averaged,
+                                 &report->placement_spread_deg);
+    if (!quiet) {
+      std::fprintf(stderr, "vo online: start-up ring calibration averaged over %d view placements (spread %.3f deg)\n",
+                   report->placements_averaged, report->placement_spread_deg);
+    }
+  }
+  return ring;
 }
 
 }  // namespace
@@ -162,6 +236,8 @@ nlohmann::json StartupCalibrationReport::ToJson() const {
                     {"uncertainty_deg", ring.uncertainty_deg},
                     {"rescued", rescued},
                     {"failure_before_rescue", ring_failure},
+                    {"placements_averaged", placements_averaged},
+                    {"placement_spread_deg", placement_spread_deg},
                     {"pairs", pairs}}},
           {"refinement_rounds", round_list},
           {"cam_from_rig", extrinsics}};

@@ -7,7 +7,8 @@
 //      residuals with the known baseline), pooled over `shots` synchronous shots, averaged around the
 //      ring into cam_j_from_cam0 and refined jointly. Later passes (ring_passes) place the overlap
 //      views by the previous result, refine the matches by KLT and detect more, weaker corners on
-//      denser views; each must confirm the pass before it.
+//      denser views; each must confirm the pass before it. The last pass is repeated from slightly
+//      turned view placements and the results averaged (`placements`).
 //      The joint refinement also estimates one angle scale of every lens (a real lens calibration
 //      that understates angles near the rim). When this fails, it runs once more as a rescue
 //      (StartupCalibrationOptions::rescue) with more and weaker features.
@@ -45,6 +46,11 @@ struct StartupCalibrationOptions {
   int later_orb_fast_threshold = 5;
   double later_view_focal_px = 450.0;
   double max_pass_change_deg = 0.5;   // a later pass moving a camera further: not converged
+  // The last pass again from placements - 1 other view placements (every camera's turned by
+  // placement_jitter_deg about a fixed axis), the converged results averaged: which corners a pass
+  // matches depends on where its views' pixel grid falls, and the mean depends less on it.
+  int placements = 3;
+  double placement_jitter_deg = 0.3;
   // When the ring passes fail, once more with more and weaker features (an overlap with little
   // texture, a real camera's low contrast).
   bool rescue = true;
@@ -75,6 +81,8 @@ struct StartupCalibrationReport {
   RingCalibrationReport ring;         // the ring passes' result (of the rescue when it ran)
   bool rescued = false;               // the ring passes failed and the rescue ran
   std::string ring_failure;           // why the ring passes failed, when the rescue ran
+  int placements_averaged = 0;        // converged view placements averaged (StartupCalibrationOptions::placements)
+  double placement_spread_deg = -1.0; // largest angle of one of them from their mean (cam_j_from_cam0)
   std::vector<StartupRound> rounds;   // stage 2
   std::vector<Rigid3> cam_from_rig;   // the result (the start when nothing could be done)
   nlohmann::json ToJson() const;
