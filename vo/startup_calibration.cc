@@ -109,15 +109,18 @@ Eigen::Quaterniond ChordalMean(const Eigen::Matrix3d& sum) {
 }
 
 // The last ring pass (`last`, converged) again from options.placements - 1 view placements turned by
-// placement_jitter_deg, and the converged results averaged: cam_j_from_cam0 by their chordal mean
-// (camera 0 kept), the angle scale by its mean. `spread_deg` receives the largest angle of a
-// placement's cam_j_from_cam0 from the mean.
+// placement_jitter_deg, and the converged results within max_pass_change_deg of it averaged:
+// cam_j_from_cam0 by their chordal mean (camera 0 kept), the angle scale by its mean. `spread_deg`
+// receives the largest angle of a placement's cam_j_from_cam0 from the mean.
 RingCalibrationReport AverageOverPlacements(const Rig& rig, RingCalibrationReport last,
                                             const std::vector<std::vector<cv::Mat>>& shots,
                                             const std::vector<cv::Mat>& static_masks,
                                             const StartupCalibrationOptions& options, int* averaged, double* spread_deg) {
   const RingCalibrationOptions pass_options = options.ring_passes > 1 ? LaterPassOptions(options) : options.ring;
   const size_t n = last.cam_from_rig.size();
+  auto camj_from_cam0 = [](const RingCalibrationReport& r, size_t j) {
+    return r.cam_from_rig[j].rotation * r.cam_from_rig[0].rotation.inverse();
+  };
   std::vector<RingCalibrationReport> results = {last};
   for (int k = 1; k < options.placements; ++k) {
     std::vector<Rigid3> placed = last.cam_from_rig;
@@ -125,11 +128,12 @@ RingCalibrationReport AverageOverPlacements(const Rig& rig, RingCalibrationRepor
       placed[j].rotation = PlacementTurn(k, static_cast<int>(j), options.placement_jitter_deg) * placed[j].rotation;
     }
     RingCalibrationReport r = RunRingPass(rig, placed, shots, static_masks, pass_options);
-    if (r.converged) results.push_back(std::move(r));
+    if (!r.converged) continue;
+    // Like a later pass, a placement must confirm the result (max_pass_change_deg), else it is left out.
+    double change = 0.0;
+    for (size_t j = 1; j < n; ++j) change = std::max(change, RotationDistanceDeg(camj_from_cam0(r, j), camj_from_cam0(last, j)));
+    if (change <= options.max_pass_change_deg) results.push_back(std::move(r));
   }
-  auto camj_from_cam0 = [](const RingCalibrationReport& r, size_t j) {
-    return r.cam_from_rig[j].rotation * r.cam_from_rig[0].rotation.inverse();
-  };
   double scale_sum = 0.0;
   for (const RingCalibrationReport& r : results) scale_sum += r.angle_scale;
   last.angle_scale = scale_sum / static_cast<double>(results.size());

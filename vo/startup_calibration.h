@@ -47,8 +47,9 @@ struct StartupCalibrationOptions {
   double later_view_focal_px = 450.0;
   double max_pass_change_deg = 0.5;   // a later pass moving a camera further: not converged
   // The last pass again from placements - 1 other view placements (every camera's turned by
-  // placement_jitter_deg about a fixed axis), the converged results averaged: which corners a pass
-  // matches depends on where its views' pixel grid falls, and the mean depends less on it.
+  // placement_jitter_deg about a fixed axis), the converged results within max_pass_change_deg of the
+  // first averaged: which corners a pass matches depends on where its views' pixel grid falls, and the
+  // mean depends less on it.
   int placements = 3;
   double placement_jitter_deg = 0.3;
   // When the ring passes fail, once more with more and weaker features (an overlap with little
