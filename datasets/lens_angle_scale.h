@@ -9,7 +9,7 @@
 // (an ocam lens's by 0.06 deg more, so that the refit's error keeps its rim pixels).
 //   equidistant: exact, r(alpha) = f d(alpha / scale) gives fx, fy / scale and k_i / scale^(2i).
 //   ocam: the forward polynomial is refitted by least squares to alpha'(rho) = scale alpha(rho) over
-//         the sensor radii of the field of view (a1 kept at 0 when it is 0), the inverse polynomial
+//         the sensor radii of the field of view (all of a0..a4), the inverse polynomial
 //         fitted to it (FitOcamInversePolynomial); the largest angle error is reported.
 //   double sphere, extended unified: no such form (std::invalid_argument).
 
