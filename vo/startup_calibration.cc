@@ -1,5 +1,6 @@
 #include "vo/startup_calibration.h"
 
+#include "datasets/lens_angle_scale.h"
 #include "vo/extrinsic_bootstrap.h"
 #include "vo/frontend.h"
 #include "vo/local_ba.h"
@@ -10,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 
 namespace rovo {
 namespace {
@@ -111,7 +113,8 @@ Eigen::Quaterniond ChordalMean(const Eigen::Matrix3d& sum) {
 // The last ring pass (`last`, converged) again from options.placements - 1 view placements turned by
 // placement_jitter_deg, and the converged results within max_pass_change_deg of it averaged:
 // cam_j_from_cam0 by their chordal mean (camera 0 kept), the angle scale by its mean. `spread_deg`
-// receives the largest angle of a placement's cam_j_from_cam0 from the mean.
+// receives the largest angle of a placement's cam_j_from_cam0 from the mean. The pairs, loop error
+// and uncertainty of the result stay those of `last`.
 RingCalibrationReport AverageOverPlacements(const Rig& rig, RingCalibrationReport last,
                                             const std::vector<std::vector<cv::Mat>>& shots,
                                             const std::vector<cv::Mat>& static_masks,
@@ -125,14 +128,19 @@ RingCalibrationReport AverageOverPlacements(const Rig& rig, RingCalibrationRepor
   for (int k = 1; k < options.placements; ++k) {
     std::vector<Rigid3> placed = last.cam_from_rig;
     for (size_t j = 0; j < n; ++j) {
-      placed[j].rotation = PlacementTurn(k, static_cast<int>(j), options.placement_jitter_deg) * placed[j].rotation;
+      // Turned about the camera's own centre: the baselines stay the rig's.
+      const Eigen::Quaterniond turned =
+          PlacementTurn(k, static_cast<int>(j), options.placement_jitter_deg) * placed[j].rotation;
+      placed[j] = Rigid3(turned, -(turned * CameraPositionInRig(placed[j])));
     }
     RingCalibrationReport r = RunRingPass(rig, placed, shots, static_masks, pass_options);
     if (!r.converged) continue;
-    // Like a later pass, a placement must confirm the result (max_pass_change_deg), else it is left out.
+    // Like a later pass, a placement must confirm the result (max_pass_change_deg) and its lens
+    // decision (the angle scale kept or left at 1), else it is left out.
     double change = 0.0;
     for (size_t j = 1; j < n; ++j) change = std::max(change, RotationDistanceDeg(camj_from_cam0(r, j), camj_from_cam0(last, j)));
-    if (change <= options.max_pass_change_deg) results.push_back(std::move(r));
+    const bool same_lenses = (r.angle_scale == 1.0) == (last.angle_scale == 1.0);
+    if (change <= options.max_pass_change_deg && same_lenses) results.push_back(std::move(r));
   }
   double scale_sum = 0.0;
   for (const RingCalibrationReport& r : results) scale_sum += r.angle_scale;
@@ -203,6 +211,16 @@ RingCalibrationReport RunRingStage(const Rig& rig, const std::vector<Rigid3>& ca
     }
   }
   return ring;
+}
+
+// Stage 2's lenses: scaled by a converged ring stage's angle scale where the lens model allows it.
+Rig RefinementRig(const Rig& rig, const RingCalibrationReport& ring) {
+  if (!ring.converged || ring.angle_scale == 1.0) return rig;
+  try {
+    return WithLensAngleScale(rig, ring.angle_scale);
+  } catch (const std::invalid_argument&) {
+    return rig;
+  }
 }
 
 }  // namespace
@@ -276,7 +294,8 @@ StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Ri
   const double uncertainty = report.ring.converged ? options.refine_start_deg : options.fallback_prior_deg;
   std::vector<Rigid3> refined = start;
   if (options.refine) {
-    refined = RefineOnShot(rig, start, first_images, uncertainty, options.refine_rounds, quiet, &report.rounds);
+    refined = RefineOnShot(RefinementRig(rig, report.ring), start, first_images, uncertainty, options.refine_rounds,
+                           quiet, &report.rounds);
   }
   if (!report.ring.converged) {
     report.cam_from_rig = refined;

@@ -67,6 +67,37 @@ TEST_P(LensAngleScale, EveryPixelTurnsAwayFromTheAxisByTheScale) {
 
 INSTANTIATE_TEST_SUITE_P(RigPresets, LensAngleScale, ::testing::Values("rovo4", "rovo4_real", "omnimvs4"));
 
+// The presets' equidistant lenses have k = 0; a lens with every k_i set checks their scaling.
+TEST(LensAngleScale, EquidistantDistortionTermsScaleExactly) {
+  Camera lens;
+  lens.model = CameraModelId::kEquidistant;
+  lens.width = 800;
+  lens.height = 800;
+  lens.params = {255.0, 256.0, 401.0, 398.5, 0.02, -0.005, 0.001, -0.0001};
+  lens.max_fov_deg = 220.0;
+  for (double scale : {0.985, 1.0156}) {
+    const AngleScaledLens scaled = ScaleLensAngles(lens, scale);
+    const ScaleErrors e = Measure(lens, scaled.camera, scale);
+    SCOPED_TRACE("scale " + std::to_string(scale));
+    EXPECT_GT(e.pixels, 2000);
+    EXPECT_LT(e.angle_deg, 1e-6);
+    EXPECT_LT(e.reprojection_px, 1e-6);
+    EXPECT_EQ(scaled.max_error_deg, 0.0);
+    EXPECT_NEAR(scaled.camera.params[7], lens.params[7] / std::pow(scale, 8), 1e-15);
+  }
+}
+
+// An ocam lens refitted at scale 1 keeps its angles (the refit alone, without a scale).
+TEST(LensAngleScale, OcamRefitAtScaleOneKeepsTheAngles) {
+  const Rig rig = MakeRigPreset("rovo4_real");
+  ASSERT_EQ(rig.cameras[0].camera.model, CameraModelId::kOcam);
+  const AngleScaledLens same = ScaleLensAngles(rig.cameras[0].camera, 1.0);
+  const ScaleErrors e = Measure(rig.cameras[0].camera, same.camera, 1.0);
+  EXPECT_GT(e.pixels, 1000);
+  EXPECT_LT(e.angle_deg, 0.01);
+  EXPECT_LT(e.reprojection_px, 0.02);
+}
+
 TEST(LensAngleScale, ScaleOfOneLeavesTheRigAlone) {
   const Rig rig = MakeRigPreset("rovo4");
   double error = -1.0;

@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <system_error>
 #include <unistd.h>
 
 namespace rovo {
@@ -46,9 +47,22 @@ double RelativeRmsePct(const std::string& dataset, const std::string& run) {
   return nlohmann::json::parse(ReadFile(out + "/metrics.json"))["runs"][0]["relative_rmse_pct"].get<double>();
 }
 
+// A scratch directory removed however the test ends.
+struct ScratchDir {
+  fs::path path;
+  explicit ScratchDir(const std::string& name)
+      : path(fs::temp_directory_path() / (name + "_" + std::to_string(::getpid()))) {
+    fs::remove_all(path);
+  }
+  ~ScratchDir() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+};
+
 TEST(LensScaleVo, TheStartUpsLensScaleKeepsTheTrajectory) {
-  const fs::path root = fs::temp_directory_path() / ("rovo_lens_scale_vo_" + std::to_string(::getpid()));
-  fs::remove_all(root);
+  const ScratchDir scratch("rovo_lens_scale_vo");
+  const fs::path& root = scratch.path;
   const std::string truth = (root / "truth").string(), declared = (root / "declared").string();
   ASSERT_EQ(RunCommand(std::string(ROVO_BINARY) + " render --preset canyon_multifov --quick --quiet --out " + truth), 0);
   WriteMisdeclaredCopy(truth, declared, 1.015);
@@ -70,7 +84,6 @@ TEST(LensScaleVo, TheStartUpsLensScaleKeepsTheTrajectory) {
   std::printf("relative RMSE: lens scale applied %.3f %%, reported only %.3f %%\n", rmse[0], rmse[1]);
   EXPECT_LT(rmse[0], 2.5);
   EXPECT_LT(3.0 * rmse[0], rmse[1]);
-  fs::remove_all(root);
 }
 
 }  // namespace
