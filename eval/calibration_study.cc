@@ -81,6 +81,7 @@ CalibrationDraw RunDraw(const CalibrationStudyOptions& o, const DatasetInfo& inf
                            LoadStaticMasks(o.dataset_dir, info.rig, info.has_static_masks), sopt, true);
     d.startup_cam_from_rig = r.cam_from_rig;
     d.startup_deg = ExtrinsicErrorDeg(r.cam_from_rig, truth);
+    d.startup_mm = 1000.0 * ExtrinsicTranslationErrorM(r.cam_from_rig, truth);
     d.startup_converged = r.converged;
     d.startup_status = r.status;
     d.lens_angle_scale = r.ring.angle_scale;
@@ -109,6 +110,7 @@ CalibrationDraw RunDraw(const CalibrationStudyOptions& o, const DatasetInfo& inf
   for (const auto& x : startup.at("cam_from_rig")) after.push_back(Rigid3FromRunJson(x));
   d.startup_cam_from_rig = after;
   d.startup_deg = ExtrinsicErrorDeg(after, truth);
+  d.startup_mm = 1000.0 * ExtrinsicTranslationErrorM(after, truth);
   d.startup_converged = startup.at("converged").get<bool>();
   d.startup_status = startup.at("status").get<std::string>();
   d.lens_angle_scale = startup.at("ring").value("angle_scale", 1.0);
@@ -121,6 +123,7 @@ CalibrationDraw RunDraw(const CalibrationStudyOptions& o, const DatasetInfo& inf
   d.at50_deg = ErrorAtFrame(by_frame, 50, truth);
   d.at100_deg = ErrorAtFrame(by_frame, 100, truth);
   d.end_deg = ErrorAtFrame(by_frame, by_frame.empty() ? 0 : by_frame.rbegin()->first, truth);
+  if (!by_frame.empty()) d.end_mm = 1000.0 * ExtrinsicTranslationErrorM(by_frame.rbegin()->second, truth);
   d.converged = d.end_deg >= 0.0 && d.end_deg < Bound(o);
   return d;
 }
@@ -129,6 +132,13 @@ std::string Deg(double v) {
   if (v < 0.0) return "-";
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3f", v);
+  return buf;
+}
+
+std::string Millimetres(double v) {
+  if (v < 0.0) return "-";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f", v);
   return buf;
 }
 
@@ -175,17 +185,19 @@ nlohmann::json OverlapFitJson(const OverlapFit& fit) {
 
 void WriteOutputs(const CalibrationStudyOptions& o, const DatasetInfo& info, const CalibrationStudyResult& result) {
   std::ostringstream csv;
-  csv << "seed,before_deg,startup_deg,at50_deg,at100_deg,end_deg,startup_converged,converged,lens_angle_scale\n";
+  csv << "seed,before_deg,startup_deg,at50_deg,at100_deg,end_deg,startup_converged,converged,lens_angle_scale,"
+         "startup_mm,end_mm\n";
   nlohmann::json rows = nlohmann::json::array();
   std::vector<uint64_t> failures;
   for (const CalibrationDraw& d : result.draws) {
     csv << d.seed << ',' << d.before_deg << ',' << d.startup_deg << ',' << d.at50_deg << ',' << d.at100_deg << ','
         << d.end_deg << ',' << (d.startup_converged ? 1 : 0) << ',' << (d.converged ? 1 : 0) << ',' << d.lens_angle_scale
-        << '\n';
+        << ',' << d.startup_mm << ',' << d.end_mm << '\n';
     rows.push_back({{"seed", d.seed}, {"before_deg", d.before_deg}, {"startup_deg", d.startup_deg},
                     {"at50_deg", d.at50_deg}, {"at100_deg", d.at100_deg}, {"end_deg", d.end_deg},
                     {"startup_converged", d.startup_converged}, {"startup_status", d.startup_status},
                     {"lens_angle_scale", d.lens_angle_scale}, {"converged", d.converged},
+                    {"startup_mm", d.startup_mm}, {"end_mm", d.end_mm},
                     {"startup_cam_from_rig", StartupExtrinsicsJson(d.startup_cam_from_rig)}});
     if (!d.converged) failures.push_back(d.seed);
   }
@@ -207,17 +219,18 @@ void WriteOutputs(const CalibrationStudyOptions& o, const DatasetInfo& info, con
 
 std::string Table(const CalibrationStudyOptions& o, const CalibrationStudyResult& result) {
   std::ostringstream s;
-  s << "| draw seed | before | after start-up | frame 50 | frame 100 | end | lens angle scale | start-up verdict |\n"
-    << "|---|---|---|---|---|---|---|---|\n";
+  s << "| draw seed | before | after start-up | frame 50 | frame 100 | end | start-up / end (mm) | lens angle scale | "
+       "start-up verdict |\n"
+    << "|---|---|---|---|---|---|---|---|---|\n";
   for (const CalibrationDraw& d : result.draws) {
     s << "| " << d.seed << " | " << Deg(d.before_deg) << " | " << Deg(d.startup_deg) << " | " << Deg(d.at50_deg)
-      << " | " << Deg(d.at100_deg) << " | " << Deg(d.end_deg) << " | " << Scale(d.lens_angle_scale) << " | "
-      << (d.startup_converged ? "converged" : d.startup_status)
-      << " |\n";
+      << " | " << Deg(d.at100_deg) << " | " << Deg(d.end_deg) << " | " << Millimetres(d.startup_mm) << " / "
+      << Millimetres(d.end_mm) << " | " << Scale(d.lens_angle_scale) << " | "
+      << (d.startup_converged ? "converged" : d.startup_status) << " |\n";
   }
   s << "\nExtrinsic error: largest over cameras i >= 1 of the rotation angle of est(cam_i_from_cam0) "
-       "true(cam_i_from_cam0)^-1, degrees. Lens angle scale: the start-up's estimate of every lens's off-axis "
-       "angle scale (1: the lenses as given).\n";
+       "true(cam_i_from_cam0)^-1, degrees; in mm, largest |t_est - t_true| of cam_i_from_cam0. Lens angle scale: "
+       "the start-up's estimate of every lens's off-axis angle scale (1: the lenses as given).\n";
   s << "Converged (" << (o.shot_only ? "start-up" : "end of run") << " < " << Bound(o) << " deg): " << result.converged
     << " of " << result.draws.size() << ".\n";
   s << "Start-up calibration converged by its own verdict: " << result.startup_converged << " of " << result.draws.size()
@@ -242,6 +255,19 @@ double ExtrinsicErrorDeg(const std::vector<Rigid3>& est, const std::vector<Rigid
     const Eigen::Quaterniond e = est[i].rotation * est[0].rotation.inverse();
     const Eigen::Quaterniond t = truth[i].rotation * truth[0].rotation.inverse();
     worst = std::max(worst, RotationDistanceDeg(e, t));
+  }
+  return worst;
+}
+
+double ExtrinsicTranslationErrorM(const std::vector<Rigid3>& est, const std::vector<Rigid3>& truth) {
+  if (est.size() != truth.size() || est.empty()) {
+    throw std::invalid_argument("ExtrinsicTranslationErrorM: camera counts differ");
+  }
+  const Rigid3 est_rig_from_cam0 = est[0].Inverse(), true_rig_from_cam0 = truth[0].Inverse();
+  double worst = 0.0;
+  for (size_t i = 1; i < est.size(); ++i) {
+    const Eigen::Vector3d e = (est[i] * est_rig_from_cam0).translation, t = (truth[i] * true_rig_from_cam0).translation;
+    worst = std::max(worst, (e - t).norm());
   }
   return worst;
 }

@@ -50,6 +50,7 @@ struct CalibrationDraw {
   double before_deg = 0.0;
   double startup_deg = 0.0;
   double at50_deg = -1.0, at100_deg = -1.0, end_deg = -1.0;  // < 0: the run is shorter / shot only
+  double startup_mm = 0.0, end_mm = -1.0;  // ExtrinsicTranslationErrorM in mm; end < 0: shot only
   bool startup_converged = false;   // the start-up calibration's own verdict
   std::string startup_status;
   double lens_angle_scale = 1.0;    // the start-up's estimate of the lenses' off-axis angle scale
@@ -70,6 +71,9 @@ struct CalibrationStudyResult {
 
 // The extrinsic error in degrees (above) of `est` against `truth` (cam_from_rig per camera).
 double ExtrinsicErrorDeg(const std::vector<Rigid3>& est, const std::vector<Rigid3>& truth);
+// Largest over cameras i >= 1 of |t_est - t_true| of cam_i_from_cam0 (metres): camera 0's centre in
+// camera i's frame, so a baseline turned in the cameras' frames counts as well as a moved centre.
+double ExtrinsicTranslationErrorM(const std::vector<Rigid3>& est, const std::vector<Rigid3>& truth);
 
 CalibrationStudyResult RunCalibrationStudy(const CalibrationStudyOptions& options);
 

@@ -109,6 +109,11 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
                   "converged start-up calibration's result; 0: none")
       ->check(CLI::Range(0.0, 45.0))
       ->capture_default_str();
+  cmd->add_option("--online-anchor-mm", args->options.online_anchor_mm,
+                  "OnlineExt: with --online-anchor, the camera centres' sigma (mm) towards the start-up's result; "
+                  "0: the centres are not held")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
   cmd->add_option_function<std::string>(
          "--online-lens-scale",
          [args](const std::string& v) { args->options.online_apply_lens_scale = v == "apply"; },

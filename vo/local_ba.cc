@@ -255,6 +255,7 @@ void LocalBaOptions::Check() const {
   }
   if (num_threads < 1) throw std::invalid_argument("LocalBaOptions.num_threads must be >= 1");
   if (!(extrinsic_anchor_deg >= 0.0)) throw std::invalid_argument("LocalBaOptions.extrinsic_anchor_deg must be >= 0");
+  if (!(extrinsic_anchor_m >= 0.0)) throw std::invalid_argument("LocalBaOptions.extrinsic_anchor_m must be >= 0");
 }
 
 std::vector<double> RingBaselineLengths(const std::vector<Rigid3>& cam_from_rig) {
@@ -272,8 +273,8 @@ std::vector<double> RingBaselineLengths(const std::vector<Rigid3>& cam_from_rig)
 namespace {
 
 // Online mode: the random-walk prior towards the extrinsics before this solve and, after a converged
-// start-up calibration, the anchor towards its result (rotation only: the centre is held by the
-// random-walk prior and the baseline terms), on every free camera the window sees.
+// start-up calibration, the anchor towards its result (rotation, and the centre when
+// extrinsic_anchor_m is set), on every free camera the window sees.
 void AddExtrinsicPriors(const LocalBaProblem& problem, const LocalBaOptions& options, const std::vector<char>& cam_used,
                         PoseParams* cams, ceres::Problem* ceres_problem) {
   const int num_cams = static_cast<int>(problem.cam_from_rig.size());
@@ -293,7 +294,8 @@ void AddExtrinsicPriors(const LocalBaProblem& problem, const LocalBaOptions& opt
       ceres_problem->AddResidualBlock(
           ExtrinsicPriorCost::Create(options.extrinsic_anchor[j],
                                      options.extrinsic_anchor_deg * M_PI / 180.0 / options.observation_sigma_rad,
-                                     1.0 / options.observation_sigma_rad),
+                                     (options.extrinsic_anchor_m > 0.0 ? options.extrinsic_anchor_m : 1.0) /
+                                         options.observation_sigma_rad),
           nullptr, cams[j].data());
     }
   }

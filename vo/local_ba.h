@@ -46,6 +46,7 @@ struct LocalBaOptions {
   // calibration sees thousands of overlap matches at once; one window's BA sees a few hundred.
   std::vector<Rigid3> extrinsic_anchor;
   double extrinsic_anchor_deg = 0.0;
+  double extrinsic_anchor_m = 0.0;  // the anchor's centre standard deviation; 0: the centre is not held (1 m)
   // The bearing residuals are sines of angles (radians to first order), unweighted: the prior is scaled by this assumed
   // bearing noise so that both terms are in units of standard deviations.
   double observation_sigma_rad = 0.001;

@@ -272,6 +272,7 @@ nlohmann::json RunInfoJson(const VoOptions& options, const DatasetInfo& info, co
   j["online_startup_shots"] = options.online_startup_shots;
   j["online_startup_spacing"] = options.online_startup_spacing;
   j["online_anchor_deg"] = options.online_anchor_deg;
+  j["online_anchor_mm"] = options.online_anchor_mm;
   j["online_apply_lens_scale"] = options.online_apply_lens_scale;
   j["lens_angle_scale_applied"] = summary.lens_angle_scale;
   j["max_new_features"] = options.max_new_features;
@@ -341,6 +342,7 @@ VoSummary RunVo(const VoOptions& options) {
     if (startup.converged) {
       backend_options.ba.extrinsic_anchor = startup.cam_from_rig;
       backend_options.ba.extrinsic_anchor_deg = options.online_anchor_deg;
+      backend_options.ba.extrinsic_anchor_m = 0.001 * options.online_anchor_mm;
     }
   }
   VoSummary summary;

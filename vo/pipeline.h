@@ -49,6 +49,8 @@ struct VoOptions {
   // OnlineExt: every keyframe BA pulls the extrinsics towards a converged start-up calibration's result
   // with this rotation sigma in degrees (LocalBaOptions::extrinsic_anchor_deg); 0: no anchor.
   double online_anchor_deg = 0.02;
+  // With it, the centres' sigma in millimetres (LocalBaOptions::extrinsic_anchor_m); 0: not held.
+  double online_anchor_mm = 3.0;
   // OnlineExt: the VO sees through lenses whose off-axis angles are scaled by the start-up's estimate
   // (RingCalibrationReport::angle_scale, datasets/lens_angle_scale.h) when it converged with one;
   // false: the dataset's lenses (the scale is only reported).

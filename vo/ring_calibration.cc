@@ -926,8 +926,15 @@ RingCalibrationReport RingCalibrator::Solve() const {
                     " deg from the ring solution (> " + std::to_string(o.max_pair_disagreement_deg) + ")";
     return report;
   }
+  // Camera 0 stays the gauge. The joint solution also turned the cameras together against their
+  // centres (model.rotations[0] against cam0_from_rig); with camera 0 kept, the centres turn by the
+  // inverse about camera 0's centre instead, so that every baseline keeps the direction the solution
+  // gives it in each camera (turn_centres; false: the centres stay the given ones).
+  const Eigen::Quaterniond rig_turn =
+      o.turn_centres ? (cam0_from_rig.inverse() * model.rotations[0]).normalized() : Eigen::Quaterniond::Identity();
+  const Eigen::Vector3d centre0 = CameraPositionInRig(rig.cameras[0].cam_from_rig);
   for (int j = 1; j < n; ++j) {
-    const Eigen::Vector3d centre = CameraPositionInRig(rig.cameras[j].cam_from_rig);
+    const Eigen::Vector3d centre = centre0 + rig_turn * (CameraPositionInRig(rig.cameras[j].cam_from_rig) - centre0);
     const Eigen::Quaterniond camj_from_rig =
         (model.rotations[j] * model.rotations[0].inverse() * cam0_from_rig).normalized();
     report.cam_from_rig[j] = Rigid3(camj_from_rig, -(camj_from_rig * centre));

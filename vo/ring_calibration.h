@@ -70,6 +70,10 @@ struct RingCalibrationOptions {
   // understates angles near the rim leaves the ring open by degrees); 0: the lenses as given.
   double angle_scale_sigma = 0.03;
   double min_angle_scale_change = 0.005;  // a smaller estimate of |kappa|: the lenses stay as given
+  // The joint solution's common rotation of the cameras against their centres is given to the centres
+  // (turned about camera 0's), so each baseline's direction in its cameras is the solution's; false:
+  // the centres stay the given ones (and the baselines keep camera 0's given error).
+  bool turn_centres = true;
   void Check() const;
 };
 

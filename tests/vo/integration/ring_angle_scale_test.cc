@@ -31,7 +31,8 @@ class RingAngleScale : public ::testing::Test {
 
   // The ring calibration of frame 0 from draw `seed`, with the lenses' angles declared `declared_scale`
   // times their true value and the angle scale estimated when `angle_scale_sigma` > 0.
-  static RingCalibrationReport Calibrate(double declared_scale, double angle_scale_sigma, uint64_t seed) {
+  static RingCalibrationReport Calibrate(double declared_scale, double angle_scale_sigma, uint64_t seed,
+                                         bool turn_centres = true) {
     const DatasetInfo info = ReadDatasetInfo(dir_);
     Rig declared = info.rig;
     for (RigCamera& c : declared.cameras) {
@@ -41,6 +42,7 @@ class RingAngleScale : public ::testing::Test {
     }
     RingCalibrationOptions options;
     options.angle_scale_sigma = angle_scale_sigma;
+    options.turn_centres = turn_centres;
     RingCalibrator ring(declared.WithExtrinsics(PerturbExtrinsics(info.rig, 5.0, 0.0, seed).cam_from_rig), {}, options);
     ring.AddFrame(LoadFrameImages(dir_, info.rig, 0).images);
     return ring.Solve();
@@ -67,6 +69,25 @@ TEST_F(RingAngleScale, ExactLensesKeepScaleOne) {
   ASSERT_TRUE(r.converged) << r.reason;
   EXPECT_NEAR(r.angle_scale, 1.0, 0.003);
   EXPECT_LT(RelativeExtrinsicErrorDeg(r.cam_from_rig, Truth()), 0.5);
+}
+
+// The draw turns camera 0 too, and camera 0 stays the gauge: the centres take the solution's common
+// turn, so every camera sees the others' centres where they are (the draw's turn of camera 0 left
+// in the baselines moves them by about a tenth of their length).
+TEST_F(RingAngleScale, TheBaselinesFollowTheCameras) {
+  const RingCalibrationReport turned = Calibrate(1.0, 0.03, 8101);
+  const RingCalibrationReport kept = Calibrate(1.0, 0.03, 8101, false);
+  ASSERT_TRUE(turned.converged) << turned.reason;
+  ASSERT_TRUE(kept.converged) << kept.reason;
+  const double turned_m = RelativeExtrinsicTranslationErrorM(turned.cam_from_rig, Truth());
+  const double kept_m = RelativeExtrinsicTranslationErrorM(kept.cam_from_rig, Truth());
+  std::fprintf(stderr, "cam_i_from_cam0 translation error: centres turned %.1f mm, kept %.1f mm\n", 1000 * turned_m,
+               1000 * kept_m);
+  EXPECT_LT(turned_m, 0.006);
+  EXPECT_GT(kept_m, 10.0 * turned_m);
+  EXPECT_NEAR(RelativeExtrinsicErrorDeg(turned.cam_from_rig, Truth()), RelativeExtrinsicErrorDeg(kept.cam_from_rig, Truth()),
+              1e-9);  // the relative rotations are the same
+  EXPECT_EQ(turned.cam_from_rig[0].translation, kept.cam_from_rig[0].translation);  // camera 0 stays the gauge
 }
 
 TEST_F(RingAngleScale, FindsTheScaleOfLensesThatOverstateAngles) {
