@@ -25,8 +25,9 @@
 // (Ceres), started by chaining the pairs from camera 0, then refined jointly on every pair's epipolar
 // residuals, each baseline direction following its camera, with one angle scale of every lens's
 // off-axis angle (angle_scale_sigma). Loop closure, |Log(prod of R_ba around the ring)|, checks the
-// pairs' consistency. The result keeps every camera's centre in the rig frame
-// (the perturbation protocol turns cameras about their centres).
+// pairs' consistency. Camera 0 stays the gauge (its cam_from_rig is kept); the joint solution's
+// common turn of the cameras against their centres (camera 0's own error, seen through the
+// baselines' directions) turns the other centres about camera 0's instead (turn_centres).
 
 #include "datasets/rig.h"
 #include "datasets/rigid3.h"
@@ -98,7 +99,7 @@ struct RingCalibrationReport {
   double max_pair_disagreement_deg = 0.0;  // largest angle between a pair's own and the joint rotation
   double uncertainty_deg = -1.0;       // one sigma of the worst-determined camera (RingUncertaintyDeg)
   double angle_scale = 1.0;            // the lenses' off-axis angle scale of the joint solution
-  std::vector<Rigid3> cam_from_rig;    // calibrated (camera 0 and every centre unchanged)
+  std::vector<Rigid3> cam_from_rig;    // calibrated (camera 0 unchanged; the centres turned about it)
 };
 
 // How well one calibration explains a ring pair's overlap matches (RingCalibrator::Fit).
@@ -128,8 +129,7 @@ class RingCalibrator {
   RingCalibrationReport Solve() const;
   // The pooled overlap matches judged by a given calibration: `cam_from_rig` (rotations used; every
   // centre stays the rig's) and the lenses' off-axis angle scale (RingCalibrationReport::angle_scale).
-  // The cameras' common rotation against their centres (which the start-up leaves at the given camera
-  // 0's) is first fitted to the matches (Cauchy at the inlier threshold), so only the relative
+  // The cameras' common rotation against their centres is first fitted to the matches (Cauchy at the inlier threshold), so only the relative
   // rotations and the lenses are judged. Two calibrations compared on the same matches: the one that
   // explains more of them, with smaller residuals, fits the images better.
   std::vector<RingPairFit> Fit(const std::vector<Rigid3>& cam_from_rig, double angle_scale = 1.0) const;

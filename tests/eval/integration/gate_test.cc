@@ -132,6 +132,9 @@ TEST_F(GateTest, CalibrationConvergesOnFreshDraws) {
   ASSERT_EQ(shot.status, 0) << shot.output;
   const nlohmann::json s = ReadJsonFile(shot_dir + "/calibration.json");
   EXPECT_GE(s.at("converged").get<int>(), 9) << shot.output;
+  // The baselines too: each camera sees camera 0's centre within 1 cm of where it is (draws 9000-9019:
+  // 4.3 mm at worst; with camera 0's drawn error left in the baselines, 60-290 mm).
+  for (const auto& draw : s.at("per_draw")) EXPECT_LT(draw.at("startup_mm").get<double>(), 10.0) << draw.dump();
   EXPECT_TRUE(fs::is_regular_file(shot_dir + "/calibration.csv"));
   // The rendered rig is the truth: the converged results explain frame 0's overlap matches as well as it.
   const nlohmann::json& fit = s.at("overlap_fit");
@@ -148,7 +151,10 @@ TEST_F(GateTest, CalibrationConvergesOnFreshDraws) {
   ASSERT_EQ(run.status, 0) << run.output;
   const nlohmann::json r = ReadJsonFile(run_dir + "/calibration.json");
   EXPECT_EQ(r.at("converged").get<int>(), 3) << run.output;
-  for (const auto& draw : r.at("per_draw")) EXPECT_LT(draw.at("end_deg").get<double>(), 0.1) << draw.dump();
+  for (const auto& draw : r.at("per_draw")) {
+    EXPECT_LT(draw.at("end_deg").get<double>(), 0.1) << draw.dump();
+    EXPECT_LT(draw.at("end_mm").get<double>(), 20.0) << draw.dump();  // draws 9000-9019: 5.0 mm at worst
+  }
 }
 
 // The same bars for quick canyon_multifov: a narrow street (near-field overlaps) seen by 400x384 lenses,
@@ -170,6 +176,8 @@ TEST_F(GateTest, CanyonCalibrationConvergesOnFreshDraws) {
   ASSERT_EQ(run.status, 0) << run.output;
   const nlohmann::json r = ReadJsonFile(run_dir + "/calibration.json");
   EXPECT_EQ(r.at("converged").get<int>(), 5) << run.output;
+  // draws 9000-9019: 9.0 mm at worst at the run's end
+  for (const auto& draw : r.at("per_draw")) EXPECT_LT(draw.at("end_mm").get<double>(), 20.0) << draw.dump();
 }
 
 }  // namespace
