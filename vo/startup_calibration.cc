@@ -147,14 +147,21 @@ RingCalibrationReport AverageOverPlacements(const Rig& rig, RingCalibrationRepor
   last.angle_scale = scale_sum / static_cast<double>(results.size());
   *spread_deg = 0.0;
   for (size_t j = 1; j < n; ++j) {
+    // Each placement keeps its own (turned) camera 0 as the gauge, so only the relative poses
+    // cam_j_from_cam0 are comparable: their rotations and translations are averaged and put back
+    // behind `last`'s camera 0.
     Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
-    for (const RingCalibrationReport& r : results) sum += camj_from_cam0(r, j).toRotationMatrix();
+    Eigen::Vector3d translation_sum = Eigen::Vector3d::Zero();
+    for (const RingCalibrationReport& r : results) {
+      sum += camj_from_cam0(r, j).toRotationMatrix();
+      translation_sum += (r.cam_from_rig[j] * r.cam_from_rig[0].Inverse()).translation;
+    }
     const Eigen::Quaterniond mean = ChordalMean(sum);
     for (const RingCalibrationReport& r : results) {
       *spread_deg = std::max(*spread_deg, RotationDistanceDeg(camj_from_cam0(r, j), mean));
     }
-    const Eigen::Quaterniond camj_from_rig = (mean * last.cam_from_rig[0].rotation).normalized();
-    last.cam_from_rig[j] = Rigid3(camj_from_rig, -(camj_from_rig * CameraPositionInRig(last.cam_from_rig[j])));
+    const Rigid3 camj_from_cam0_mean(mean, translation_sum / static_cast<double>(results.size()));
+    last.cam_from_rig[j] = camj_from_cam0_mean * last.cam_from_rig[0];
   }
   *averaged = static_cast<int>(results.size());
   return last;

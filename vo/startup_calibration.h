@@ -79,8 +79,9 @@ struct StartupCalibrationReport {
   bool converged = false;
   std::string status;                 // "converged", or why not
   std::vector<int> shots;             // frames used by the ring stage
-  // The ring passes' result (of the rescue when it ran). With placements averaged, cam_from_rig and
-  // angle_scale are their average; pairs, loop error and uncertainty are the first placement's.
+  // The ring passes' result (of the rescue when it ran). With placements averaged, cam_from_rig (as
+  // cam_j_from_cam0 behind the first placement's camera 0) and angle_scale are their average; pairs,
+  // loop error and uncertainty are the first placement's.
   RingCalibrationReport ring;
   bool rescued = false;               // the ring passes failed and the rescue ran
   std::string ring_failure;           // why the ring passes failed, when the rescue ran
