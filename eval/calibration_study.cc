@@ -45,6 +45,8 @@ bool RunReusable(const std::string& dir, uint64_t seed, int frame_end, int start
     const nlohmann::json j = nlohmann::json::parse(ReadFile(RunInfoPath(dir)));
     return j.value("draw_seed", int64_t{-1}) == static_cast<int64_t>(seed) && j.at("frames")[1] == frame_end &&
            j.value("online_startup_shots", -1) == startup_shots && j.value("online_startup_spacing", -1) == spacing &&
+           j.value("online_anchor_deg", -1.0) == VoOptions{}.online_anchor_deg &&
+           j.value("online_anchor_mm", -1.0) == VoOptions{}.online_anchor_mm && j.value("version", "") == ROVO_VERSION &&
            j.contains("startup_calibration");
   } catch (const std::exception&) {
     return false;

@@ -187,6 +187,11 @@ void CheckVoOptions(const VoOptions& options) {
     throw std::invalid_argument("vo: the RANSAC inlier threshold must be positive (--tau, degrees), got " +
                                 std::to_string(options.ransac_tau_deg));
   }
+  if (!(options.online_anchor_deg >= 0.0) || !(options.online_anchor_mm >= 0.0)) {
+    throw std::invalid_argument("vo: the OnlineExt anchor's sigmas must be >= 0 (--online-anchor " +
+                                std::to_string(options.online_anchor_deg) + " deg, --online-anchor-mm " +
+                                std::to_string(options.online_anchor_mm) + ")");
+  }
 }
 
 FrontendOptions MakeFrontendOptions(const VoOptions& options) {
@@ -342,7 +347,8 @@ VoSummary RunVo(const VoOptions& options) {
     if (startup.converged) {
       backend_options.ba.extrinsic_anchor = startup.cam_from_rig;
       backend_options.ba.extrinsic_anchor_deg = options.online_anchor_deg;
-      backend_options.ba.extrinsic_anchor_m = 0.001 * options.online_anchor_mm;
+      // The centres are held only where the start-up knew them (it turned them by a well-determined turn).
+      backend_options.ba.extrinsic_anchor_m = startup.ring.centres_known ? 0.001 * options.online_anchor_mm : 0.0;
     }
   }
   VoSummary summary;

@@ -594,11 +594,13 @@ RingModel RefineRing(const std::vector<PairState>& pairs, const std::vector<std:
 // variance, largest eigenvalue over cameras 1..N-1. A near-field overlap leaves the rotation about
 // the epipolar planes' normal (roughly the yaw of a pair) nearly free, because depth absorbs it:
 // this is where that shows. -1: not computable.
+// camera_zero_free: every camera free, and the result is camera 0's one sigma alone (how well the
+// matches, without the prior, know the cameras' common turn against their centres).
 double RingUncertaintyDeg(const std::vector<PairState>& pairs, const std::vector<std::vector<int>>& inliers,
-                          const Rig& rig, RingModel model, bool angle_scale_free) {
+                          const Rig& rig, RingModel model, bool angle_scale_free, bool camera_zero_free = false) {
   ceres::Problem problem;
   for (auto& q : model.rotations) problem.AddParameterBlock(q.coeffs().data(), 4, new ceres::EigenQuaternionManifold);
-  problem.SetParameterBlockConstant(model.rotations[0].coeffs().data());
+  if (!camera_zero_free) problem.SetParameterBlockConstant(model.rotations[0].coeffs().data());
   std::vector<double> residuals;
   AddRingResiduals(pairs, inliers, rig, 0.0, angle_scale_free, &model, &problem, &residuals);
   if (residuals.size() < 10) return -1.0;
@@ -609,12 +611,13 @@ double RingUncertaintyDeg(const std::vector<PairState>& pairs, const std::vector
   options.null_space_rank = -1;
   ceres::Covariance covariance(options);
   std::vector<std::pair<const double*, const double*>> blocks;
-  for (size_t j = 1; j < model.rotations.size(); ++j) {
+  const size_t first = camera_zero_free ? 0 : 1, end = camera_zero_free ? 1 : model.rotations.size();
+  for (size_t j = first; j < end; ++j) {
     blocks.emplace_back(model.rotations[j].coeffs().data(), model.rotations[j].coeffs().data());
   }
   if (!covariance.Compute(blocks, &problem)) return -1.0;
   double worst = 0.0;
-  for (size_t j = 1; j < model.rotations.size(); ++j) {
+  for (size_t j = first; j < end; ++j) {
     Eigen::Matrix3d c;
     covariance.GetCovarianceMatrixInTangentSpace({model.rotations[j].coeffs().data()}, c.data());
     const double largest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(c).eigenvalues().maxCoeff();
@@ -930,8 +933,13 @@ RingCalibrationReport RingCalibrator::Solve() const {
   // centres (model.rotations[0] against cam0_from_rig); with camera 0 kept, the centres turn by the
   // inverse about camera 0's centre instead, so that every baseline keeps the direction the solution
   // gives it in each camera (turn_centres; false: the centres stay the given ones).
-  const Eigen::Quaterniond rig_turn =
-      o.turn_centres ? (cam0_from_rig.inverse() * model.rotations[0]).normalized() : Eigen::Quaterniond::Identity();
+  report.common_turn_deg = RotationDistanceDeg(model.rotations[0], cam0_from_rig);
+  report.common_turn_sigma_deg = RingUncertaintyDeg(impl_->pairs, inliers, rig, model, model.kappa != 0.0, true);
+  report.centres_turned = o.turn_centres;
+  report.centres_known = o.turn_centres && report.common_turn_sigma_deg >= 0.0 &&
+                         report.common_turn_sigma_deg <= o.max_common_turn_sigma_deg;
+  const Eigen::Quaterniond rig_turn = report.centres_turned ? (cam0_from_rig.inverse() * model.rotations[0]).normalized()
+                                                            : Eigen::Quaterniond::Identity();
   const Eigen::Vector3d centre0 = CameraPositionInRig(rig.cameras[0].cam_from_rig);
   for (int j = 1; j < n; ++j) {
     const Eigen::Vector3d centre = centre0 + rig_turn * (CameraPositionInRig(rig.cameras[j].cam_from_rig) - centre0);

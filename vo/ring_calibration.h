@@ -75,6 +75,10 @@ struct RingCalibrationOptions {
   // (turned about camera 0's), so each baseline's direction in its cameras is the solution's; false:
   // the centres stay the given ones (and the baselines keep camera 0's given error).
   bool turn_centres = true;
+  // The turned centres count as known (RingCalibrationReport::centres_known) when the matches alone
+  // know the turn within this one sigma. A less certain turn is still given to the centres: the
+  // solution's estimate, held near the given camera 0 by its prior, beats the draw's error.
+  double max_common_turn_sigma_deg = 0.5;
   void Check() const;
 };
 
@@ -99,6 +103,10 @@ struct RingCalibrationReport {
   double max_pair_disagreement_deg = 0.0;  // largest angle between a pair's own and the joint rotation
   double uncertainty_deg = -1.0;       // one sigma of the worst-determined camera (RingUncertaintyDeg)
   double angle_scale = 1.0;            // the lenses' off-axis angle scale of the joint solution
+  double common_turn_deg = 0.0;        // the joint solution's common turn of the cameras against their centres
+  double common_turn_sigma_deg = -1.0; // its one sigma from the matches alone (no prior); < 0: not computed
+  bool centres_turned = false;         // the centres took that turn (turn_centres)
+  bool centres_known = false;          // ... and the matches know it (max_common_turn_sigma_deg)
   std::vector<Rigid3> cam_from_rig;    // calibrated (camera 0 unchanged; the centres turned about it)
 };
 
@@ -129,8 +137,8 @@ class RingCalibrator {
   RingCalibrationReport Solve() const;
   // The pooled overlap matches judged by a given calibration: `cam_from_rig` (rotations used; every
   // centre stays the rig's) and the lenses' off-axis angle scale (RingCalibrationReport::angle_scale).
-  // The cameras' common rotation against their centres is first fitted to the matches (Cauchy at the inlier threshold), so only the relative
-  // rotations and the lenses are judged. Two calibrations compared on the same matches: the one that
+  // The cameras' common rotation against their centres is first fitted to the matches (Cauchy at the
+  // inlier threshold), so only the relative rotations and the lenses are judged. Two calibrations compared on the same matches: the one that
   // explains more of them, with smaller residuals, fits the images better.
   std::vector<RingPairFit> Fit(const std::vector<Rigid3>& cam_from_rig, double angle_scale = 1.0) const;
 

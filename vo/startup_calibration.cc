@@ -220,7 +220,9 @@ RingCalibrationReport RunRingStage(const Rig& rig, const std::vector<Rigid3>& ca
   return ring;
 }
 
-// Stage 2's lenses: scaled by a converged ring stage's angle scale where the lens model allows it.
+// Stage 2's lenses: scaled by a converged ring stage's angle scale where the lens model allows it
+// (whatever VoOptions::online_apply_lens_scale says: stage 2 refines the ring's solution, which was
+// found with the scaled lenses; the lenses the VO then uses are the pipeline's choice).
 Rig RefinementRig(const Rig& rig, const RingCalibrationReport& ring) {
   if (!ring.converged || ring.angle_scale == 1.0) return rig;
   try {
@@ -262,6 +264,10 @@ nlohmann::json StartupCalibrationReport::ToJson() const {
                     {"reason", ring.reason},
                     {"loop_error_deg", ring.loop_error_deg},
                     {"angle_scale", ring.angle_scale},
+                    {"common_turn_deg", ring.common_turn_deg},
+                    {"common_turn_sigma_deg", ring.common_turn_sigma_deg},
+                    {"centres_turned", ring.centres_turned},
+                    {"centres_known", ring.centres_known},
                     {"uncertainty_deg", ring.uncertainty_deg},
                     {"rescued", rescued},
                     {"failure_before_rescue", ring_failure},

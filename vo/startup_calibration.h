@@ -48,8 +48,8 @@ struct StartupCalibrationOptions {
   double max_pass_change_deg = 0.5;   // a later pass moving a camera further: not converged
   // The last pass again from placements - 1 other view placements (every camera's turned by
   // placement_jitter_deg about a fixed axis), the converged results within max_pass_change_deg of the
-  // first averaged: which corners a pass matches depends on where its views' pixel grid falls, and the
-  // mean depends less on it.
+  // first and with its lens decision (angle scale estimated or left at 1) averaged: which corners a
+  // pass matches depends on where its views' pixel grid falls, and the mean depends less on it.
   int placements = 3;
   double placement_jitter_deg = 0.3;
   // When the ring passes fail, once more with more and weaker features (an overlap with little

@@ -155,8 +155,8 @@ TEST(LocalBa, OnlineCalibrationRecoversPerturbedExtrinsics) {
 }
 
 // The anchor holds the centres only when extrinsic_anchor_m is set: with an anchor whose camera-2
-// centre is 2 cm off, exact observations keep that centre in place without it, and a tight centre
-// sigma pulls it to the anchor's.
+// centre is 2 cm off, a tight centre sigma pulls the centre 2 cm to the anchor's (without it, the exact
+// observations keep it at its true place).
 TEST(LocalBa, TheAnchorHoldsTheCentresWhenAsked) {
   std::mt19937_64 rng(53);
   const Scenario s = MakeScenario(rng, 6, 300);

@@ -21,7 +21,9 @@ inline double RelativeExtrinsicErrorDeg(const std::vector<Rigid3>& est, const st
 inline double RelativeExtrinsicTranslationErrorM(const std::vector<Rigid3>& est, const std::vector<Rigid3>& truth) {
   double worst = 0.0;
   for (size_t i = 1; i < est.size(); ++i) {
-    worst = std::max(worst, ((est[i] * est[0].Inverse()).translation - (truth[i] * truth[0].Inverse()).translation).norm());
+    const Eigen::Vector3d e = (est[i] * est[0].Inverse()).translation;
+    const Eigen::Vector3d t = (truth[i] * truth[0].Inverse()).translation;
+    worst = std::max(worst, (e - t).norm());
   }
   return worst;
 }

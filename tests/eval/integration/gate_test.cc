@@ -132,9 +132,13 @@ TEST_F(GateTest, CalibrationConvergesOnFreshDraws) {
   ASSERT_EQ(shot.status, 0) << shot.output;
   const nlohmann::json s = ReadJsonFile(shot_dir + "/calibration.json");
   EXPECT_GE(s.at("converged").get<int>(), 9) << shot.output;
-  // The baselines too: each camera sees camera 0's centre within 1 cm of where it is (draws 9000-9019:
-  // 4.3 mm at worst; with camera 0's drawn error left in the baselines, 60-290 mm).
-  for (const auto& draw : s.at("per_draw")) EXPECT_LT(draw.at("startup_mm").get<double>(), 10.0) << draw.dump();
+  // The baselines too: after a converged shot each camera sees camera 0's centre within 1 cm of where
+  // it is (draws 9000-9019: 4.3 mm at worst; with camera 0's drawn error left in the baselines, 60-290 mm).
+  for (const auto& draw : s.at("per_draw")) {
+    if (draw.at("converged").get<bool>()) {
+      EXPECT_LT(draw.at("startup_mm").get<double>(), 10.0) << draw.dump();
+    }
+  }
   EXPECT_TRUE(fs::is_regular_file(shot_dir + "/calibration.csv"));
   // The rendered rig is the truth: the converged results explain frame 0's overlap matches as well as it.
   const nlohmann::json& fit = s.at("overlap_fit");
