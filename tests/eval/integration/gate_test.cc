@@ -133,7 +133,7 @@ TEST_F(GateTest, CalibrationConvergesOnFreshDraws) {
   const nlohmann::json s = ReadJsonFile(shot_dir + "/calibration.json");
   EXPECT_GE(s.at("converged").get<int>(), 9) << shot.output;
   // The baselines too: after a converged shot each camera sees camera 0's centre within 1 cm of where
-  // it is (draws 9000-9019: 4.3 mm at worst; with camera 0's drawn error left in the baselines, 60-290 mm).
+  // it is (draws 9000-9019: 3.8 mm at worst; with camera 0's drawn error left in the baselines, 60-290 mm).
   for (const auto& draw : s.at("per_draw")) {
     if (draw.at("converged").get<bool>()) {
       EXPECT_LT(draw.at("startup_mm").get<double>(), 10.0) << draw.dump();
@@ -157,7 +157,7 @@ TEST_F(GateTest, CalibrationConvergesOnFreshDraws) {
   EXPECT_EQ(r.at("converged").get<int>(), 3) << run.output;
   for (const auto& draw : r.at("per_draw")) {
     EXPECT_LT(draw.at("end_deg").get<double>(), 0.1) << draw.dump();
-    EXPECT_LT(draw.at("end_mm").get<double>(), 20.0) << draw.dump();  // draws 9000-9019: 5.0 mm at worst
+    EXPECT_LT(draw.at("end_mm").get<double>(), 20.0) << draw.dump();  // draws 9000-9019: 6.8 mm at worst
   }
 }
 
@@ -180,7 +180,7 @@ TEST_F(GateTest, CanyonCalibrationConvergesOnFreshDraws) {
   ASSERT_EQ(run.status, 0) << run.output;
   const nlohmann::json r = ReadJsonFile(run_dir + "/calibration.json");
   EXPECT_EQ(r.at("converged").get<int>(), 5) << run.output;
-  // draws 9000-9019: 9.0 mm at worst at the run's end
+  // draws 9000-9019: 8.0 mm at worst at the run's end
   for (const auto& draw : r.at("per_draw")) EXPECT_LT(draw.at("end_mm").get<double>(), 20.0) << draw.dump();
 }
 
