@@ -71,7 +71,7 @@ class RealRigCalibration : public ::testing::Test {
 std::string RealRigCalibration::dir_;
 
 // One shot per frame, draws 7000-7009: no draw claims convergence beyond 1.0 deg from the file's
-// calibration. Measured: frame 0 converges on 9 of 10 draws (0.44-0.57 deg), frame 1 on none (its
+// calibration. Measured: frame 0 converges on 10 of 10 draws (0.49-0.56 deg), frame 1 on none (its
 // plain-walled 0-1 overlap leaves the ring open), frame 2 on none (two pairs of 20-60 matches; the
 // one draw whose ring closed, 1.04 deg from the file, has a pair 0.78 deg from the joint solution);
 // they keep the drawn extrinsics and say why, instead of returning a wrong result.
@@ -84,10 +84,10 @@ TEST_F(RealRigCalibration, NoShotClaimsAWrongResult) {
 
 // Frame 0 (the textured hall) alone, draws 7100-7109: at least 9 converge within 1.0 deg of the file's
 // calibration, agreeing with each other within 0.3 deg, and the lenses' angle scale comes out above 1
-// on every one (the file's lenses understate angles near the rim). Measured: 10 of 10, 0.42-0.55 deg
-// from the file, scale 1.015-1.016, agreeing within 0.14 deg (0.18 with one view placement; these draws
+// on every one (the file's lenses understate angles near the rim). Measured: 10 of 10, 0.44-0.56 deg
+// from the file, scale 1.015-1.017, agreeing within 0.14 deg (0.18 with one view placement; these draws
 // were among those that chose the later passes' corner density; fresh draws 7500-7709 agree within
-// 0.17-0.25 deg, docs/results.md).
+// 0.12-0.17 deg, docs/results.md).
 TEST_F(RealRigCalibration, TexturedShotConvergesAlone) {
   const Outcome o = Run(0, 1, 7100, 10, 1.0);
   EXPECT_GE(o.close, 9);
@@ -101,7 +101,7 @@ TEST_F(RealRigCalibration, TexturedShotConvergesAlone) {
 
 // The three shots pooled (three places, one rig), draws 7300-7309, which were not used for tuning:
 // at least 9 converge within 1.0 deg of the file's calibration and agree with each other within 0.3 deg.
-// Measured: 10 of 10, 0.30-0.41 deg from the file, agreeing within 0.18 deg (lens angle scale 1.006-1.009).
+// Measured: 10 of 10, 0.32-0.42 deg from the file, agreeing within 0.16 deg (lens angle scale 1.008-1.009).
 TEST_F(RealRigCalibration, ThreePooledShotsConvergeAndAgree) {
   const Outcome o = Run(0, 3, 7300, 10, 1.0);
   EXPECT_GE(o.close, 9);
