@@ -138,8 +138,9 @@ class RingCalibrator {
   // The pooled overlap matches judged by a given calibration: `cam_from_rig` (rotations used; every
   // centre stays the rig's) and the lenses' off-axis angle scale (RingCalibrationReport::angle_scale).
   // The cameras' common rotation against their centres is first fitted to the matches (Cauchy at the
-  // inlier threshold), so only the relative rotations and the lenses are judged. Two calibrations compared on the same matches: the one that
-  // explains more of them, with smaller residuals, fits the images better.
+  // inlier threshold), so only the relative rotations and the lenses are judged. Two calibrations
+  // compared on the same matches: the one that explains more of them, with smaller residuals, fits
+  // the images better.
   std::vector<RingPairFit> Fit(const std::vector<Rigid3>& cam_from_rig, double angle_scale = 1.0) const;
 
   // The overlap view of pair `pair_index` for camera `side` (0 = a, 1 = b) at the last AddFrame, for
