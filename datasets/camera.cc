@@ -1,13 +1,12 @@
 #include "datasets/camera.h"
 
-#include "datasets/camera_models.h"
-#include "datasets/ocam.h"
-
-#include <unsupported/Eigen/AutoDiff>
-
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <unsupported/Eigen/AutoDiff>
+
+#include "datasets/camera_models.h"
+#include "datasets/ocam.h"
 
 namespace rovo {
 namespace {
@@ -55,8 +54,8 @@ std::string ExpectedNumParamsText() {
 // Projection with d(uv)/d(point) by forward-mode automatic differentiation through the templated
 // model (three derivative directions, no heap allocation for up to kMaxInline parameters).
 template <typename Model>
-bool ProjectWithJacobian(const std::vector<double>& params, const Eigen::Vector3d& point_in_cam,
-                         Eigen::Vector2d* uv, Eigen::Matrix<double, 2, 3>* J_uv_point) {
+bool ProjectWithJacobian(const std::vector<double>& params, const Eigen::Vector3d& point_in_cam, Eigen::Vector2d* uv,
+                         Eigen::Matrix<double, 2, 3>* J_uv_point) {
   using Ad = Eigen::AutoDiffScalar<Eigen::Vector3d>;
   constexpr int kMaxInline = 48;
   const int n = static_cast<int>(params.size());

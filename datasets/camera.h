@@ -3,7 +3,6 @@
 // over the models of camera_models.h.
 
 #include <Eigen/Core>
-
 #include <optional>
 #include <string>
 #include <vector>

@@ -1,14 +1,14 @@
 // Speed of the camera models through Camera (double): Project, Project with Jacobian, Unproject,
 // on directions spread over the whole 220-degree FOV (a fixed pseudo-random set, so runs compare).
 // Run: build-*/datasets/rovo_datasets_benchmark
-#include "datasets/camera.h"
-#include "datasets/ocam.h"
-
 #include <benchmark/benchmark.h>
 
 #include <cmath>
 #include <random>
 #include <vector>
+
+#include "datasets/camera.h"
+#include "datasets/ocam.h"
 
 namespace rovo {
 namespace {

@@ -88,7 +88,8 @@ struct EquidistantModel {
     for (int i = 0; i < 20; ++i) {
       const T t2 = theta * theta;
       const T f = Distort(params, theta) - rho;
-      const T df = T(1) + t2 * (T(3) * params[4] + t2 * (T(5) * params[5] + t2 * (T(7) * params[6] + t2 * T(9) * params[7])));
+      const T df =
+          T(1) + t2 * (T(3) * params[4] + t2 * (T(5) * params[5] + t2 * (T(7) * params[6] + t2 * T(9) * params[7])));
       if (!(df > T(0))) return false;
       const T step = f / df;
       theta -= step;

@@ -1,18 +1,16 @@
 // `rovo dataset ...` subcommands: validate, info, rig, import-omnimvs (export, import, lens-fit: exchange_cli.cc).
-#include "datasets/cli_groups.h"
-#include "datasets/dataset.h"
-#include "datasets/exchange.h"
-#include "datasets/omnimvs.h"
-
 #include <CLI/CLI.hpp>
-
-#include <stdexcept>
-
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <stdexcept>
 #include <string>
+
+#include "datasets/cli_groups.h"
+#include "datasets/dataset.h"
+#include "datasets/exchange.h"
+#include "datasets/omnimvs.h"
 
 namespace rovo {
 namespace {
@@ -54,8 +52,8 @@ void RunInfo(const std::string& dir) {
     std::printf("trajectory (groundtruth.tum missing)\n");
   }
   std::printf("depth      %s\nmasks      %s\n", info.has_depth ? "yes" : "no", info.has_masks ? "yes" : "no");
-  std::printf("\n%-8s %-14s %-11s %7s  %-26s %8s %8s\n", "camera", "model", "size", "FOV", "position in rig (m)",
-              "yaw", "pitch");
+  std::printf("\n%-8s %-14s %-11s %7s  %-26s %8s %8s\n", "camera", "model", "size", "FOV", "position in rig (m)", "yaw",
+              "pitch");
   for (const RigCamera& rc : info.rig.cameras) {
     // Rounded to the printed millimetre, without "-0.000".
     const Eigen::Vector3d position =
@@ -72,8 +70,8 @@ void RunInfo(const std::string& dir) {
     const PerturbedExtrinsics& set = info.perturbed[i];
     double max_deg = 0.0;
     for (size_t c = 0; c < set.cam_from_rig.size() && c < info.rig.cameras.size(); ++c) {
-      max_deg = std::max(max_deg, RotationDistanceDeg(set.cam_from_rig[c].rotation,
-                                                      info.rig.cameras[c].cam_from_rig.rotation));
+      max_deg = std::max(max_deg,
+                         RotationDistanceDeg(set.cam_from_rig[c].rotation, info.rig.cameras[c].cam_from_rig.rotation));
     }
     std::printf("  [%zu] sigma %.3g deg, %.3g m, seed %llu, largest rotation error %.2f deg\n", i,
                 set.sigma_rotation_deg, set.sigma_translation_m, static_cast<unsigned long long>(set.seed), max_deg);
@@ -95,7 +93,8 @@ void AddDatasetCommands(CliGroups& groups) {
 
   auto info_dir = std::make_shared<std::string>();
   CLI::App* info = dataset->add_subcommand(
-      "info", "Summary of a dataset: generator, seed, preset, frames, duration, path length, rig table, perturbed sets");
+      "info",
+      "Summary of a dataset: generator, seed, preset, frames, duration, path length, rig table, perturbed sets");
   info->add_option("dir", *info_dir, "Dataset folder")->required();
   info->callback([info_dir] { RunInfo(*info_dir); });
 
@@ -132,30 +131,33 @@ void AddDatasetCommands(CliGroups& groups) {
       "Convert an OmniMVS config.yaml rig calibration to rig.json (frame change to REP-103, inverse polynomials "
       "refitted; prints how far the file's own inverse polynomials were off)");
   import->add_option("yaml", import_options->yaml, "OmniMVS config.yaml")->required()->check(CLI::ExistingFile);
-  import->add_option("--out,-o", import_options->out,
-                     "Output rig.json, or with --images the dataset folder")->required();
-  import->add_option("--images", import_options->images,
-                     "Import the whole capture: the folder the config's dataset.img_fmt is relative to (a dataset "
-                     "without ground-truth poses)")->check(CLI::ExistingDirectory);
-  import->add_option("--masks", import_options->masks,
-                     "With --images: a folder of static masks cam<i>.png (0 = invalid: rig body, operator)")
+  import->add_option("--out,-o", import_options->out, "Output rig.json, or with --images the dataset folder")
+      ->required();
+  import
+      ->add_option("--images", import_options->images,
+                   "Import the whole capture: the folder the config's dataset.img_fmt is relative to (a dataset "
+                   "without ground-truth poses)")
+      ->check(CLI::ExistingDirectory);
+  import
+      ->add_option("--masks", import_options->masks,
+                   "With --images: a folder of static masks cam<i>.png (0 = invalid: rig body, operator)")
       ->check(CLI::ExistingDirectory);
   import->callback([import_options] {
     if (!import_options->images.empty()) {
       std::printf("%s", ImportOmniMvsCapture(import_options->yaml, import_options->images, import_options->masks,
                                              import_options->out).c_str());
-      return;
-    }
-    std::string report;
-    const Rig imported = ReadOmniMvsConfig(import_options->yaml, &report);
-    std::printf("%s", report.c_str());
-    WriteRigJson(import_options->out, imported, "omnimvs " + import_options->yaml);
-    std::printf("wrote %s (%d cameras)\n", import_options->out.c_str(), imported.NumCameras());
-  });
-
-  AddExchangeCommands(dataset);
+  return;
 }
+std::string report;
+const Rig imported = ReadOmniMvsConfig(import_options->yaml, &report);
+std::printf("%s", report.c_str());
+WriteRigJson(import_options->out, imported, "omnimvs " + import_options->yaml);
+std::printf("wrote %s (%d cameras)\n", import_options->out.c_str(), imported.NumCameras());
+}  // namespace rovo
+);
 
+AddExchangeCommands(dataset);
+}
 
 void ParseFrameRange(const std::string& text, int* begin, int* end) {
   if (text.empty()) return;

@@ -1,11 +1,6 @@
 #include "datasets/dataset.h"
 
-#include "datasets/camera_models.h"
-#include "datasets/io.h"
-#include "datasets/ocam.h"
-
 #include <OpenImageIO/imageio.h>
-#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -13,9 +8,14 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 #include <stdexcept>
+
+#include "datasets/camera_models.h"
+#include "datasets/io.h"
+#include "datasets/ocam.h"
 
 namespace rovo {
 namespace fs = std::filesystem;
@@ -91,8 +91,8 @@ class JsonChecker {
       return fallback;
     }
     if (v < lo || v > hi || (lo_open && v == lo)) {
-      Issue(pointer, "value " + Format(v) + " out of range " + (lo_open ? "(" : "[") + Format(lo) + ", " +
-                         Format(hi) + "]");
+      Issue(pointer,
+            "value " + Format(v) + " out of range " + (lo_open ? "(" : "[") + Format(lo) + ", " + Format(hi) + "]");
       return fallback;
     }
     return v;
@@ -151,8 +151,7 @@ class JsonChecker {
   }
 
   // Array of finite numbers; size checked when expected_size >= 0.
-  std::vector<double> Numbers(const json& obj, const std::string& pointer, const std::string& key,
-                              int expected_size) {
+  std::vector<double> Numbers(const json& obj, const std::string& pointer, const std::string& key, int expected_size) {
     const json* j = Member(obj, pointer, key);
     if (!j) return {};
     const std::string p = pointer + "/" + key;
@@ -382,8 +381,7 @@ SensorRecord ParseSensor(JsonChecker& check, const json& sj, const std::string& 
   s.sensitivity_spread = check.Number(sj, p, "sensitivity_spread", 0.0, 0.0, 10.0);
   s.camera_sensitivity = check.Numbers(sj, p, "camera_sensitivity", num_cameras);
   for (size_t c = 0; c < s.camera_sensitivity.size(); ++c) {
-    if (!(s.camera_sensitivity[c] > 0.0))
-      check.Issue(p + "/camera_sensitivity/" + std::to_string(c), "must be > 0");
+    if (!(s.camera_sensitivity[c] > 0.0)) check.Issue(p + "/camera_sensitivity/" + std::to_string(c), "must be > 0");
   }
   s.full_well_e = check.Number(sj, p, "full_well_e", 1.0, 0.0, kBig, /*lo_open=*/true);
   s.shot_noise = check.Bool(sj, p, "shot_noise");
@@ -407,7 +405,8 @@ TimingRecord ParseTiming(JsonChecker& check, const json& tj, const std::string& 
   if (t.exposure == "sensor" && !has_sensor)
     check.Issue(p + "/exposure", "`sensor` needs the /sensor record (exposure.csv holds the exposure times)");
   t.shutter_ms = check.Number(tj, p, "shutter_ms", 0.0, 0.0, 1000.0);
-  if (t.exposure == "fixed" && !(t.shutter_ms > 0.0)) check.Issue(p + "/shutter_ms", "must be > 0 with exposure `fixed`");
+  if (t.exposure == "fixed" && !(t.shutter_ms > 0.0))
+    check.Issue(p + "/shutter_ms", "must be > 0 with exposure `fixed`");
   if (t.exposure != "fixed" && t.shutter_ms != 0.0)
     check.Issue(p + "/shutter_ms", "must be 0 unless exposure is `fixed`");
   t.rolling_shutter_ms = check.Number(tj, p, "rolling_shutter_ms", 0.0, 0.0, 1000.0);
@@ -425,8 +424,8 @@ DatasetInfo ParseDatasetJson(JsonChecker& check, const json& root) {
   if (!check.Object(root, "")) return info;
   info.schema_version = static_cast<int>(check.Integer(root, "", "schema_version", 0, 1, 1 << 20));
   if (info.schema_version > kDatasetSchemaVersion) {
-    check.Issue("/schema_version", "version " + std::to_string(info.schema_version) +
-                                       " is newer than this reader (" + std::to_string(kDatasetSchemaVersion) + ")");
+    check.Issue("/schema_version", "version " + std::to_string(info.schema_version) + " is newer than this reader (" +
+                                       std::to_string(kDatasetSchemaVersion) + ")");
   }
   info.generator = check.String(root, "", "generator", true);
   info.generator_version = check.String(root, "", "generator_version", false);
@@ -437,8 +436,10 @@ DatasetInfo ParseDatasetJson(JsonChecker& check, const json& root) {
   info.frame_count = static_cast<int>(check.Integer(root, "", "frame_count", 0, 1, 100000000));
   info.has_depth = check.Bool(root, "", "has_depth");
   info.has_masks = check.Bool(root, "", "has_masks");
-  if (root.is_object() && root.contains("has_ground_truth")) info.has_ground_truth = check.Bool(root, "", "has_ground_truth");
-  if (root.is_object() && root.contains("has_static_masks")) info.has_static_masks = check.Bool(root, "", "has_static_masks");
+  if (root.is_object() && root.contains("has_ground_truth"))
+    info.has_ground_truth = check.Bool(root, "", "has_ground_truth");
+  if (root.is_object() && root.contains("has_static_masks"))
+    info.has_static_masks = check.Bool(root, "", "has_static_masks");
   if (const json* rig = check.Member(root, "", "rig")) info.rig = ParseRig(check, *rig, "/rig");
   if (root.is_object() && root.contains("sensor"))
     info.sensor = ParseSensor(check, root["sensor"], "/sensor", info.rig.NumCameras());
@@ -532,8 +533,9 @@ void CheckImage(const std::string& path, const std::string& field, int width, in
                            " but the rig camera is " + std::to_string(width) + "x" + std::to_string(height)});
   }
   if (spec.nchannels < 1 || spec.nchannels > max_channels) {
-    issues->push_back({path, field, "image has " + std::to_string(spec.nchannels) + " channels (expected 1.." +
-                                        std::to_string(max_channels) + ")"});
+    issues->push_back({path, field,
+                       "image has " + std::to_string(spec.nchannels) + " channels (expected 1.." +
+                           std::to_string(max_channels) + ")"});
   }
   input->close();
 }
@@ -617,18 +619,16 @@ std::vector<ExposureRow> ParseExposureCsv(const std::string& text, const std::st
   if (line_number == 0) {
     issues->push_back({path, "file", "empty file (expected the header and one row per frame and camera)"});
   } else if (rows.size() != expected_rows) {
-    issues->push_back({path, "lines", std::to_string(rows.size()) + " rows but dataset.json has " +
-                                          std::to_string(frame_count) + " frames x " + std::to_string(num_cameras) +
-                                          " cameras = " + std::to_string(expected_rows)});
+    issues->push_back({path, "lines",
+                       std::to_string(rows.size()) + " rows but dataset.json has " + std::to_string(frame_count) +
+                           " frames x " + std::to_string(num_cameras) + " cameras = " + std::to_string(expected_rows)});
   }
   return rows;
 }
 
 }  // namespace
 
-bool SensorRecord::operator==(const SensorRecord& o) const {
-  return SensorJson(*this) == SensorJson(o);
-}
+bool SensorRecord::operator==(const SensorRecord& o) const { return SensorJson(*this) == SensorJson(o); }
 
 bool TimingRecord::operator==(const TimingRecord& o) const { return TimingJson(*this) == TimingJson(o); }
 
@@ -764,7 +764,8 @@ static void CheckStaticMasks(const std::string& dir, const DatasetInfo& info, st
   for (const RigCamera& rc : info.rig.cameras) {
     const std::string path = StaticMaskPath(dir, rc.name);
     if (!fs::exists(path)) {
-      issues->push_back({path, "file", "missing static mask of camera " + rc.name + " (dataset.json has_static_masks)"});
+      issues->push_back(
+          {path, "file", "missing static mask of camera " + rc.name + " (dataset.json has_static_masks)"});
     } else {
       CheckImage(path, "header", rc.camera.width, rc.camera.height, 1, issues);
     }
@@ -831,12 +832,13 @@ std::vector<ValidationIssue> ValidateDataset(const std::string& dir) {
         const double qn = std::sqrt(line.values[4] * line.values[4] + line.values[5] * line.values[5] +
                                     line.values[6] * line.values[6] + line.values[7] * line.values[7]);
         if (!(std::abs(qn - 1.0) <= 1e-6)) {
-          issues.push_back({gt_path, field, "quaternion (qx qy qz qw) norm " + JsonChecker::Format(qn) +
-                                                " is not 1 (tolerance 1e-6)"});
+          issues.push_back({gt_path, field,
+                            "quaternion (qx qy qz qw) norm " + JsonChecker::Format(qn) + " is not 1 (tolerance 1e-6)"});
         }
         if (!(line.values[0] > previous_t)) {
-          issues.push_back({gt_path, field, "timestamp " + JsonChecker::Format(line.values[0]) +
-                                                " is not after the previous one " + JsonChecker::Format(previous_t)});
+          issues.push_back({gt_path, field,
+                            "timestamp " + JsonChecker::Format(line.values[0]) + " is not after the previous one " +
+                                JsonChecker::Format(previous_t)});
         }
         previous_t = line.values[0];
       }
@@ -847,8 +849,9 @@ std::vector<ValidationIssue> ValidateDataset(const std::string& dir) {
   }
   if (!json_ok) return issues;
   if (gt_lines >= 0 && info.frame_count > 0 && gt_lines != info.frame_count) {
-    issues.push_back({gt_path, "lines", std::to_string(gt_lines) + " poses but dataset.json /frame_count is " +
-                                            std::to_string(info.frame_count)});
+    issues.push_back(
+        {gt_path, "lines",
+         std::to_string(gt_lines) + " poses but dataset.json /frame_count is " + std::to_string(info.frame_count)});
   }
 
   if (json_ok && info.has_static_masks) CheckStaticMasks(dir, info, &issues);

@@ -2,13 +2,13 @@
 // The on-disk dataset (datasets/FORMAT.md): dataset.json, camN/NNNNNN.png, groundtruth.tum,
 // optional depth/ and masks/.
 
-#include "datasets/rig.h"
-#include "datasets/trajectory.h"
-
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "datasets/rig.h"
+#include "datasets/trajectory.h"
 
 namespace rovo {
 
@@ -17,10 +17,10 @@ inline constexpr int kDatasetSchemaVersion = 1;
 // dataset.json "sensor": the physical sensor model a render used (render/sensor.h; the rules are
 // in datasets/FORMAT.md, section "Sensor"). Absent for the default rendering.
 struct SensorRecord {
-  std::string profile;               // "ideal", "realistic"
+  std::string profile;  // "ideal", "realistic"
   bool auto_exposure = true;
-  double exposure_ms = 0.1;          // fixed exposure (auto_exposure false)
-  double gain = 1.0;                 // fixed analogue gain (auto_exposure false)
+  double exposure_ms = 0.1;  // fixed exposure (auto_exposure false)
+  double gain = 1.0;         // fixed analogue gain (auto_exposure false)
   double min_exposure_ms = 0.01;
   double max_exposure_ms = 20.0;
   double max_gain = 16.0;
@@ -36,8 +36,8 @@ struct SensorRecord {
   double read_noise_e = 0.0;
   double dark_current_e_per_s = 0.0;
   int adc_bits = 12;
-  std::string response = "srgb";     // "srgb", "bt709" or "linear"
-  bool grayscale = false;            // 1-channel images
+  std::string response = "srgb";  // "srgb", "bt709" or "linear"
+  bool grayscale = false;         // 1-channel images
   bool operator==(const SensorRecord& other) const;
   bool operator!=(const SensorRecord& other) const { return !(*this == other); }
 };
@@ -46,10 +46,10 @@ struct SensorRecord {
 // (render/timing.h; the time rules are in datasets/FORMAT.md, section "Timing"). Absent when every
 // camera saw frame i at the time of line i of groundtruth.tum.
 struct TimingRecord {
-  std::string exposure = "none";        // motion blur interval: "none", "fixed" (shutter_ms), "sensor" (exposure.csv)
-  double shutter_ms = 0.0;              // the fixed interval ("fixed"), else 0
-  double rolling_shutter_ms = 0.0;      // readout of the whole image, top row first; 0 = global shutter
-  double trigger_offset_std_ms = 0.0;   // standard deviation of the seeded draw (0: explicit or none)
+  std::string exposure = "none";          // motion blur interval: "none", "fixed" (shutter_ms), "sensor" (exposure.csv)
+  double shutter_ms = 0.0;                // the fixed interval ("fixed"), else 0
+  double rolling_shutter_ms = 0.0;        // readout of the whole image, top row first; 0 = global shutter
+  double trigger_offset_std_ms = 0.0;     // standard deviation of the seeded draw (0: explicit or none)
   std::vector<double> trigger_offset_ms;  // o_c, one per rig camera
   bool operator==(const TimingRecord& other) const;
   bool operator!=(const TimingRecord& other) const { return !(*this == other); }
@@ -75,7 +75,7 @@ struct DatasetInfo {
   std::string scene_hash;    // hash of the scene the images were rendered from
   double frame_rate = 10.0;  // Hz
   int frame_count = 0;
-  Rig rig;                   // ground-truth rig (intrinsics + cam_from_rig)
+  Rig rig;                                     // ground-truth rig (intrinsics + cam_from_rig)
   std::vector<PerturbedExtrinsics> perturbed;  // NoisyExt starting points
   bool has_depth = false;
   bool has_masks = false;
@@ -96,7 +96,7 @@ std::string GroundTruthPath(const std::string& dir);
 std::string ImagePath(const std::string& dir, const std::string& camera_name, int frame);  // camN/NNNNNN.png
 std::string DepthPath(const std::string& dir, const std::string& camera_name, int frame);  // depth/camN/NNNNNN.exr
 std::string MaskPath(const std::string& dir, const std::string& camera_name, int frame);   // masks/camN/NNNNNN.png
-std::string StaticMaskPath(const std::string& dir, const std::string& camera_name);      // static_masks/camN.png
+std::string StaticMaskPath(const std::string& dir, const std::string& camera_name);        // static_masks/camN.png
 std::string ExposurePath(const std::string& dir);                                          // exposure.csv
 
 // Reads and checks dataset.json (throws std::runtime_error naming file and field).

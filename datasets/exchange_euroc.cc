@@ -12,7 +12,6 @@
 namespace rovo {
 namespace {
 
-
 std::vector<double> ReadNumbers(const YAML::Node& node, const std::string& path, const std::string& field) {
   if (!node || !node.IsSequence()) throw std::runtime_error(path + ": " + field + ": missing or not a list");
   std::vector<double> out;

@@ -91,7 +91,8 @@ PerturbedExtrinsics PerturbationInfo(const std::string& path, ExchangeFormat for
         set.sigma_translation_m = p.value("sigma_translation_m", 0.0);
         set.seed = p.value("seed", uint64_t{0});
       } catch (const nlohmann::json::exception&) {  // not an object, or a field of another type
-        throw std::runtime_error(path + ": /rovo_perturbation: expected {sigma_rotation_deg, sigma_translation_m, seed} "
+        throw std::runtime_error(path +
+                                 ": /rovo_perturbation: expected {sigma_rotation_deg, sigma_translation_m, seed} "
                                  "numbers");
       }
     }

@@ -14,7 +14,6 @@
 namespace rovo {
 namespace {
 
-
 void WriteMatrix(std::ostringstream& out, const std::string& key, const Rigid3& b_from_a) {
   const Eigen::Matrix4d m = b_from_a.Matrix4();
   out << "  " << key << ":\n";
@@ -130,7 +129,8 @@ std::vector<ExchangeCamera> ReadKalibrCamchain(const std::string& path) {
     if (!node.IsMap() || !node["camera_model"]) throw std::runtime_error(what + "/camera_model: missing");
     lens.camera_model = Text(node["camera_model"], what + "/camera_model");
     lens.intrinsics = Numbers(node["intrinsics"], what + "/intrinsics");
-    lens.distortion_model = node["distortion_model"] ? Text(node["distortion_model"], what + "/distortion_model") : "none";
+    lens.distortion_model =
+        node["distortion_model"] ? Text(node["distortion_model"], what + "/distortion_model") : "none";
     if (node["distortion_coeffs"])
       lens.distortion_coeffs = Numbers(node["distortion_coeffs"], what + "/distortion_coeffs");
     FromKalibrFields(lens, what, &camera.model, &camera.params);

@@ -4,7 +4,6 @@
 // errors that name the file.
 
 #include <nlohmann/json.hpp>
-
 #include <string>
 
 namespace rovo {

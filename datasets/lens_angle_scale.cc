@@ -1,12 +1,11 @@
 #include "datasets/lens_angle_scale.h"
 
-#include "datasets/ocam.h"
-
 #include <Eigen/Dense>
-
 #include <cmath>
 #include <stdexcept>
 #include <string>
+
+#include "datasets/ocam.h"
 
 namespace rovo {
 namespace {

@@ -1,15 +1,14 @@
 #include "datasets/ocam.h"
 
-#include "datasets/camera_models.h"
-
 #include <Eigen/Dense>
-
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+
+#include "datasets/camera_models.h"
 
 namespace rovo {
 namespace {
@@ -48,7 +47,8 @@ void CheckBasics(const std::vector<double>& params, double max_fov_deg, const ch
                                 std::to_string(params.size()));
   }
   for (size_t i = 0; i < params.size(); ++i) {
-    if (!std::isfinite(params[i])) throw std::invalid_argument(where + "params[" + std::to_string(i) + "] is not finite");
+    if (!std::isfinite(params[i]))
+      throw std::invalid_argument(where + "params[" + std::to_string(i) + "] is not finite");
   }
   if (!(params[5] < 0)) throw std::invalid_argument(where + "params[5] (a0): must be negative, got " + Fmt(params[5]));
   if (!(std::abs(params[2] - params[3] * params[4]) > 1e-9)) {
@@ -275,8 +275,8 @@ Camera MakeOcamCamera(int width, int height, double cx, double cy, double c, dou
   const OcamInverseFit fit = FitOcamInversePolynomial(camera.params, max_fov_deg, tolerance_px);
   if (!(fit.max_error_px < tolerance_px)) {
     throw std::invalid_argument("MakeOcamCamera: inverse polynomial: the best fit (degree " +
-                                std::to_string(fit.inverse_poly.size() - 1) + ") is off by " +
-                                Fmt(fit.max_error_px) + " px, more than the tolerance " + Fmt(tolerance_px) + " px");
+                                std::to_string(fit.inverse_poly.size() - 1) + ") is off by " + Fmt(fit.max_error_px) +
+                                " px, more than the tolerance " + Fmt(tolerance_px) + " px");
   }
   camera.params.insert(camera.params.end(), fit.inverse_poly.begin(), fit.inverse_poly.end());
   camera.Check("MakeOcamCamera");
@@ -340,9 +340,9 @@ Camera ReadOcamCalibTxt(const std::string& path, double max_fov_deg, double* fil
 
   const std::vector<double> poly = counted(0);
   const std::vector<double> inverse = counted(1);
-  const std::vector<double> center = exactly(2, 2);   // row, column
-  const std::vector<double> affine = exactly(3, 3);   // c, d, e
-  const std::vector<double> size = exactly(4, 2);     // height, width
+  const std::vector<double> center = exactly(2, 2);  // row, column
+  const std::vector<double> affine = exactly(3, 3);  // c, d, e
+  const std::vector<double> size = exactly(4, 2);    // height, width
   if (poly.empty() || !(poly[0] < 0)) throw error(0, "a0 must be present and negative");
   for (size_t i = 5; i < poly.size(); ++i) {
     if (poly[i] != 0.0) throw error(0, "coefficient a" + std::to_string(i) + " is nonzero; only a0..a4 are supported");

@@ -14,10 +14,10 @@
 // affine A = [c d; e 1] (a bound on the pixel displacement), maximised over a dense theta grid
 // covering [-pi/2, theta_edge].
 
-#include "datasets/camera.h"
-
 #include <string>
 #include <vector>
+
+#include "datasets/camera.h"
 
 namespace rovo {
 
@@ -30,11 +30,11 @@ struct OcamInverseFit {
 // Least-squares fit of rho(theta) to the forward model over theta in [-pi/2, theta_edge + 2 deg]
 // (or up to where the forward model stays monotonic, if that is less), in a Chebyshev basis on the
 // interval mapped to [-1, 1] (solved with Eigen's ColPivHouseholderQR) and converted to monomials
-// in theta. The basis is (theta + pi/2) T_k, so rho(-pi/2) = 0: the axis maps to the centre. The degree increases from 3 until max_error_px < tolerance_px; returns the first fit
-// that meets it, else the one with the smallest max error up to max_degree (check max_error_px).
-// `params`: at least the first 10 values (cx .. a4); any inverse coefficients are ignored.
-// Throws std::invalid_argument when a0 >= 0, the affine is singular, max_fov_deg is not in
-// (0, 360), or theta(rho) is not increasing up to the FOV edge (message says where).
+// in theta. The basis is (theta + pi/2) T_k, so rho(-pi/2) = 0: the axis maps to the centre. The degree increases from
+// 3 until max_error_px < tolerance_px; returns the first fit that meets it, else the one with the smallest max error up
+// to max_degree (check max_error_px). `params`: at least the first 10 values (cx .. a4); any inverse coefficients are
+// ignored. Throws std::invalid_argument when a0 >= 0, the affine is singular, max_fov_deg is not in (0, 360), or
+// theta(rho) is not increasing up to the FOV edge (message says where).
 OcamInverseFit FitOcamInversePolynomial(const std::vector<double>& params, double max_fov_deg,
                                         double tolerance_px = 0.01, int max_degree = 20);
 
@@ -52,8 +52,7 @@ bool OcamForwardMonotonic(const std::vector<double>& params, double max_fov_deg,
 // are zero-padded). cx, cy in rovo pixels (column, row). Throws std::invalid_argument when the
 // fit does not reach tolerance_px or the parameters are invalid.
 Camera MakeOcamCamera(int width, int height, double cx, double cy, double c, double d, double e,
-                      const std::vector<double>& forward_poly, double max_fov_deg = 220.0,
-                      double tolerance_px = 0.01);
+                      const std::vector<double>& forward_poly, double max_fov_deg = 220.0, double tolerance_px = 0.01);
 
 // Reads Scaramuzza's OCamCalib calib_results.txt. After comment lines ('#') and blank lines come,
 // one per line:
@@ -72,7 +71,6 @@ Camera MakeOcamCamera(int width, int height, double cx, double cy, double c, dou
 // is kept when it agrees with the forward one to 0.01 px over the FOV and refitted otherwise;
 // `file_inverse_error_px` (optional) receives the file's own inverse error. Errors name the file,
 // the line and the field (std::runtime_error).
-Camera ReadOcamCalibTxt(const std::string& path, double max_fov_deg = 220.0,
-                        double* file_inverse_error_px = nullptr);
+Camera ReadOcamCalibTxt(const std::string& path, double max_fov_deg = 220.0, double* file_inverse_error_px = nullptr);
 
 }  // namespace rovo

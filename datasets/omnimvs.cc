@@ -1,10 +1,5 @@
 #include "datasets/omnimvs.h"
 
-#include "datasets/ocam.h"
-#include "datasets/dataset.h"
-#include "datasets/io.h"
-#include "rovo/version.h"
-
 #include <yaml-cpp/yaml.h>
 
 #include <cctype>
@@ -13,6 +8,11 @@
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
+
+#include "datasets/dataset.h"
+#include "datasets/io.h"
+#include "datasets/ocam.h"
+#include "rovo/version.h"
 
 namespace rovo {
 namespace {
@@ -31,8 +31,8 @@ struct OmniMvsCamera {
 // /work/shared/data/omnimvs_itbt_config.yaml, cameras 1..4 (rovo4_real).
 const OmniMvsCamera kItbtCameras[4] = {
     {{-392.21983020642324, 0.0, 0.0012707685299884767, -1.7456026867522776E-6, 2.257655719602505E-9},
-     {611.433, 386.965, -15.0504, -65.1466, -119.568, 27.7131, 355.781, 206.82, -667.654, -1290.67, -985.814,
-      -361.63, -52.6566},
+     {611.433, 386.965, -15.0504, -65.1466, -119.568, 27.7131, 355.781, 206.82, -667.654, -1290.67, -985.814, -361.63,
+      -52.6566},
      756.215,
      811.661,
      {0.999876, -2.91382E-4, -1.66556E-4},
@@ -53,8 +53,8 @@ const OmniMvsCamera kItbtCameras[4] = {
       -0.14432158757883862},
      220.0},
     {{-397.8543380457763, 0.0, 0.0014956852335708303, -2.272212930459553E-6, 2.6072875869332744E-9},
-     {607.095, 381.297, -21.3511, -43.0875, -56.1323, -71.1995, -22.3406, 318.49, 865.72, 1041.49, 665.323,
-      220.271, 29.8479},
+     {607.095, 381.297, -21.3511, -43.0875, -56.1323, -71.1995, -22.3406, 318.49, 865.72, 1041.49, 665.323, 220.271,
+      29.8479},
      769.23,
      809.789,
      {1.00032, -0.00668755, 0.00648385},
@@ -64,8 +64,8 @@ const OmniMvsCamera kItbtCameras[4] = {
       -0.15046281430153374},
      220.0},
     {{-392.9083750477403, 0.0, 0.0013458091464087045, -1.9466309855382977E-6, 2.4144190106312376E-9},
-     {609.338, 384.453, -20.1199, -45.4585, -36.506, -26.2937, -130.633, -175.538, 77.9449, 334.117, 279.3,
-      99.8473, 13.3981},
+     {609.338, 384.453, -20.1199, -45.4585, -36.506, -26.2937, -130.633, -175.538, 77.9449, 334.117, 279.3, 99.8473,
+      13.3981},
      797.373,
      819.266,
      {1.00004, -0.0140823, 0.0149072},
@@ -260,8 +260,7 @@ Rig ReadOmniMvsConfig(const std::string& yaml_path, std::string* report) {
 Rig MakeRovo4RealRig() {
   Rig rig;
   for (int i = 0; i < 4; ++i) {
-    rig.cameras.push_back(
-        ConvertCamera(kItbtCameras[i], i, "rovo4_real cameras[" + std::to_string(i) + "]", nullptr));
+    rig.cameras.push_back(ConvertCamera(kItbtCameras[i], i, "rovo4_real cameras[" + std::to_string(i) + "]", nullptr));
   }
   return rig;
 }
@@ -390,7 +389,8 @@ std::string ImportOmniMvsCapture(const std::string& yaml_path, const std::string
     }
     if (info.has_static_masks) {
       const fs::path mask = fs::path(masks_dir) / (name + ".png");
-      if (!fs::is_regular_file(mask)) throw std::runtime_error(mask.string() + ": missing static mask of camera " + name);
+      if (!fs::is_regular_file(mask))
+        throw std::runtime_error(mask.string() + ": missing static mask of camera " + name);
       fs::create_directories(fs::path(out_dir) / "static_masks");
       WriteFileAtomic(StaticMaskPath(out_dir, name), ReadFile(mask.string()));
     }
@@ -398,7 +398,8 @@ std::string ImportOmniMvsCapture(const std::string& yaml_path, const std::string
   for (int k = 0; k < 3; ++k) info.perturbed.push_back(PerturbExtrinsics(info.rig, 5.0, 0.0, 1000003ull + k));
   WriteDatasetInfo(out_dir, info);
   report += "imported " + std::to_string(info.frame_count) + " frames x " + std::to_string(info.rig.NumCameras()) +
-            " cameras into " + out_dir + " (no ground-truth poses" + (info.has_static_masks ? ", static masks" : "") + ")\n";
+            " cameras into " + out_dir + " (no ground-truth poses" + (info.has_static_masks ? ", static masks" : "") +
+            ")\n";
   return report;
 }
 

@@ -19,14 +19,14 @@
 // Intrinsics: OmniMVS reads the file with OCamCalib's conventions (x_o along rows:
 // (row, col) = [c d; e 1] (x_o, y_o) + center, OpenCV ray (y_o, x_o, -poly)). In our ocam layout
 // [cx, cy, c', d', e', a0'..a4', b0..b(K-1)] (x along columns) that is, after scaling the sensor
-// plane by c: cx = col, cy = row, c' = 1/c, d' = e/c, e' = d/c, a'_i = a_i c^(1-i). The file's own inverse polynomial is NOT used: it disagrees with
-// its forward polynomial by pixels; the inverse is refitted (FitOcamInversePolynomial) over the
-// full field of view.
-
-#include "datasets/rig.h"
+// plane by c: cx = col, cy = row, c' = 1/c, d' = e/c, e' = d/c, a'_i = a_i c^(1-i). The file's own inverse polynomial
+// is NOT used: it disagrees with its forward polynomial by pixels; the inverse is refitted (FitOcamInversePolynomial)
+// over the full field of view.
 
 #include <string>
 #include <vector>
+
+#include "datasets/rig.h"
 
 namespace rovo {
 

@@ -1,14 +1,19 @@
 #include "datasets/progress.h"
 
-#include <cstdio>
-
 #include <unistd.h>
+
+#include <cstdio>
 
 namespace rovo {
 
 Progress::Progress(std::string label, int64_t total, std::string unit, bool quiet)
-    : label_(std::move(label)), unit_(std::move(unit)), total_(total), quiet_(quiet), tty_(::isatty(2) != 0),
-      start_(std::chrono::steady_clock::now()), last_print_(start_) {}
+    : label_(std::move(label)),
+      unit_(std::move(unit)),
+      total_(total),
+      quiet_(quiet),
+      tty_(::isatty(2) != 0),
+      start_(std::chrono::steady_clock::now()),
+      last_print_(start_) {}
 
 Progress::~Progress() { Finish(); }
 
@@ -48,9 +53,9 @@ void Progress::Print(bool final_line) {
     const int filled = static_cast<int>(frac * width + 0.5);
     std::string bar(static_cast<size_t>(filled), '#');
     bar.resize(width, '.');
-    std::snprintf(line, sizeof(line), "\r%s [%s] %lld/%lld %s  %.2f %s/s  ETA %.0fs   ", label_.c_str(),
-                  bar.c_str(), static_cast<long long>(done_), static_cast<long long>(total_), unit_.c_str(), rate,
-                  unit_.c_str(), eta);
+    std::snprintf(line, sizeof(line), "\r%s [%s] %lld/%lld %s  %.2f %s/s  ETA %.0fs   ", label_.c_str(), bar.c_str(),
+                  static_cast<long long>(done_), static_cast<long long>(total_), unit_.c_str(), rate, unit_.c_str(),
+                  eta);
     std::fputs(line, stderr);
     if (final_line) std::fputs("\n", stderr);
   } else {

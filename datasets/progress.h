@@ -14,9 +14,9 @@ class Progress {
   // total: number of units; unit: e.g. "frames". quiet: print nothing.
   Progress(std::string label, int64_t total, std::string unit = "frames", bool quiet = false);
   ~Progress();
-  void Add(int64_t n = 1);          // n more units done
-  void SetDone(int64_t done);       // absolute count
-  void Finish();                    // final line (idempotent)
+  void Add(int64_t n = 1);     // n more units done
+  void SetDone(int64_t done);  // absolute count
+  void Finish();               // final line (idempotent)
 
  private:
   void Print(bool final_line);

@@ -1,12 +1,12 @@
 #include "datasets/rig.h"
 
-#include "datasets/ocam.h"
-#include "datasets/omnimvs.h"
-
 #include <cmath>
 #include <random>
 #include <set>
 #include <stdexcept>
+
+#include "datasets/ocam.h"
+#include "datasets/omnimvs.h"
 
 namespace rovo {
 namespace {
@@ -23,8 +23,8 @@ Camera ScaledCamera(const Camera& camera, double scale) {
   out.height = std::max(1, static_cast<int>(std::lround(camera.height * scale)));
   std::vector<double>& p = out.params;
   switch (camera.model) {
-    case CameraModelId::kEquidistant:  // fx fy cx cy k1..k4
-    case CameraModelId::kDoubleSphere:  // fx fy cx cy xi alpha
+    case CameraModelId::kEquidistant:      // fx fy cx cy k1..k4
+    case CameraModelId::kDoubleSphere:     // fx fy cx cy xi alpha
     case CameraModelId::kExtendedUnified:  // fx fy cx cy alpha beta
       if (p.size() < 4) throw std::invalid_argument("Rig::Scaled: camera has too few parameters");
       p[0] *= scale;
@@ -167,8 +167,8 @@ Rig Rig::Scaled(double scale) const {
 
 Rig Rig::WithExtrinsics(const std::vector<Rigid3>& cam_from_rig) const {
   if (cam_from_rig.size() != cameras.size()) {
-    throw std::invalid_argument("Rig::WithExtrinsics: " + std::to_string(cam_from_rig.size()) +
-                                " extrinsics for " + std::to_string(cameras.size()) + " cameras");
+    throw std::invalid_argument("Rig::WithExtrinsics: " + std::to_string(cam_from_rig.size()) + " extrinsics for " +
+                                std::to_string(cameras.size()) + " cameras");
   }
   Rig out = *this;
   for (size_t i = 0; i < cameras.size(); ++i) out.cameras[i].cam_from_rig = cam_from_rig[i];

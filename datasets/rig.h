@@ -3,14 +3,13 @@
 // Gauge: camera 0 is the reference for online extrinsics; its cam_from_rig is held fixed and the
 // other cameras are estimated relative to it (the paper's Fig. 8).
 
-#include "datasets/camera.h"
-#include "datasets/rigid3.h"
-
-#include <nlohmann/json_fwd.hpp>
-
 #include <cstdint>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
+
+#include "datasets/camera.h"
+#include "datasets/rigid3.h"
 
 namespace rovo {
 

@@ -7,8 +7,6 @@
 
 #include "datasets/run.h"
 
-#include "datasets/io.h"
-
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -17,16 +15,16 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "datasets/io.h"
+
 namespace rovo {
 namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> kFramesColumns = {"frame",        "timestamp",
-                                                 "num_correspondences", "num_inliers",
-                                                 "inlier_ratio", "mean_reproj_error_deg",
-                                                 "keyframe",     "status",
-                                                 "time_ms",      "missing_cameras"};
+const std::vector<std::string> kFramesColumns = {
+    "frame",  "timestamp", "num_correspondences", "num_inliers", "inlier_ratio", "mean_reproj_error_deg", "keyframe",
+    "status", "time_ms",   "missing_cameras"};
 // frames.csv as written before missing_cameras existed: still read (no camera missing).
 const std::vector<std::string> kFramesColumnsWithoutMissing(kFramesColumns.begin(), kFramesColumns.end() - 1);
 const std::vector<std::string> kExtrinsicsColumns = {"frame", "timestamp", "camera", "qx", "qy",
@@ -63,8 +61,8 @@ class CsvReader {
       std::vector<std::string> fields = Split(line);
       if (!have_header) {
         if (fields != columns_) {
-          throw std::runtime_error(path_ + ":" + std::to_string(line_number) +
-                                   ": bad header line, expected \"" + Join(columns_) + "\", got \"" + line + "\"");
+          throw std::runtime_error(path_ + ":" + std::to_string(line_number) + ": bad header line, expected \"" +
+                                   Join(columns_) + "\", got \"" + line + "\"");
         }
         have_header = true;
         continue;
@@ -233,7 +231,8 @@ void WriteFramesCsv(const std::string& path, const std::vector<FrameRecord>& fra
   std::string text = Join(kFramesColumns) + "\n";
   for (const FrameRecord& f : frames) {
     if (f.status.find(',') != std::string::npos || f.status.find('\n') != std::string::npos) {
-      throw std::invalid_argument(path + ": frame " + std::to_string(f.frame) + ": status must not contain ',' or newline");
+      throw std::invalid_argument(path + ": frame " + std::to_string(f.frame) +
+                                  ": status must not contain ',' or newline");
     }
     text += Join({std::to_string(f.frame), FormatDouble(f.timestamp), std::to_string(f.num_correspondences),
                   std::to_string(f.num_inliers), FormatDouble(f.inlier_ratio), FormatDouble(f.mean_reproj_error_deg),

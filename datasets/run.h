@@ -5,13 +5,12 @@
 //   <run>/extrinsics.csv   one row per frame and camera: cam_from_rig estimate at that frame
 //   <run>/run.json         configuration and summary (free-form object + required keys below)
 
-#include "datasets/rigid3.h"
-#include "datasets/trajectory.h"
-
 #include <nlohmann/json.hpp>
-
 #include <string>
 #include <vector>
+
+#include "datasets/rigid3.h"
+#include "datasets/trajectory.h"
 
 namespace rovo {
 
@@ -21,14 +20,14 @@ namespace rovo {
 struct FrameRecord {
   int frame = 0;
   double timestamp = 0.0;
-  int num_correspondences = 0;      // 2D-3D correspondences offered to the RANSAC, all views
+  int num_correspondences = 0;  // 2D-3D correspondences offered to the RANSAC, all views
   int num_inliers = 0;
-  double inlier_ratio = 0.0;        // num_inliers / num_correspondences
+  double inlier_ratio = 0.0;           // num_inliers / num_correspondences
   double mean_reproj_error_deg = 0.0;  // mean angular error of inliers after refinement
   bool keyframe = false;
   std::string status = "ok";
-  double time_ms = 0.0;             // wall time spent on this frame
-  std::string missing_cameras;      // cameras whose image was missing or unreadable, "1;3"; "" when none
+  double time_ms = 0.0;         // wall time spent on this frame
+  std::string missing_cameras;  // cameras whose image was missing or unreadable, "1;3"; "" when none
 };
 
 struct ExtrinsicsRecord {

@@ -1,7 +1,5 @@
 #include "datasets/trajectory.h"
 
-#include "datasets/io.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -9,6 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+
+#include "datasets/io.h"
 
 namespace rovo {
 namespace {
@@ -83,8 +83,7 @@ Trajectory ReadTum(const std::string& path) {
     const double norm = q.norm();
     // Text files carry a few digits only; a norm this far from 1 is not rounding but a wrong column.
     if (!(std::abs(norm - 1.0) < 1e-3)) {
-      throw std::runtime_error(where + "quaternion (qx qy qz qw) has norm " + std::to_string(norm) +
-                               ", expected 1");
+      throw std::runtime_error(where + "quaternion (qx qy qz qw) has norm " + std::to_string(norm) + ", expected 1");
     }
     if (!trajectory.empty() && !(line.values[0] > trajectory.back().timestamp)) {
       throw std::runtime_error(where + "timestamp " + std::to_string(line.values[0]) +
@@ -109,8 +108,8 @@ std::string FormatTum(const Trajectory& trajectory) {
   for (const StampedPose& pose : trajectory) {
     const Eigen::Vector3d& t = pose.world_from_rig.translation;
     const Eigen::Quaterniond& q = pose.world_from_rig.rotation;
-    std::snprintf(buf, sizeof(buf), "%.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", pose.timestamp, t.x(),
-                  t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+    std::snprintf(buf, sizeof(buf), "%.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", pose.timestamp, t.x(), t.y(),
+                  t.z(), q.x(), q.y(), q.z(), q.w());
     out += buf;
   }
   return out;

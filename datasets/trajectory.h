@@ -2,10 +2,10 @@
 // Time-stamped rig poses and the TUM trajectory text format
 // (`timestamp tx ty tz qx qy qz qw`, one pose per line, holding world_from_rig).
 
-#include "datasets/rigid3.h"
-
 #include <string>
 #include <vector>
+
+#include "datasets/rigid3.h"
 
 namespace rovo {
 
@@ -38,7 +38,7 @@ Trajectory ReadKittiPoses(const std::string& path, const std::vector<double>& ti
 
 // One data line of a TUM file before any interpretation (for validators that report every fault).
 struct TumLine {
-  int line_number = 0;  // 1-based line in the file
+  int line_number = 0;                          // 1-based line in the file
   double values[8] = {0, 0, 0, 0, 0, 0, 0, 0};  // timestamp tx ty tz qx qy qz qw, all finite
 };
 // Splits TUM text into data lines (skips blank lines and `#` comments). A malformed line (not 8

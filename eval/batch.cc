@@ -1,9 +1,5 @@
 #include "eval/batch.h"
 
-#include "datasets/io.h"
-#include "render/render.h"
-#include "rovo/version.h"
-
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -18,6 +14,10 @@
 #include <map>
 #include <sstream>
 #include <stdexcept>
+
+#include "datasets/io.h"
+#include "render/render.h"
+#include "rovo/version.h"
 
 namespace rovo {
 namespace fs = std::filesystem;

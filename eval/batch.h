@@ -16,12 +16,11 @@
 // sacct needs Slurm's accounting storage, which many clusters (and a bare slurmctld) do not run, so
 // status uses squeue for queued and running tasks and the markers for finished ones.
 
-#include "eval/suite.h"
-
 #include <nlohmann/json.hpp>
-
 #include <string>
 #include <vector>
+
+#include "eval/suite.h"
 
 namespace rovo {
 

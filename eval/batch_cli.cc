@@ -1,11 +1,10 @@
 // `rovo batch`: a suite as Slurm job arrays (eval/batch.h).
-#include "eval/batch.h"
-#include "eval/suite_cli.h"
-
 #include <CLI/CLI.hpp>
-
 #include <cstdio>
 #include <memory>
+
+#include "eval/batch.h"
+#include "eval/suite_cli.h"
 
 namespace rovo {
 
@@ -49,8 +48,8 @@ void AddPlanCommand(CLI::App* batch) {
     std::printf("Batch folder %s:\n", layout.options.dir.c_str());
     for (const std::string& stage : BatchStages()) {
       const BatchResources& r = layout.Resources(stage);
-      std::printf("  %-6s %4d task(s), each --cpus-per-task=%d --mem=%s --time=%s\n", stage.c_str(), layout.Tasks(stage),
-                  r.cpus, r.mem.c_str(), r.time.c_str());
+      std::printf("  %-6s %4d task(s), each --cpus-per-task=%d --mem=%s --time=%s\n", stage.c_str(),
+                  layout.Tasks(stage), r.cpus, r.mem.c_str(), r.time.c_str());
     }
     std::printf("Submit with `rovo batch submit %s` (or %s/submit.sh)\n", layout.options.dir.c_str(),
                 layout.options.dir.c_str());

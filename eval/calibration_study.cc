@@ -1,5 +1,15 @@
 #include "eval/calibration_study.h"
 
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
 #include "datasets/cli_groups.h"
 #include "datasets/dataset.h"
 #include "datasets/io.h"
@@ -11,17 +21,6 @@
 #include "vo/image_loader.h"
 #include "vo/pipeline.h"
 #include "vo/startup_calibration.h"
-
-#include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
-
-#include <algorithm>
-#include <cstdio>
-#include <filesystem>
-#include <map>
-#include <sstream>
-#include <stdexcept>
-#include <string>
 
 namespace rovo {
 namespace fs = std::filesystem;
@@ -47,8 +46,8 @@ bool RunReusable(const std::string& dir, uint64_t seed, int frame_end, int start
     return j.value("draw_seed", int64_t{-1}) == static_cast<int64_t>(seed) && j.at("frames")[1] == frame_end &&
            j.value("online_startup_shots", -1) == startup_shots && j.value("online_startup_spacing", -1) == spacing &&
            j.value("online_anchor_deg", -1.0) == VoOptions{}.online_anchor_deg &&
-           j.value("online_anchor_mm", -1.0) == VoOptions{}.online_anchor_mm && j.value("version", "") == ROVO_VERSION &&
-           j.contains("startup_calibration");
+           j.value("online_anchor_mm", -1.0) == VoOptions{}.online_anchor_mm &&
+           j.value("version", "") == ROVO_VERSION && j.contains("startup_calibration");
   } catch (const std::exception&) {
     return false;
   }
@@ -179,8 +178,12 @@ nlohmann::json FitScoreJson(const FitScore& s) { return {{"inliers", s.inliers},
 nlohmann::json OverlapFitJson(const OverlapFit& fit) {
   nlohmann::json rows = nlohmann::json::array();
   for (const OverlapFitRow& r : fit.rows) {
-    rows.push_back({{"frame", r.frame}, {"camera_a", r.camera_a}, {"camera_b", r.camera_b}, {"matches", r.matches},
-                    {"given", FitScoreJson(r.given)}, {"given_scaled", FitScoreJson(r.given_scaled)},
+    rows.push_back({{"frame", r.frame},
+                    {"camera_a", r.camera_a},
+                    {"camera_b", r.camera_b},
+                    {"matches", r.matches},
+                    {"given", FitScoreJson(r.given)},
+                    {"given_scaled", FitScoreJson(r.given_scaled)},
                     {"results", FitScoreJson(r.results)}});
   }
   return {{"results", fit.results}, {"angle_scale", fit.angle_scale}, {"rows", rows}};
@@ -194,27 +197,45 @@ void WriteOutputs(const CalibrationStudyOptions& o, const DatasetInfo& info, con
   std::vector<uint64_t> failures;
   for (const CalibrationDraw& d : result.draws) {
     csv << d.seed << ',' << d.before_deg << ',' << d.startup_deg << ',' << d.at50_deg << ',' << d.at100_deg << ','
-        << d.end_deg << ',' << (d.startup_converged ? 1 : 0) << ',' << (d.converged ? 1 : 0) << ',' << d.lens_angle_scale
-        << ',' << d.startup_mm << ',' << d.end_mm << '\n';
-    rows.push_back({{"seed", d.seed}, {"before_deg", d.before_deg}, {"startup_deg", d.startup_deg},
-                    {"at50_deg", d.at50_deg}, {"at100_deg", d.at100_deg}, {"end_deg", d.end_deg},
-                    {"startup_converged", d.startup_converged}, {"startup_status", d.startup_status},
-                    {"lens_angle_scale", d.lens_angle_scale}, {"converged", d.converged},
-                    {"startup_mm", d.startup_mm}, {"end_mm", d.end_mm},
+        << d.end_deg << ',' << (d.startup_converged ? 1 : 0) << ',' << (d.converged ? 1 : 0) << ','
+        << d.lens_angle_scale << ',' << d.startup_mm << ',' << d.end_mm << '\n';
+    rows.push_back({{"seed", d.seed},
+                    {"before_deg", d.before_deg},
+                    {"startup_deg", d.startup_deg},
+                    {"at50_deg", d.at50_deg},
+                    {"at100_deg", d.at100_deg},
+                    {"end_deg", d.end_deg},
+                    {"startup_converged", d.startup_converged},
+                    {"startup_status", d.startup_status},
+                    {"lens_angle_scale", d.lens_angle_scale},
+                    {"converged", d.converged},
+                    {"startup_mm", d.startup_mm},
+                    {"end_mm", d.end_mm},
                     {"startup_cam_from_rig", StartupExtrinsicsJson(d.startup_cam_from_rig)}});
     if (!d.converged) failures.push_back(d.seed);
   }
   const double bound = Bound(o);
   const nlohmann::json j = {
-      {"generator", "rovo study calibration"}, {"version", ROVO_VERSION},
-      {"dataset", o.dataset_dir}, {"dataset_seed", info.seed},
-      {"sigma_deg", o.sigma_deg}, {"first_seed", o.first_seed}, {"draws", o.draws},
-      {"frames", o.frames}, {"shot_only", o.shot_only}, {"shot", o.shot}, {"startup_shots", o.startup_shots},
-      {"shot_spacing", o.shot_spacing}, {"startup_converged", result.startup_converged},
+      {"generator", "rovo study calibration"},
+      {"version", ROVO_VERSION},
+      {"dataset", o.dataset_dir},
+      {"dataset_seed", info.seed},
+      {"sigma_deg", o.sigma_deg},
+      {"first_seed", o.first_seed},
+      {"draws", o.draws},
+      {"frames", o.frames},
+      {"shot_only", o.shot_only},
+      {"shot", o.shot},
+      {"startup_shots", o.startup_shots},
+      {"shot_spacing", o.shot_spacing},
+      {"startup_converged", result.startup_converged},
       {"startup_agreement_deg", result.startup_agreement_deg},
-      {"converged_below_deg", bound}, {"converged", result.converged},
+      {"converged_below_deg", bound},
+      {"converged", result.converged},
       {"rate", result.draws.empty() ? 0.0 : static_cast<double>(result.converged) / result.draws.size()},
-      {"failed_seeds", failures}, {"reproduce", result.reproduce}, {"per_draw", rows},
+      {"failed_seeds", failures},
+      {"reproduce", result.reproduce},
+      {"per_draw", rows},
       {"overlap_fit", OverlapFitJson(result.overlap_fit)}};
   WriteFileAtomic((fs::path(o.out_dir) / "calibration.csv").string(), csv.str());
   WriteJsonFileAtomic((fs::path(o.out_dir) / "calibration.json").string(), j);
@@ -236,8 +257,9 @@ std::string Table(const CalibrationStudyOptions& o, const CalibrationStudyResult
        "the start-up's estimate of every lens's off-axis angle scale (1: the lenses as given).\n";
   s << "Converged (" << (o.shot_only ? "start-up" : "end of run") << " < " << Bound(o) << " deg): " << result.converged
     << " of " << result.draws.size() << ".\n";
-  s << "Start-up calibration converged by its own verdict: " << result.startup_converged << " of " << result.draws.size()
-    << "; largest difference between two of those results: " << Deg(result.startup_agreement_deg) << " deg.\n";
+  s << "Start-up calibration converged by its own verdict: " << result.startup_converged << " of "
+    << result.draws.size() << "; largest difference between two of those results: " << Deg(result.startup_agreement_deg)
+    << " deg.\n";
   if (result.converged < static_cast<int>(result.draws.size())) {
     s << "Reproduce a failure: `" << result.reproduce << "` with {seed} one of:";
     for (const CalibrationDraw& d : result.draws) {
@@ -257,7 +279,8 @@ namespace {
 template <typename Error>
 double WorstRelativeError(const std::vector<Rigid3>& est, const std::vector<Rigid3>& truth, const char* what,
                           Error error) {
-  if (est.size() != truth.size() || est.empty()) throw std::invalid_argument(std::string(what) + ": camera counts differ");
+  if (est.size() != truth.size() || est.empty())
+    throw std::invalid_argument(std::string(what) + ": camera counts differ");
   const Rigid3 est_rig_from_cam0 = est[0].Inverse(), true_rig_from_cam0 = truth[0].Inverse();
   double worst = 0.0;
   for (size_t i = 1; i < est.size(); ++i) {
@@ -269,8 +292,9 @@ double WorstRelativeError(const std::vector<Rigid3>& est, const std::vector<Rigi
 }  // namespace
 
 double ExtrinsicErrorDeg(const std::vector<Rigid3>& est, const std::vector<Rigid3>& truth) {
-  return WorstRelativeError(est, truth, "ExtrinsicErrorDeg",
-                            [](const Rigid3& e, const Rigid3& t) { return RotationDistanceDeg(e.rotation, t.rotation); });
+  return WorstRelativeError(est, truth, "ExtrinsicErrorDeg", [](const Rigid3& e, const Rigid3& t) {
+    return RotationDistanceDeg(e.rotation, t.rotation);
+  });
 }
 
 double ExtrinsicTranslationErrorM(const std::vector<Rigid3>& est, const std::vector<Rigid3>& truth) {
@@ -286,7 +310,8 @@ CalibrationStudyResult RunCalibrationStudy(const CalibrationStudyOptions& option
   const DatasetInfo info = ReadDatasetInfo(o.dataset_dir);
   if (o.shot < 0 || o.shot >= info.frame_count) {
     throw std::invalid_argument("study calibration: --shot " + std::to_string(o.shot) + " is not a frame of " +
-                                DatasetJsonPath(o.dataset_dir) + " (frame_count " + std::to_string(info.frame_count) + ")");
+                                DatasetJsonPath(o.dataset_dir) + " (frame_count " + std::to_string(info.frame_count) +
+                                ")");
   }
   const int last_shot = o.shot + (o.startup_shots - 1) * o.shot_spacing;
   if (o.shot_only && last_shot >= info.frame_count) {
@@ -297,7 +322,8 @@ CalibrationStudyResult RunCalibrationStudy(const CalibrationStudyOptions& option
   }
   if (!o.shot_only && info.frame_count > 0 && !fs::exists(GroundTruthPath(o.dataset_dir))) {
     // The OnlineExt runs need no ground truth, but say what the numbers are measured against.
-    if (!o.quiet) std::fprintf(stderr, "study calibration: no ground-truth poses; errors are against dataset.json's rig\n");
+    if (!o.quiet)
+      std::fprintf(stderr, "study calibration: no ground-truth poses; errors are against dataset.json's rig\n");
   }
   EnsureWritableDir(o.out_dir);
   CalibrationStudyResult result;
@@ -316,8 +342,9 @@ CalibrationStudyResult RunCalibrationStudy(const CalibrationStudyOptions& option
   result.startup_converged = static_cast<int>(agreeing.size());
   for (size_t i = 0; i < agreeing.size(); ++i) {
     for (size_t j = i + 1; j < agreeing.size(); ++j) {
-      result.startup_agreement_deg = std::max(
-          result.startup_agreement_deg, ExtrinsicErrorDeg(agreeing[i]->startup_cam_from_rig, agreeing[j]->startup_cam_from_rig));
+      result.startup_agreement_deg =
+          std::max(result.startup_agreement_deg,
+                   ExtrinsicErrorDeg(agreeing[i]->startup_cam_from_rig, agreeing[j]->startup_cam_from_rig));
     }
   }
   if (!o.fit_frames.empty()) {
@@ -350,13 +377,17 @@ void AddCalibrationStudyCommand(CLI::App* study) {
   cmd->add_option("--frames", options->frames, "OnlineExt runs over the first N frames (0: all)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  cmd->add_flag("--shot-only", options->shot_only,
-                "Start-up calibration only, on one synchronous shot or --startup-shots pooled (no VO; no ground-truth poses "
-                "needed)");
-  cmd->add_option("--shot", options->shot, "The frame of --shot-only")->check(CLI::NonNegativeNumber)->capture_default_str();
-  cmd->add_option("--startup-shots", options->startup_shots,
-                  "Shots pooled by the start-up calibration, every --shot-spacing frames (rovo vo --online-startup-shots); "
-                  "default: 1 with --shot-only, else rovo vo's default")
+  cmd->add_flag(
+      "--shot-only", options->shot_only,
+      "Start-up calibration only, on one synchronous shot or --startup-shots pooled (no VO; no ground-truth poses "
+      "needed)");
+  cmd->add_option("--shot", options->shot, "The frame of --shot-only")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option(
+         "--startup-shots", options->startup_shots,
+         "Shots pooled by the start-up calibration, every --shot-spacing frames (rovo vo --online-startup-shots); "
+         "default: 1 with --shot-only, else rovo vo's default")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
   cmd->add_option("--shot-spacing", options->shot_spacing, "Frames between two shots of --startup-shots")

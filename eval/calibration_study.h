@@ -28,17 +28,17 @@ struct CalibrationStudyOptions {
   std::string out_dir;
   int draws = 20;
   double sigma_deg = 5.0;
-  uint64_t first_seed = 1000;    // draw k has seed first_seed + k (rovo vo --draw-seed)
-  int frames = 0;                // > 0: the OnlineExt runs cover the first N frames; 0: all
-  bool shot_only = false;        // start-up calibration on one shot, no VO
-  int shot = 0;                  // the shot (first frame)
-  int startup_shots = 0;         // shots pooled by the start-up calibration; 0: 1 with shot_only, else
-                                 // VoOptions::online_startup_shots' default
-  int shot_spacing = 10;         // VoOptions::online_startup_spacing (frames between two shots)
+  uint64_t first_seed = 1000;  // draw k has seed first_seed + k (rovo vo --draw-seed)
+  int frames = 0;              // > 0: the OnlineExt runs cover the first N frames; 0: all
+  bool shot_only = false;      // start-up calibration on one shot, no VO
+  int shot = 0;                // the shot (first frame)
+  int startup_shots = 0;       // shots pooled by the start-up calibration; 0: 1 with shot_only, else
+                               // VoOptions::online_startup_shots' default
+  int shot_spacing = 10;       // VoOptions::online_startup_spacing (frames between two shots)
   int threads = 0;
-  double converged_deg = 0.1;    // the run's final error below: converged
+  double converged_deg = 0.1;       // the run's final error below: converged
   double shot_converged_deg = 0.5;  // shot_only: the start-up error below: converged
-  double bound_deg = -1.0;       // > 0: replaces converged_deg / shot_converged_deg
+  double bound_deg = -1.0;          // > 0: replaces converged_deg / shot_converged_deg
   bool quiet = false;
   // Frames whose own overlap matches judge the dataset's calibration against the converged start-up
   // results (eval/overlap_fit.h); empty: none.
@@ -50,11 +50,11 @@ struct CalibrationDraw {
   double before_deg = 0.0;
   double startup_deg = 0.0;
   double at50_deg = -1.0, at100_deg = -1.0, end_deg = -1.0;  // < 0: the run is shorter / shot only
-  double startup_mm = 0.0, end_mm = -1.0;  // ExtrinsicTranslationErrorM in mm; end < 0: shot only
-  bool startup_converged = false;   // the start-up calibration's own verdict
+  double startup_mm = 0.0, end_mm = -1.0;                    // ExtrinsicTranslationErrorM in mm; end < 0: shot only
+  bool startup_converged = false;                            // the start-up calibration's own verdict
   std::string startup_status;
-  double lens_angle_scale = 1.0;    // the start-up's estimate of the lenses' off-axis angle scale
-  bool converged = false;           // the study's verdict (error below the bound)
+  double lens_angle_scale = 1.0;             // the start-up's estimate of the lenses' off-axis angle scale
+  bool converged = false;                    // the study's verdict (error below the bound)
   std::vector<Rigid3> startup_cam_from_rig;  // the start-up calibration's result
 };
 
@@ -65,8 +65,8 @@ struct CalibrationStudyResult {
   // start-up calibration converged by its own verdict; -1: fewer than two such draws.
   double startup_agreement_deg = -1.0;
   int startup_converged = 0;
-  std::string reproduce;            // command template for one draw ("{seed}" replaced)
-  OverlapFit overlap_fit;           // with fit_frames
+  std::string reproduce;   // command template for one draw ("{seed}" replaced)
+  OverlapFit overlap_fit;  // with fit_frames
 };
 
 // The extrinsic error in degrees (above) of `est` against `truth` (cam_from_rig per camera).

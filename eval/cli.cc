@@ -1,4 +1,10 @@
 // `rovo` subcommands of eval/: eval, suite, demo, gate.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+
 #include "datasets/cli_groups.h"
 #include "datasets/io.h"
 #include "eval/gate.h"
@@ -6,13 +12,6 @@
 #include "eval/suite.h"
 #include "eval/suite_cli.h"
 #include "scenes/city.h"
-
-#include <CLI/CLI.hpp>
-
-#include <cstdio>
-#include <filesystem>
-#include <memory>
-#include <sstream>
 
 namespace rovo {
 
@@ -93,8 +92,10 @@ void AddSuiteOptions(CLI::App* cmd, SuiteCliArgs* args) {
   std::string variants;
   for (const std::string& v : SuiteVariantNames()) variants += (variants.empty() ? "" : ",") + v;
   cmd->add_option("--presets", args->presets,
-                  "Comma-separated presets (default: all: " + preset_names + "); PRESET+VARIANT renders the preset with "
-                  "sensor or timing effects (" + variants + "; eval/suite.h)");
+                  "Comma-separated presets (default: all: " + preset_names +
+                      "); PRESET+VARIANT renders the preset with "
+                      "sensor or timing effects (" +
+                      variants + "; eval/suite.h)");
   cmd->add_flag("--robustness", args->robustness,
                 "Robustness table: each preset (default cloudy_urban) plain and with every variant, then the harder "
                 "worlds (indoor_hall, suburban_road, night_street) plain and +realistic");

@@ -1,10 +1,10 @@
 #include "eval/gate.h"
 
-#include "eval/suite.h"
-
 #include <algorithm>
 #include <cstdio>
 #include <stdexcept>
+
+#include "eval/suite.h"
 
 namespace rovo {
 
@@ -47,7 +47,8 @@ std::vector<GateCheck> CheckGates(const nlohmann::json& gates, const std::string
   for (const nlohmann::json& g : gates["gates"]) {
     const std::string where = gates_what + ": gates[" + std::to_string(index++) + "]";
     auto text = [&](const char* key) {
-      if (!g.contains(key) || !g[key].is_string()) throw std::runtime_error(where + ": missing string field \"" + key + "\"");
+      if (!g.contains(key) || !g[key].is_string())
+        throw std::runtime_error(where + ": missing string field \"" + key + "\"");
       return g[key].get<std::string>();
     };
     GateCheck c;
@@ -63,7 +64,8 @@ std::vector<GateCheck> CheckGates(const nlohmann::json& gates, const std::string
     const bool has_max = g.contains("max"), has_min = g.contains("min");
     if (has_max == has_min) throw std::runtime_error(where + ": exactly one of \"max\" and \"min\" is required");
     const nlohmann::json& bound = has_max ? g["max"] : g["min"];
-    if (!bound.is_number()) throw std::runtime_error(where + ": field \"" + (has_max ? "max" : "min") + "\" must be a number");
+    if (!bound.is_number())
+      throw std::runtime_error(where + ": field \"" + (has_max ? "max" : "min") + "\" must be a number");
     c.is_max = has_max;
     c.bound = bound.get<double>();
     if (g.contains("note")) {

@@ -12,7 +12,6 @@
 // (SuiteOptions); omitted ones take SuiteOptions' defaults.
 
 #include <nlohmann/json.hpp>
-
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,7 +20,7 @@ namespace rovo {
 
 struct GateCheck {
   std::string preset, mode, metric;
-  bool is_max = true;   // bound kind: value <= bound (max) or value >= bound (min)
+  bool is_max = true;  // bound kind: value <= bound (max) or value >= bound (min)
   double bound = 0.0;
   std::optional<double> value;
   bool pass = false;

@@ -2,7 +2,6 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
-
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -29,8 +28,8 @@ UmeyamaResult AlignUmeyama(const std::vector<Eigen::Vector3d>& src, const std::v
   mean_src /= static_cast<double>(n);
   mean_dst /= static_cast<double>(n);
 
-  Eigen::Matrix3d sigma = Eigen::Matrix3d::Zero();      // (1/n) sum y x^T
-  Eigen::Matrix3d cov_src = Eigen::Matrix3d::Zero();    // (1/n) sum x x^T
+  Eigen::Matrix3d sigma = Eigen::Matrix3d::Zero();    // (1/n) sum y x^T
+  Eigen::Matrix3d cov_src = Eigen::Matrix3d::Zero();  // (1/n) sum x x^T
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector3d x = src[i] - mean_src;
     const Eigen::Vector3d y = dst[i] - mean_dst;
@@ -47,8 +46,7 @@ UmeyamaResult AlignUmeyama(const std::vector<Eigen::Vector3d>& src, const std::v
   if (!(largest > 0.0) || lambda(1) <= 1e-12 * largest) {
     std::ostringstream msg;
     msg << "AlignUmeyama: degenerate input, the " << n << " source points are "
-        << (largest > 0.0 ? "collinear" : "all at one position")
-        << " (spread eigenvalues " << lambda.transpose()
+        << (largest > 0.0 ? "collinear" : "all at one position") << " (spread eigenvalues " << lambda.transpose()
         << "); the rotation about their line is undetermined, so the trajectory cannot be aligned";
     throw std::invalid_argument(msg.str());
   }
@@ -282,7 +280,8 @@ RunEvaluation EvaluateRun(const Trajectory& full_gt, const std::vector<Rigid3>& 
       m.rmse_se3_m = TranslationRmse(gt, run.trajectory, association, out.gt_from_est);
       if (m.path_length_m > 0.0) m.relative_rmse_pct = 100.0 * *m.rmse_se3_m / m.path_length_m;
     } catch (const std::invalid_argument& e) {
-      m.alignment_note = std::string("SE(3) alignment impossible: ") + e.what() + "; error along path uses origin alignment";
+      m.alignment_note =
+          std::string("SE(3) alignment impossible: ") + e.what() + "; error along path uses origin alignment";
     }
     for (const auto& [i, j] : association.pairs) {
       FrameError fe;

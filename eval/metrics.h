@@ -8,15 +8,14 @@
 //   * origin alignment: gt_from_est = gt_world_from_rig_0 * est_world_from_rig_0^-1 (first pose).
 // Translation RMSE = sqrt(mean_i |p_gt_i - gt_from_est * p_est_i|^2) over associated frames.
 
-#include "datasets/rigid3.h"
-#include "datasets/run.h"
-#include "datasets/trajectory.h"
-
 #include <Eigen/Core>
-
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "datasets/rigid3.h"
+#include "datasets/run.h"
+#include "datasets/trajectory.h"
 
 namespace rovo {
 
@@ -63,7 +62,7 @@ Rigid3 AlignOrigin(const Trajectory& gt, const Trajectory& estimate, const Assoc
 // Segment lengths are `fractions` of the gt path length of the associated frames (KITTI uses
 // 100..800 m for km-long sequences; our sequences are shorter, so the lengths scale with them).
 struct DriftResult {
-  double translation_pct = 0.0;     // 100 * mean |t(E)| / L
+  double translation_pct = 0.0;        // 100 * mean |t(E)| / L
   double rotation_deg_per_100m = 0.0;  // mean angle(E) [deg] / L * 100
   int num_segments = 0;
   std::vector<double> segment_lengths_m;
@@ -95,21 +94,21 @@ std::vector<ExtrinsicError> ExtrinsicErrors(const std::vector<ExtrinsicsRecord>&
 // Everything `rovo eval` reports for one run.
 struct RunMetrics {
   std::string label;
-  std::string mode;           // gt | noisy | online
-  int noise_set = -1;         // -1 for GTExt or when run.json does not say
-  int gt_frames = 0;          // of the span the run covers (run.json "frames"), else all
+  std::string mode;    // gt | noisy | online
+  int noise_set = -1;  // -1 for GTExt or when run.json does not say
+  int gt_frames = 0;   // of the span the run covers (run.json "frames"), else all
   int estimated_frames = 0;
   int associated_frames = 0;
-  int missing_frames = 0;     // gt frames without an estimate
-  int lost_frames = 0;        // frames.csv status "lost"
-  double path_length_m = 0.0;  // gt path length over the span the run covers
-  std::optional<double> rmse_se3_m;     // empty when alignment is impossible (too few/degenerate)
+  int missing_frames = 0;            // gt frames without an estimate
+  int lost_frames = 0;               // frames.csv status "lost"
+  double path_length_m = 0.0;        // gt path length over the span the run covers
+  std::optional<double> rmse_se3_m;  // empty when alignment is impossible (too few/degenerate)
   std::optional<double> rmse_origin_m;
   std::optional<double> relative_rmse_pct;  // 100 * rmse_se3 / path length
   DriftResult drift;
-  double mean_inlier_ratio = 0.0;       // over frames with status ok
-  double mean_reproj_error_deg = 0.0;   // over frames with status ok
-  double mean_time_ms = 0.0;            // over all frames
+  double mean_inlier_ratio = 0.0;      // over frames with status ok
+  double mean_reproj_error_deg = 0.0;  // over frames with status ok
+  double mean_time_ms = 0.0;           // over all frames
   // Per camera i >= 1 (index i-1): error at the last frame, and mean over frames.
   std::vector<double> final_ext_rotation_deg, final_ext_translation_m;
   std::vector<double> mean_ext_rotation_deg, mean_ext_translation_m;

@@ -1,13 +1,13 @@
 #include "eval/overlap_fit.h"
 
-#include "vo/image_loader.h"
-#include "vo/ring_calibration.h"
-#include "vo/startup_calibration.h"
-
 #include <algorithm>
 #include <cstdio>
 #include <sstream>
 #include <stdexcept>
+
+#include "vo/image_loader.h"
+#include "vo/ring_calibration.h"
+#include "vo/startup_calibration.h"
 
 namespace rovo {
 namespace {
@@ -72,7 +72,8 @@ OverlapFit FitOverlaps(const std::string& dataset_dir, const DatasetInfo& info, 
   for (int frame : frames) {
     if (frame < 0 || frame >= info.frame_count) {
       throw std::invalid_argument("--fit-frames: " + std::to_string(frame) + " is not a frame of " +
-                                  DatasetJsonPath(dataset_dir) + " (frame_count " + std::to_string(info.frame_count) + ")");
+                                  DatasetJsonPath(dataset_dir) + " (frame_count " + std::to_string(info.frame_count) +
+                                  ")");
     }
     RingCalibrator ring(info.rig, masks, options);
     ring.AddFrame(LoadFrameImages(dataset_dir, info.rig, frame).images);

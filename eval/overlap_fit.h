@@ -25,8 +25,8 @@ struct FitCalibration {
 
 // How one calibration explains a set of matches.
 struct FitScore {
-  int inliers = 0;              // epipolar residual below the start-up's inlier threshold, in front of both
-  double median_deg = -1.0;     // median |epipolar residual| over all the matches; -1: no match
+  int inliers = 0;           // epipolar residual below the start-up's inlier threshold, in front of both
+  double median_deg = -1.0;  // median |epipolar residual| over all the matches; -1: no match
 };
 
 // One ring pair of one frame (camera_a = camera_b = -1: all pairs of the frame).
@@ -34,14 +34,14 @@ struct OverlapFitRow {
   int frame = 0;
   int camera_a = -1, camera_b = -1;
   int matches = 0;
-  FitScore given;               // the dataset's calibration
-  FitScore given_scaled;        // its extrinsics with the results' median angle scale
-  FitScore results;             // per result, then the median over results
+  FitScore given;         // the dataset's calibration
+  FitScore given_scaled;  // its extrinsics with the results' median angle scale
+  FitScore results;       // per result, then the median over results
 };
 
 struct OverlapFit {
-  int results = 0;              // converged start-up results judged (0: none; the other scores stay -1 / 0)
-  double angle_scale = 1.0;     // the median of their angle scales
+  int results = 0;                  // converged start-up results judged (0: none; the other scores stay -1 / 0)
+  double angle_scale = 1.0;         // the median of their angle scales
   std::vector<OverlapFitRow> rows;  // per frame: its pairs, then the frame's total
 };
 

@@ -1,7 +1,7 @@
 #include "eval/plots.h"
 
-#include "datasets/io.h"
-#include "rovo/version.h"
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -9,8 +9,8 @@
 #include <filesystem>
 #include <sstream>
 
-#include <sys/wait.h>
-#include <unistd.h>
+#include "datasets/io.h"
+#include "rovo/version.h"
 
 namespace rovo {
 namespace fs = std::filesystem;
@@ -44,11 +44,20 @@ std::string HtmlEscape(const std::string& s) {
   std::string out;
   for (char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -118,8 +127,8 @@ bool RunPlotScript(const std::string& name, const std::string& folder, bool quie
     return warn("eval/plots/" + name + " not found (looked in " + std::string(ROVO_SOURCE_DIR) + " and next to rovo)");
   }
   if (python.empty()) return warn("/usr/bin/python3 not found");
-  const std::string command = ShellQuote(python) + " " + ShellQuote(script) + " " + ShellQuote(folder) +
-                              (quiet ? " >/dev/null 2>&1" : " >&2");
+  const std::string command =
+      ShellQuote(python) + " " + ShellQuote(script) + " " + ShellQuote(folder) + (quiet ? " >/dev/null 2>&1" : " >&2");
   const int status = std::system(command.c_str());
   if (status == -1 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
     const int code = (status != -1 && WIFEXITED(status)) ? WEXITSTATUS(status) : -1;
@@ -197,9 +206,8 @@ std::string MarkdownToHtml(const std::string& markdown) {
         table_header_done = false;
         continue;
       }
-      const bool separator = std::all_of(line.begin(), line.end(), [](char c) {
-        return c == '|' || c == '-' || c == ':' || c == ' ';
-      });
+      const bool separator =
+          std::all_of(line.begin(), line.end(), [](char c) { return c == '|' || c == '-' || c == ':' || c == ' '; });
       if (separator && !table_header_done) {
         table_header_done = true;
         continue;
@@ -238,14 +246,14 @@ std::string MarkdownToHtml(const std::string& markdown) {
 
 void WriteHtmlReport(const std::string& path, const std::string& title, const std::string& markdown,
                      const std::vector<std::string>& pngs) {
-  std::string html =
-      "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>" + HtmlEscape(title) +
-      "</title>\n<style>body{font-family:sans-serif;margin:24px;background:#fff;color:#111}"
-      "table{border-collapse:collapse;margin:12px 0;font-size:13px}"
-      "th,td{border:1px solid #999;padding:4px 8px;text-align:right}th{background:#e8eef6}"
-      "td:first-child,th:first-child{text-align:left}figure{display:inline-block;margin:8px}"
-      "img{max-width:100%;border:1px solid #ccc}figcaption{font-size:12px;color:#444}</style>\n"
-      "</head><body>\n<h1>" + HtmlEscape(title) + "</h1>\n<p>rovo " ROVO_VERSION "</p>\n";
+  std::string html = "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>" + HtmlEscape(title) +
+                     "</title>\n<style>body{font-family:sans-serif;margin:24px;background:#fff;color:#111}"
+                     "table{border-collapse:collapse;margin:12px 0;font-size:13px}"
+                     "th,td{border:1px solid #999;padding:4px 8px;text-align:right}th{background:#e8eef6}"
+                     "td:first-child,th:first-child{text-align:left}figure{display:inline-block;margin:8px}"
+                     "img{max-width:100%;border:1px solid #ccc}figcaption{font-size:12px;color:#444}</style>\n"
+                     "</head><body>\n<h1>" +
+                     HtmlEscape(title) + "</h1>\n<p>rovo " ROVO_VERSION "</p>\n";
   html += MarkdownToHtml(markdown);
   if (pngs.empty()) {
     html += "<p><i>No plots (python3 with matplotlib was not available or failed).</i></p>\n";
@@ -253,8 +261,8 @@ void WriteHtmlReport(const std::string& path, const std::string& title, const st
   for (const std::string& png : pngs) {
     // Caption "<report folder>/<file>": plots live in <report>/plots/.
     const fs::path png_path(png);
-    const std::string name = png_path.parent_path().parent_path().filename().string() + "/" +
-                             png_path.filename().string();
+    const std::string name =
+        png_path.parent_path().parent_path().filename().string() + "/" + png_path.filename().string();
     html += "<figure><img alt=\"" + HtmlEscape(name) + "\" src=\"data:image/png;base64," + Base64Encode(ReadFile(png)) +
             "\"><figcaption>" + HtmlEscape(name) + "</figcaption></figure>\n";
   }

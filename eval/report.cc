@@ -1,23 +1,21 @@
 #include "eval/report.h"
 
-#include "eval/format.h"
-
-#include "datasets/dataset.h"
-#include "datasets/io.h"
-#include "eval/foreign_run.h"
-#include "eval/plots.h"
-#include "rovo/version.h"
-
 #include <cstdio>
 #include <filesystem>
 #include <map>
 #include <stdexcept>
 
+#include "datasets/dataset.h"
+#include "datasets/io.h"
+#include "eval/foreign_run.h"
+#include "eval/format.h"
+#include "eval/plots.h"
+#include "rovo/version.h"
+
 namespace rovo {
 namespace fs = std::filesystem;
 
 namespace {
-
 
 std::string FmtOpt(const char* format, const std::optional<double>& value) {
   return value ? Fmt(format, *value) : std::string("n/a");
@@ -166,7 +164,8 @@ std::vector<RunEvaluation> EvaluateAndReport(const std::string& dataset_dir, con
   if (run_dirs.empty()) throw std::invalid_argument("rovo eval: no run folders given");
   const DatasetInfo info = ReadDatasetInfo(dataset_dir);
   if (!info.has_ground_truth) {
-    throw std::runtime_error(DatasetJsonPath(dataset_dir) + ": has_ground_truth is false: rovo eval scores runs "
+    throw std::runtime_error(DatasetJsonPath(dataset_dir) +
+                             ": has_ground_truth is false: rovo eval scores runs "
                              "against ground-truth poses, which this dataset (a capture) does not have; rovo vo runs "
                              "on it, and rovo study calibration --shot-only measures against its own calibration");
   }
@@ -179,10 +178,10 @@ std::vector<RunEvaluation> EvaluateAndReport(const std::string& dataset_dir, con
   std::map<std::string, int> label_count;
   nlohmann::json runs_json = nlohmann::json::array();
   std::string summary =
-      Csv({"label", "mode", "noise_set", "run_seed", "gt_frames", "associated_frames", "missing_frames",
-           "lost_frames", "path_length_m", "rmse_se3_m", "relative_rmse_pct", "rmse_origin_m",
-           "drift_translation_pct", "drift_rotation_deg_per_100m", "mean_inlier_ratio", "mean_reproj_error_deg",
-           "max_final_ext_rotation_deg", "max_final_ext_translation_m", "mean_time_ms"});
+      Csv({"label", "mode", "noise_set", "run_seed", "gt_frames", "associated_frames", "missing_frames", "lost_frames",
+           "path_length_m", "rmse_se3_m", "relative_rmse_pct", "rmse_origin_m", "drift_translation_pct",
+           "drift_rotation_deg_per_100m", "mean_inlier_ratio", "mean_reproj_error_deg", "max_final_ext_rotation_deg",
+           "max_final_ext_translation_m", "mean_time_ms"});
   for (const std::string& run_dir : run_dirs) {
     std::string note;
     const RunData run = ReadRunOrTrajectory(run_dir, gt, options.trajectory_format, &note);
@@ -230,8 +229,8 @@ std::vector<RunEvaluation> EvaluateAndReport(const std::string& dataset_dir, con
     nlohmann::json rj = MetricsToJson(m);
     rj["run_dir"] = fs::absolute(run_dir).lexically_normal().string();
     rj["run_seed"] = run.info.value("seed", nlohmann::json(nullptr));
-    rj["gt_from_est"] = {{"qx", evaluation.gt_from_est.rotation.x()}, {"qy", evaluation.gt_from_est.rotation.y()},
-                         {"qz", evaluation.gt_from_est.rotation.z()}, {"qw", evaluation.gt_from_est.rotation.w()},
+    rj["gt_from_est"] = {{"qx", evaluation.gt_from_est.rotation.x()},    {"qy", evaluation.gt_from_est.rotation.y()},
+                         {"qz", evaluation.gt_from_est.rotation.z()},    {"qw", evaluation.gt_from_est.rotation.w()},
                          {"tx", evaluation.gt_from_est.translation.x()}, {"ty", evaluation.gt_from_est.translation.y()},
                          {"tz", evaluation.gt_from_est.translation.z()}};
     runs_json.push_back(rj);
@@ -240,8 +239,8 @@ std::vector<RunEvaluation> EvaluateAndReport(const std::string& dataset_dir, con
                     std::to_string(m.lost_frames), Num(m.path_length_m), m.rmse_se3_m ? Num(*m.rmse_se3_m) : "",
                     m.relative_rmse_pct ? Num(*m.relative_rmse_pct) : "", m.rmse_origin_m ? Num(*m.rmse_origin_m) : "",
                     Num(m.drift.translation_pct), Num(m.drift.rotation_deg_per_100m), Num(m.mean_inlier_ratio),
-                    Num(m.mean_reproj_error_deg), Num(m.max_final_ext_rotation_deg),
-                    Num(m.max_final_ext_translation_m), Num(m.mean_time_ms)});
+                    Num(m.mean_reproj_error_deg), Num(m.max_final_ext_rotation_deg), Num(m.max_final_ext_translation_m),
+                    Num(m.mean_time_ms)});
     if (!options.quiet && m.missing_frames > 0) {
       std::fprintf(stderr, "rovo eval: %s: %d of %d ground-truth frames have no estimate\n", label.c_str(),
                    m.missing_frames, m.gt_frames);
@@ -259,9 +258,9 @@ std::vector<RunEvaluation> EvaluateAndReport(const std::string& dataset_dir, con
   for (const RunEvaluation& e : evaluations) metrics.push_back(e.metrics);
   const std::string title = "rovo eval: " + (info.preset.empty() ? dataset_dir : info.preset);
   const std::string table = RunTableMarkdown(metrics);
-  WriteFileAtomic((fs::path(out_dir) / "table.md").string(),
-                  "# " + title + "\n\nDataset: `" + dataset_dir + "` (seed " + std::to_string(info.seed) + ")\n\n" +
-                      table + "\n" + MetricsLegendMarkdown());
+  WriteFileAtomic((fs::path(out_dir) / "table.md").string(), "# " + title + "\n\nDataset: `" + dataset_dir +
+                                                                 "` (seed " + std::to_string(info.seed) + ")\n\n" +
+                                                                 table + "\n" + MetricsLegendMarkdown());
 
   nlohmann::json report;
   report["generator"] = "rovo eval";
@@ -276,8 +275,7 @@ std::vector<RunEvaluation> EvaluateAndReport(const std::string& dataset_dir, con
 
   if (options.plots) {
     const std::vector<std::string> pngs = RunReportPlots(out_dir, options.quiet);
-    WriteHtmlReport((fs::path(out_dir) / "report.html").string(), title, table + "\n" + MetricsLegendMarkdown(),
-                    pngs);
+    WriteHtmlReport((fs::path(out_dir) / "report.html").string(), title, table + "\n" + MetricsLegendMarkdown(), pngs);
   }
   return evaluations;
 }

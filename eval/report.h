@@ -12,18 +12,17 @@
 //   with --kitti: <out>/<label>/kitti_estimate.txt (aligned) and kitti_groundtruth.txt, line by line
 //   associated.
 
-#include "eval/metrics.h"
-
 #include <nlohmann/json.hpp>
-
 #include <string>
 #include <vector>
+
+#include "eval/metrics.h"
 
 namespace rovo {
 
 struct EvalReportOptions {
   bool kitti = false;
-  bool plots = true;     // run eval/plots/plot_report.py and write report.html
+  bool plots = true;  // run eval/plots/plot_report.py and write report.html
   bool quiet = false;
   EvalOptions eval;
   std::string trajectory_format = "auto";  // of runs from other systems (eval/foreign_run.h)

@@ -1,18 +1,4 @@
 #include "eval/suite.h"
-#include "eval/format.h"
-
-#include "datasets/dataset.h"
-#include "datasets/io.h"
-#include "datasets/progress.h"
-#include "datasets/run.h"
-#include "eval/plots.h"
-#include "eval/report.h"
-#include "render/render.h"
-#include "render/timing.h"
-#include "rovo/version.h"
-#include "scenes/city.h"
-#include "scenes/rng.h"
-#include "vo/pipeline.h"
 
 #include <algorithm>
 #include <atomic>
@@ -24,6 +10,20 @@
 #include <stdexcept>
 #include <thread>
 #include <type_traits>
+
+#include "datasets/dataset.h"
+#include "datasets/io.h"
+#include "datasets/progress.h"
+#include "datasets/run.h"
+#include "eval/format.h"
+#include "eval/plots.h"
+#include "eval/report.h"
+#include "render/render.h"
+#include "render/timing.h"
+#include "rovo/version.h"
+#include "scenes/city.h"
+#include "scenes/rng.h"
+#include "vo/pipeline.h"
 
 namespace rovo {
 namespace fs = std::filesystem;
@@ -39,8 +39,9 @@ bool RunReusable(const std::string& run_dir, const RunSettings& want, std::strin
     return false;
   }
   if (!info.is_object() || !info.contains("dataset") || !info.contains("frames") ||
-      info["frames"] != nlohmann::json::array({0, want.frame_end}) || !fs::is_regular_file(RunTrajectoryPath(run_dir), ec) ||
-      !fs::is_regular_file(RunFramesPath(run_dir), ec) || !fs::is_regular_file(RunExtrinsicsPath(run_dir), ec)) {
+      info["frames"] != nlohmann::json::array({0, want.frame_end}) ||
+      !fs::is_regular_file(RunTrajectoryPath(run_dir), ec) || !fs::is_regular_file(RunFramesPath(run_dir), ec) ||
+      !fs::is_regular_file(RunExtrinsicsPath(run_dir), ec)) {
     return false;  // incomplete (a run writes run.json last)
   }
   // Runs from before max_new_features was recorded had no limit.
@@ -89,7 +90,8 @@ bool EffectsMatch(const DatasetInfo& info, const RenderOptions& render) {
   const int n = info.rig.NumCameras();
   if (render.sensor.enabled != info.sensor.has_value() || render.timing.Enabled() != info.timing.has_value())
     return false;
-  if (info.sensor && *info.sensor != MakeSensorRecord(render.sensor, CameraSensitivities(render.sensor, n, render.seed)))
+  if (info.sensor &&
+      *info.sensor != MakeSensorRecord(render.sensor, CameraSensitivities(render.sensor, n, render.seed)))
     return false;
   return !info.timing ||
          *info.timing == MakeTimingRecord(render.timing, TriggerOffsetsMs(render.timing, n, render.seed));
@@ -99,7 +101,8 @@ bool EffectsMatch(const DatasetInfo& info, const RenderOptions& render) {
 // match `render`'s.
 bool DatasetComplete(const std::string& dataset_dir, int max_frames, const RenderOptions& render) {
   std::error_code ec;
-  if (!fs::is_regular_file(DatasetJsonPath(dataset_dir), ec) || !fs::is_regular_file(GroundTruthPath(dataset_dir), ec)) {
+  if (!fs::is_regular_file(DatasetJsonPath(dataset_dir), ec) ||
+      !fs::is_regular_file(GroundTruthPath(dataset_dir), ec)) {
     return false;
   }
   try {
@@ -134,10 +137,18 @@ Stat ComputeStat(const std::vector<double>& values) {
 }
 
 const std::vector<std::string>& AggregatedMetricNames() {
-  static const std::vector<std::string> names = {
-      "rmse_se3_m",          "relative_rmse_pct",          "rmse_origin_m",          "drift_translation_pct",
-      "drift_rotation_deg_per_100m", "mean_inlier_ratio",  "mean_reproj_error_deg",  "max_final_ext_rotation_deg",
-      "max_final_ext_translation_m", "mean_time_ms",       "lost_frames",            "missing_frames"};
+  static const std::vector<std::string> names = {"rmse_se3_m",
+                                                 "relative_rmse_pct",
+                                                 "rmse_origin_m",
+                                                 "drift_translation_pct",
+                                                 "drift_rotation_deg_per_100m",
+                                                 "mean_inlier_ratio",
+                                                 "mean_reproj_error_deg",
+                                                 "max_final_ext_rotation_deg",
+                                                 "max_final_ext_translation_m",
+                                                 "mean_time_ms",
+                                                 "lost_frames",
+                                                 "missing_frames"};
   return names;
 }
 
@@ -145,7 +156,8 @@ std::optional<double> MetricValue(const RunMetrics& m, const std::string& name) 
   if (name == "rmse_se3_m") return m.rmse_se3_m;
   if (name == "relative_rmse_pct") return m.relative_rmse_pct;
   if (name == "rmse_origin_m") return m.rmse_origin_m;
-  if (name == "drift_translation_pct") return m.drift.num_segments > 0 ? std::optional<double>(m.drift.translation_pct) : std::nullopt;
+  if (name == "drift_translation_pct")
+    return m.drift.num_segments > 0 ? std::optional<double>(m.drift.translation_pct) : std::nullopt;
   if (name == "drift_rotation_deg_per_100m") {
     return m.drift.num_segments > 0 ? std::optional<double>(m.drift.rotation_deg_per_100m) : std::nullopt;
   }
@@ -249,7 +261,8 @@ std::optional<PaperRow> PaperRowForPreset(const std::string& preset) {
 
 std::string SuiteTableMarkdown(const std::vector<PresetSummary>& presets, bool quick) {
   std::string md =
-      "| sequence | frames | length [m] | RMSE NoisyExt [m] | RMSE OnlineExt [m] | RMSE GTExt [m] | rel. Noisy/Online/GT "
+      "| sequence | frames | length [m] | RMSE NoisyExt [m] | RMSE OnlineExt [m] | RMSE GTExt [m] | rel. "
+      "Noisy/Online/GT "
       "[%] | paper rel. Noisy/Online/GT [%] | inliers Online/GT [%] | paper | reproj Online/GT [deg] | paper | "
       "ext rot Online [deg] |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const PresetSummary& p : presets) {
@@ -277,11 +290,11 @@ std::string SuiteTableMarkdown(const std::vector<PresetSummary>& presets, bool q
       paper_inl = Fmt("%.1f", paper->inlier_online) + " / " + Fmt("%.1f", paper->inlier_gt);
       paper_rep = Fmt("%.2f", paper->reproj_online) + " / " + Fmt("%.2f", paper->reproj_gt);
     }
-    const std::string name = (paper ? paper->sequence + " (`" + p.preset + "`)" : "`" + p.preset + "`") +
-                             (quick ? " quick" : "");
-    const std::string frames = std::to_string(p.frames) + (p.dataset_frames > p.frames
-                                                               ? " of " + std::to_string(p.dataset_frames)
-                                                               : std::string());
+    const std::string name =
+        (paper ? paper->sequence + " (`" + p.preset + "`)" : "`" + p.preset + "`") + (quick ? " quick" : "");
+    const std::string frames =
+        std::to_string(p.frames) +
+        (p.dataset_frames > p.frames ? " of " + std::to_string(p.dataset_frames) : std::string());
     md += "| " + name + " | " + frames + " | " + Fmt("%.1f", p.path_length_m) + " | " +
           mean_std("noisy", "rmse_se3_m", "%.3f") + " | " + mean_std("online", "rmse_se3_m", "%.3f") + " | " +
           mean_std("gt", "rmse_se3_m", "%.3f") + " | " + mean("noisy", "relative_rmse_pct", "%.2f") + " / " +
@@ -291,13 +304,14 @@ std::string SuiteTableMarkdown(const std::vector<PresetSummary>& presets, bool q
           mean("online", "mean_reproj_error_deg", "%.3f") + " / " + mean("gt", "mean_reproj_error_deg", "%.3f") +
           " | " + paper_rep + " | " + mean_std("online", "max_final_ext_rotation_deg", "%.3f") + " |\n";
   }
-  md += "\nRMSE = translation RMSE after SE(3) Umeyama alignment (mean ± std over the noise sets; GTExt runs once; "
-        "\"k of K runs\": only k runs have the value, e.g. a run lost on every frame has no trajectory to align); "
-        "rel. = RMSE / ground-truth path length; the paper's relative errors use its Table I RMSEs and sequence "
-        "lengths (4view-MultiFOV 440 m, Static 2000 m, Dynamic 1320 m, Cloudy 350 m, Sunset 350 m); our scenes "
-        "differ from the paper's, so compare relative errors. inliers = mean inlier ratio of the multi-view P3P "
-        "RANSAC; reproj = mean angular reprojection error of inliers; ext rot = largest error over cameras of "
-        "cam_i_from_cam0 at the last frame.\n";
+  md +=
+      "\nRMSE = translation RMSE after SE(3) Umeyama alignment (mean ± std over the noise sets; GTExt runs once; "
+      "\"k of K runs\": only k runs have the value, e.g. a run lost on every frame has no trajectory to align); "
+      "rel. = RMSE / ground-truth path length; the paper's relative errors use its Table I RMSEs and sequence "
+      "lengths (4view-MultiFOV 440 m, Static 2000 m, Dynamic 1320 m, Cloudy 350 m, Sunset 350 m); our scenes "
+      "differ from the paper's, so compare relative errors. inliers = mean inlier ratio of the multi-view P3P "
+      "RANSAC; reproj = mean angular reprojection error of inliers; ext rot = largest error over cameras of "
+      "cam_i_from_cam0 at the last frame.\n";
   return md;
 }
 

@@ -17,17 +17,17 @@
 //   <out>/table.md, <out>/report.html                  Table I layout with the paper's figures
 // Datasets go to <data>/<preset>[_quick]_s<seed>/ (default <data> = <out>/data).
 // Resume: a run folder whose run.json is complete and records the settings asked for (RunSettings)
-// is not run again; one made with other settings is; a dataset whose frames (all, or the first --frames) exist is not rendered again.
-
-#include "eval/metrics.h"
-#include "vo/pipeline.h"
-
-#include <nlohmann/json.hpp>
+// is not run again; one made with other settings is; a dataset whose frames (all, or the first --frames) exist is not
+// rendered again.
 
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "eval/metrics.h"
+#include "vo/pipeline.h"
 
 namespace rovo {
 
@@ -65,9 +65,9 @@ struct SuiteOptions {
                                      // runs reproducible (OnlineExt depends on the thread count)
   std::string data_dir;              // "" = <out>/data
   std::string out_dir;
-  uint64_t scene_seed = 0;           // scene / render seed
-  uint64_t vo_seed = 0;              // RANSAC seed of every run
-  int max_new_features = -1;         // VoOptions::max_new_features of every run; < 0: its default
+  uint64_t scene_seed = 0;    // scene / render seed
+  uint64_t vo_seed = 0;       // RANSAC seed of every run
+  int max_new_features = -1;  // VoOptions::max_new_features of every run; < 0: its default
   int MaxNewFeatures() const { return max_new_features >= 0 ? max_new_features : VoOptions{}.max_new_features; }
   bool plots = true;
   bool quiet = false;
@@ -127,9 +127,9 @@ uint64_t StoredNoiseSetSeed(uint64_t scene_seed, int k);
 struct PresetSummary {
   std::string preset;
   std::string dataset_dir;
-  int frames = 0;                 // frames the runs cover (the first N of the dataset)
-  int dataset_frames = 0;         // frames of the preset's trajectory; > frames for a --frames suite
-  double path_length_m = 0.0;     // ground-truth length of the frames the runs cover
+  int frames = 0;                  // frames the runs cover (the first N of the dataset)
+  int dataset_frames = 0;          // frames of the preset's trajectory; > frames for a --frames suite
+  double path_length_m = 0.0;      // ground-truth length of the frames the runs cover
   std::vector<ModeSummary> modes;  // gt, noisy, online (those that ran)
   const ModeSummary* Find(const std::string& mode) const;
 };

@@ -15,7 +15,7 @@ struct SuiteCliArgs {
   SuiteOptions options;
   std::string presets;  // comma-separated
   bool no_plots = false;
-  bool robustness = false;  // --robustness: RobustnessEntries(presets)
+  bool robustness = false;       // --robustness: RobustnessEntries(presets)
   SuiteOptions Options() const;  // with presets and plots filled in
 };
 

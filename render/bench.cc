@@ -1,9 +1,6 @@
 // `rovo bench render`: speed table (full render vs. raw Embree cast of the same rays, BVH build,
 // peak memory, optional Cycles ratio) and the --quality anti-aliasing study.
-#include "render/render.h"
-#include "render/tracer.h"
-
-#include <nlohmann/json.hpp>
+#include <sys/resource.h>
 #include <tbb/task_arena.h>
 
 #include <chrono>
@@ -11,11 +8,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include <sys/resource.h>
+#include "render/render.h"
+#include "render/tracer.h"
 
 namespace rovo {
 namespace {
@@ -110,9 +109,10 @@ void RunQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tbb::ta
       {2, true, -0.5f, false},  {2, false, -0.5f, false}, {2, true, -0.5f, true},  {4, true, -0.5f, false},
       {4, false, -0.5f, false}, {4, true, -0.5f, true},
   };
-  std::printf("\nanti-aliasing: camera 0 of frame 0, %dx%d, %d quarter-pixel yaw steps, reference %d spp "
-              "(fixed pattern, trilinear, LOD bias 0); 8-bit units, mean over valid pixels and channels\n",
-              rays.width, rays.height, kSteps, kReferenceSpp);
+  std::printf(
+      "\nanti-aliasing: camera 0 of frame 0, %dx%d, %d quarter-pixel yaw steps, reference %d spp "
+      "(fixed pattern, trilinear, LOD bias 0); 8-bit units, mean over valid pixels and channels\n",
+      rays.width, rays.height, kSteps, kReferenceSpp);
   std::printf("| spp | pattern | texture filter | LOD bias | mean abs error | shimmer | CPU s/view |\n");
   std::printf("|---:|---|---|---:|---:|---:|---:|\n");
   for (const Variant& v : variants) {
@@ -153,11 +153,12 @@ void PrintCyclesRatio(const std::string& path, double bench_default_cpu, int spp
     return row["cpu_seconds_per_frame"].get<double>();
   };
   const double cycles = cpu(0), rovo_same_spp = cpu(1), rovo_default = cpu(2);
-  std::printf("\nCycles (%s, %s): %.1f CPU s/frame; rovo render --scene on the same exported frames "
-              "(whole command incl. load, BVH, PNG): %.2f CPU s/frame at the same spp (%.1fx), %.2f at the "
-              "default spp (%.1fx, target >= 30x)\n",
-              path.c_str(), timing.value("rows", nlohmann::json::array())[0].value("renderer", "?").c_str(), cycles,
-              rovo_same_spp, cycles / rovo_same_spp, rovo_default, cycles / rovo_default);
+  std::printf(
+      "\nCycles (%s, %s): %.1f CPU s/frame; rovo render --scene on the same exported frames "
+      "(whole command incl. load, BVH, PNG): %.2f CPU s/frame at the same spp (%.1fx), %.2f at the "
+      "default spp (%.1fx, target >= 30x)\n",
+      path.c_str(), timing.value("rows", nlohmann::json::array())[0].value("renderer", "?").c_str(), cycles,
+      rovo_same_spp, cycles / rovo_same_spp, rovo_default, cycles / rovo_default);
   std::printf("Cycles CPU s/frame over this bench's default-quality (%d spp) render: %.1fx (different scenes)\n",
               spp_default, cycles / bench_default_cpu);
 }
@@ -238,8 +239,9 @@ double TimeDatasetWriting(const RenderBenchOptions& options, int frames, int spp
 
 // The speed table and the ratios against the targets.
 void PrintRowTable(const std::vector<BenchRow>& rows, int64_t valid_pixels, int spp_default) {
-  std::printf("\n| mode | spp | wall s/frame | CPU s/frame | camera Mrays/s (wall) | camera Mrays/CPU-s |\n"
-              "|---|---:|---:|---:|---:|---:|\n");
+  std::printf(
+      "\n| mode | spp | wall s/frame | CPU s/frame | camera Mrays/s (wall) | camera Mrays/CPU-s |\n"
+      "|---|---:|---:|---:|---:|---:|\n");
   for (const BenchRow& row : rows) {
     const double rays_per_frame = valid_pixels * static_cast<double>(row.spp);
     std::printf("| %s | %d | %.3f | %.3f | %.1f | %.1f |\n", row.name.c_str(), row.spp, row.seconds_per_frame,

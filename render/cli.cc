@@ -1,18 +1,16 @@
 // `rovo` subcommands of render/: `rovo render`, `rovo scene preview`, `rovo bench render`.
-#include "datasets/cli_groups.h"
-#include "render/render.h"
-#include "render/timing.h"
-
 #include <CLI/CLI.hpp>
-
 #include <cstdio>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
 
+#include "datasets/cli_groups.h"
+#include "render/render.h"
+#include "render/timing.h"
+
 namespace rovo {
 namespace {
-
 
 void ParseShard(const std::string& text, int* index, int* count) {
   const size_t slash = text.find('/');
@@ -55,35 +53,36 @@ struct SensorArgs {
 
   void Add(CLI::App* cmd) {
     const std::string g = "Sensor model (render/README.md; off by default: the scene's exposure and sRGB)";
-    o_profile = cmd->add_option("--sensor", profile,
-                    "off | ideal (HDR sun, auto-exposure, sRGB response, no noise) | realistic (automotive fisheye "
-                    "camera: 12-bit ADC, 10 ke- full well, 3 e- read noise, shot noise, dark current, BT.709 "
-                    "response, 5 % per-camera sensitivity spread); exposure.csv records every exposure")
-        ->check(CLI::IsMember({"off", "ideal", "realistic"}))
-        ->group(g)
-        ->capture_default_str();
+    o_profile =
+        cmd->add_option("--sensor", profile,
+                        "off | ideal (HDR sun, auto-exposure, sRGB response, no noise) | realistic (automotive fisheye "
+                        "camera: 12-bit ADC, 10 ke- full well, 3 e- read noise, shot noise, dark current, BT.709 "
+                        "response, 5 % per-camera sensitivity spread); exposure.csv records every exposure")
+            ->check(CLI::IsMember({"off", "ideal", "realistic"}))
+            ->group(g)
+            ->capture_default_str();
     auto on_off = CLI::IsMember({"on", "off"});
     o_ae = cmd->add_option("--auto-exposure", auto_exposure,
                            "on | off (default on; off: the fixed --exposure-ms, default 0.1, and --gain, default 1)")
                ->check(on_off)
                ->group(g);
-    o_exposure = cmd->add_option("--exposure-ms", exposure_ms, "Fixed exposure time in ms (turns auto-exposure off)")
-                     ->group(g);
+    o_exposure =
+        cmd->add_option("--exposure-ms", exposure_ms, "Fixed exposure time in ms (turns auto-exposure off)")->group(g);
     o_gain = cmd->add_option("--gain", gain, "Fixed analogue gain >= 1 (turns auto-exposure off)")->group(g);
     o_target = cmd->add_option("--ae-target", ae_target,
                                "Auto-exposure target: centre-weighted mean signal as a fraction of full scale "
                                "(default 0.18)")
                    ->group(g);
-    o_sensitivity = cmd->add_option("--sensitivity", sensitivity,
-                                    "Electrons per ms per unit scene radiance (default 100000)")
-                        ->group(g);
+    o_sensitivity =
+        cmd->add_option("--sensitivity", sensitivity, "Electrons per ms per unit scene radiance (default 100000)")
+            ->group(g);
     o_spread = cmd->add_option("--sensitivity-spread", spread,
                                "Std. dev. of ln(per-camera sensitivity), seeded (ideal 0, realistic 0.05)")
                    ->group(g);
     o_full_well = cmd->add_option("--full-well", full_well, "Full-well capacity, electrons (default 10000)")->group(g);
     o_read = cmd->add_option("--read-noise", read_noise, "Read noise, electrons rms (ideal 0, realistic 3)")->group(g);
-    o_dark = cmd->add_option("--dark-current", dark_current, "Dark current, electrons/s (ideal 0, realistic 50)")
-                 ->group(g);
+    o_dark =
+        cmd->add_option("--dark-current", dark_current, "Dark current, electrons/s (ideal 0, realistic 50)")->group(g);
     o_shot = cmd->add_option("--shot-noise", shot_noise, "on | off: Poisson shot noise (ideal off, realistic on)")
                  ->check(on_off)
                  ->group(g);
@@ -148,7 +147,8 @@ void AddRenderCommand(CliGroups& groups) {
       "camN/NNNNNN.png, groundtruth.tum, dataset.json, optional depth/ and masks/ (and exposure.csv with "
       "--sensor). Resumable: rerunning "
       "skips frames whose files all exist.");
-  auto* preset = cmd->add_option("--preset", args->options.preset, "Scene preset to generate and render (e.g. static_urban)");
+  auto* preset =
+      cmd->add_option("--preset", args->options.preset, "Scene preset to generate and render (e.g. static_urban)");
   auto* scene = cmd->add_option("--scene", args->options.scene_dir, "Scene folder (scenes/FORMAT.md)");
   preset->excludes(scene);
   cmd->add_flag("--quick", args->options.quick, "The preset's quick form: fewer frames, smaller images");
@@ -175,12 +175,15 @@ void AddRenderCommand(CliGroups& groups) {
     TimingSettings& t = args->options.timing;
     cmd->add_option("--shutter-ms", t.shutter_ms,
                     "Motion blur over a fixed exposure interval of this many ms, centred on each row's time "
-                    "(default spp " + std::to_string(kDefaultBlurSpp) + " when blurring)")
+                    "(default spp " +
+                        std::to_string(kDefaultBlurSpp) + " when blurring)")
         ->group(g);
     cmd->add_flag("--motion-blur", t.shutter_from_sensor,
                   "Motion blur over the sensor model's exposure time of each frame and camera (exposure.csv; default "
-                  "spp " + std::to_string(kDefaultBlurSpp) + " when some exposure reaches " +
-                      std::to_string(kBlurSppMinExposureMs).substr(0, 3) + " ms, else " + std::to_string(kDefaultSpp) + ")")
+                  "spp " +
+                      std::to_string(kDefaultBlurSpp) + " when some exposure reaches " +
+                      std::to_string(kBlurSppMinExposureMs).substr(0, 3) + " ms, else " + std::to_string(kDefaultSpp) +
+                      ")")
         ->group(g);
     cmd->add_option("--rolling-shutter-ms", t.rolling_shutter_ms,
                     "Rolling shutter: readout time of the whole image in ms, top row first")
@@ -196,8 +199,8 @@ void AddRenderCommand(CliGroups& groups) {
   {
     const TimingSettings realistic = RealisticTiming();
     char values[160];
-    std::snprintf(values, sizeof(values), "--rolling-shutter-ms %g --trigger-offset-ms %g", realistic.rolling_shutter_ms,
-                  realistic.trigger_offset_std_ms);
+    std::snprintf(values, sizeof(values), "--rolling-shutter-ms %g --trigger-offset-ms %g",
+                  realistic.rolling_shutter_ms, realistic.trigger_offset_std_ms);
     cmd->add_flag("--realistic", args->realistic,
                   std::string("The realistic profile of an automotive fisheye camera (render/README.md): --sensor "
                               "realistic --motion-blur ") +
@@ -234,7 +237,8 @@ void AddPreviewCommand(CliGroups& groups) {
   cmd->add_option("--rig", args->options.rig, "Rig preset or rig.json (default: the scene's)");
   cmd->add_option("--scale", args->options.scale, "Image scale of each view")->capture_default_str();
   cmd->add_option("--spp", args->options.spp, "Samples per pixel")->capture_default_str();
-  cmd->add_option("--width", args->options.width, "Downscale the sheet to at most this many pixels wide (default: no limit)");
+  cmd->add_option("--width", args->options.width,
+                  "Downscale the sheet to at most this many pixels wide (default: no limit)");
   cmd->add_option("--threads", args->options.threads, "Threads (default: all cores)");
   cmd->callback([args] {
     PreviewOptions options = args->options;

@@ -1,15 +1,14 @@
 #include "render/image_io.h"
 
-#include "datasets/io.h"
-#include "rovo/version.h"
-
 #include <OpenImageIO/imageio.h>
+#include <signal.h>
 
 #include <cerrno>
 #include <filesystem>
 #include <stdexcept>
 
-#include <signal.h>
+#include "datasets/io.h"
+#include "rovo/version.h"
 
 namespace rovo {
 namespace {

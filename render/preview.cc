@@ -1,10 +1,6 @@
 // `rovo scene preview` (contact sheet). (`rovo bench render` is in render/bench.cc.)
-#include "datasets/io.h"
-#include "render/image_io.h"
-#include "render/render.h"
-#include "render/tracer.h"
-
 #include <OpenImageIO/imageio.h>
+#include <sys/resource.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -15,7 +11,10 @@
 #include <functional>
 #include <stdexcept>
 
-#include <sys/resource.h>
+#include "datasets/io.h"
+#include "render/image_io.h"
+#include "render/render.h"
+#include "render/tracer.h"
 
 namespace rovo {
 namespace {
@@ -42,7 +41,8 @@ std::vector<uint8_t> DownscaleRgb8(const std::vector<uint8_t>& src, int width, i
     for (int y = 0; y < height; ++y)
       for (const auto& [x, wx] : w)
         for (int c = 0; c < 3; ++c)
-          rows[(static_cast<size_t>(y) * out_width + ox) * 3 + c] += wx * src[(static_cast<size_t>(y) * width + x) * 3 + c];
+          rows[(static_cast<size_t>(y) * out_width + ox) * 3 + c] +=
+              wx * src[(static_cast<size_t>(y) * width + x) * 3 + c];
   }
   std::vector<uint8_t> out(static_cast<size_t>(out_height) * out_width * 3);
   for (int oy = 0; oy < out_height; ++oy) {
@@ -89,8 +89,8 @@ void RenderScenePreview(const PreviewOptions& options) {
   if (frames.empty()) frames = num_traj >= 3 ? std::vector<int>{0, num_traj / 2, num_traj - 1} : std::vector<int>{0};
   for (int f : frames)
     if (f < 0 || f >= num_traj)
-      throw std::out_of_range("--frames: frame " + std::to_string(f) + " outside the trajectory (0:" +
-                              std::to_string(num_traj) + ")");
+      throw std::out_of_range("--frames: frame " + std::to_string(f) +
+                              " outside the trajectory (0:" + std::to_string(num_traj) + ")");
   std::string out = options.out_png;
   if (out.empty()) {
     if (options.scene_dir.empty()) throw std::invalid_argument("--out: required with --preset");

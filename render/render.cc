@@ -1,13 +1,5 @@
 #include "render/render.h"
 
-#include "datasets/dataset.h"
-#include "datasets/io.h"
-#include "datasets/progress.h"
-#include "render/image_io.h"
-#include "render/tracer.h"
-#include "rovo/version.h"
-#include "scenes/city.h"
-
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -22,6 +14,14 @@
 #include <optional>
 #include <stdexcept>
 #include <thread>
+
+#include "datasets/dataset.h"
+#include "datasets/io.h"
+#include "datasets/progress.h"
+#include "render/image_io.h"
+#include "render/tracer.h"
+#include "rovo/version.h"
+#include "scenes/city.h"
 
 namespace rovo {
 namespace {
@@ -48,8 +48,7 @@ struct FrameJob {
 class FrameWriter {
  public:
   FrameWriter(const std::string& out_dir, const Rig& rig, bool depth, bool masks, Progress* progress)
-      : out_dir_(out_dir), rig_(rig), depth_(depth), masks_(masks), progress_(progress),
-        thread_([this] { Run(); }) {}
+      : out_dir_(out_dir), rig_(rig), depth_(depth), masks_(masks), progress_(progress), thread_([this] { Run(); }) {}
   // Joins without rethrowing (the error was or will be reported by Push/Close).
   ~FrameWriter() {
     {
@@ -148,8 +147,9 @@ void CheckExistingDataset(const std::string& out_dir, const DatasetInfo& info) {
   const DatasetInfo old = ReadDatasetInfo(out_dir);
   const std::string file = DatasetJsonPath(out_dir);
   auto differ = [&](const std::string& field) {
-    throw std::runtime_error(file + ": field '" + field +
-                             "' differs from this render's settings; the folder holds another dataset (use a new --out)");
+    throw std::runtime_error(
+        file + ": field '" + field +
+        "' differs from this render's settings; the folder holds another dataset (use a new --out)");
   };
   if (old.scene_hash != info.scene_hash) differ("scene_hash");
   if (old.frame_count != info.frame_count) differ("frame_count");
@@ -182,7 +182,8 @@ Scene SceneForOptions(const std::string& preset, bool quick, uint64_t seed, cons
 }
 
 RigChoice ChooseRig(const std::string& rig, const Scene& scene, const std::string& scene_dir, double scale) {
-  if (scale < 0.0 || scale > 4.0) throw std::invalid_argument("--scale " + std::to_string(scale) + ": must be in (0, 4]");
+  if (scale < 0.0 || scale > 4.0)
+    throw std::invalid_argument("--scale " + std::to_string(scale) + ": must be in (0, 4]");
   const std::string scene_rig_json = scene_dir.empty() ? "" : (fs::path(scene_dir) / "rig.json").string();
   RigChoice choice;
   if (!rig.empty() && EndsWith(rig, ".json")) {
@@ -252,8 +253,8 @@ void CheckSceneMotion(const Scene& scene, const std::string& scene_name) {
   if (num_traj == 0) throw std::runtime_error(scene_name + ": trajectory: the scene has no rig poses");
   for (const Object& obj : scene.objects) {
     if (obj.IsDynamic() && obj.world_from_object_per_frame.size() != num_traj)
-      throw std::runtime_error(scene_name + ": object '" + obj.name + "': " +
-                               std::to_string(obj.world_from_object_per_frame.size()) +
+      throw std::runtime_error(scene_name + ": object '" + obj.name +
+                               "': " + std::to_string(obj.world_from_object_per_frame.size()) +
                                " motion frames for a trajectory of " + std::to_string(num_traj));
   }
 }
@@ -394,8 +395,8 @@ std::vector<double> ShutterMs(const TimingSettings& timing, const SensorPlan& pl
 // Timing needs the trajectory around every frame: the window of each frame (HalfWindowSeconds)
 // must stay within its neighbouring trajectory intervals, so that the three motion steps of the
 // dynamic objects (Tracer::SetFrameWindow) hold the exact poses. Throws naming the options.
-void CheckTimingWindows(const RenderOptions& options, const Scene& scene, int begin, int count,
-                        const SensorPlan& plan, int num_cameras) {
+void CheckTimingWindows(const RenderOptions& options, const Scene& scene, int begin, int count, const SensorPlan& plan,
+                        int num_cameras) {
   const Trajectory& traj = scene.rig_trajectory;
   for (int f = 0; f < count; ++f) {
     const int i = begin + f;
@@ -405,27 +406,26 @@ void CheckTimingWindows(const RenderOptions& options, const Scene& scene, int be
     if (i > 0) room = std::min(room, traj[i].timestamp - traj[i - 1].timestamp);
     if (i + 1 < static_cast<int>(traj.size())) room = std::min(room, traj[i + 1].timestamp - traj[i].timestamp);
     if (h > room)
-      throw std::invalid_argument(
-          "--shutter-ms/--motion-blur, --rolling-shutter-ms, --trigger-offset(s)-ms: frame " + std::to_string(i) +
-          " is exposed up to " + std::to_string(h * 1000.0) + " ms from its time, beyond the trajectory interval of " +
-          std::to_string(room * 1000.0) + " ms");
+      throw std::invalid_argument("--shutter-ms/--motion-blur, --rolling-shutter-ms, --trigger-offset(s)-ms: frame " +
+                                  std::to_string(i) + " is exposed up to " + std::to_string(h * 1000.0) +
+                                  " ms from its time, beyond the trajectory interval of " +
+                                  std::to_string(room * 1000.0) + " ms");
   }
 }
 
 // The images of one frame with timing (render/timing.h): the dynamic objects over the frame's
 // window (the scene's motion), each camera at its own times (the rig from the dataset's poses).
-void RenderTimedFrame(const RenderOptions& options, const Rig& rig, int traj_frame, int f,
-                      const SensorPlan& plan, const std::vector<CameraRays>& rays, const ShadeSettings& settings,
-                      Tracer& tracer, std::vector<float>* linear, const SensorPipeline* pipeline, FrameJob* job) {
+void RenderTimedFrame(const RenderOptions& options, const Rig& rig, int traj_frame, int f, const SensorPlan& plan,
+                      const std::vector<CameraRays>& rays, const ShadeSettings& settings, Tracer& tracer,
+                      std::vector<float>* linear, const SensorPipeline* pipeline, FrameJob* job) {
   const std::vector<double> shutter = ShutterMs(options.timing, plan, f, rig.NumCameras());
   const double h = HalfWindowSeconds(plan.trigger_offset_ms, options.timing.rolling_shutter_ms, shutter);
   tracer.SetFrameWindow(traj_frame, h);
   for (int c = 0; c < rig.NumCameras(); ++c) {
     Rigid3 world_from_cam;
     const CameraMotion motion =
-        MakeCameraMotion(plan.groundtruth, f, rig.cameras[c].cam_from_rig, h > 0.0 ? h : 1.0,
-                         plan.trigger_offset_ms[c], shutter[c], options.timing.rolling_shutter_ms,
-                         rays[c].height, &world_from_cam);
+        MakeCameraMotion(plan.groundtruth, f, rig.cameras[c].cam_from_rig, h > 0.0 ? h : 1.0, plan.trigger_offset_ms[c],
+                         shutter[c], options.timing.rolling_shutter_ms, rays[c].height, &world_from_cam);
     CameraImage& image = job->images[c];
     if (pipeline) image.linear.swap(*linear);
     tracer.Render(rays[c], world_from_cam, settings, &image, &motion);
@@ -438,8 +438,8 @@ void RenderTimedFrame(const RenderOptions& options, const Rig& rig, int traj_fra
 
 // Renders the dataset frames `todo` (trajectory frames begin + f) and writes them beside the tracer.
 void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& rig, int begin,
-                  const std::vector<int>& todo, int spp, const SensorPlan& plan, tbb::task_arena& arena,
-                  Tracer& tracer, RenderSummary* summary) {
+                  const std::vector<int>& todo, int spp, const SensorPlan& plan, tbb::task_arena& arena, Tracer& tracer,
+                  RenderSummary* summary) {
   std::vector<CameraRays> rays;
   arena.execute([&] {
     std::vector<Camera> cameras;

@@ -1,35 +1,35 @@
 #pragma once
 // Renders a dataset (datasets/FORMAT.md) from a scene and a rig. Entry point of `rovo render`.
 
+#include <cstdint>
+#include <string>
+#include <vector>
+
 #include "datasets/rig.h"
 #include "render/sensor.h"
 #include "render/timing.h"
 #include "scenes/scene.h"
 
-#include <cstdint>
-#include <string>
-#include <vector>
-
 namespace rovo {
 
 struct RenderOptions {
-  std::string preset;          // scenes preset to generate and render, or ""
-  bool quick = false;          // the preset's quick form (fewer frames, smaller images)
-  std::string scene_dir;       // or a scene folder (scenes/FORMAT.md)
-  std::string rig;             // rig preset name or rig .json path; "" = the scene's rig (ChooseRig)
-  std::string out_dir;         // dataset folder
-  int frame_begin = 0;         // [frame_begin, frame_end) of the trajectory; -1 = to the end
+  std::string preset;     // scenes preset to generate and render, or ""
+  bool quick = false;     // the preset's quick form (fewer frames, smaller images)
+  std::string scene_dir;  // or a scene folder (scenes/FORMAT.md)
+  std::string rig;        // rig preset name or rig .json path; "" = the scene's rig (ChooseRig)
+  std::string out_dir;    // dataset folder
+  int frame_begin = 0;    // [frame_begin, frame_end) of the trajectory; -1 = to the end
   int frame_end = -1;
-  int shard_index = 0;         // render frames with (frame / chunk) % shard_count == shard_index
+  int shard_index = 0;  // render frames with (frame / chunk) % shard_count == shard_index
   int shard_count = 1;
-  int spp = 0;                 // samples per pixel; 0 = the measured default
-  int threads = 0;             // 0 = all cores
-  uint64_t seed = 0;           // scene seed (preset) and seed of the sensor model's draws
-  bool depth = false;          // write depth/ (EXR ray length)
-  bool masks = false;          // write masks/ (16-bit object ids)
-  double scale = 0.0;          // image scale; 0 = 1.0, or the preset's quick scale with --quick
-  bool quiet = false;          // no progress output
-  float vignetting = 0.0f;     // optional vignetting: gain 1 - v * (theta / theta_max)^2 (0 = off)
+  int spp = 0;              // samples per pixel; 0 = the measured default
+  int threads = 0;          // 0 = all cores
+  uint64_t seed = 0;        // scene seed (preset) and seed of the sensor model's draws
+  bool depth = false;       // write depth/ (EXR ray length)
+  bool masks = false;       // write masks/ (16-bit object ids)
+  double scale = 0.0;       // image scale; 0 = 1.0, or the preset's quick scale with --quick
+  bool quiet = false;       // no progress output
+  float vignetting = 0.0f;  // optional vignetting: gain 1 - v * (theta / theta_max)^2 (0 = off)
   // The physical sensor model (render/sensor.h); off by default (the scene's exposure and sRGB).
   SensorSettings sensor;
   // Exposure timing (render/timing.h): trigger offsets, motion blur, rolling shutter; off by default.
@@ -39,9 +39,9 @@ struct RenderOptions {
 struct RenderSummary {
   int frames_total = 0;
   int frames_rendered = 0;
-  int frames_skipped = 0;      // already complete on disk (resume)
+  int frames_skipped = 0;  // already complete on disk (resume)
   double seconds = 0.0;
-  std::string rig;             // the rig used and where it came from (DescribeRigChoice)
+  std::string rig;  // the rig used and where it came from (DescribeRigChoice)
 };
 
 // Renders the frames of `options` (see RenderOptions) into options.out_dir. Throws
@@ -96,31 +96,31 @@ bool FrameComplete(const std::string& out_dir, const Rig& rig, int frame, bool d
 // `rovo scene preview`: a contact sheet with one row per frame and one column per camera.
 struct PreviewOptions {
   std::string scene_dir;
-  std::string preset;          // alternatively a preset (generated, quick form)
+  std::string preset;  // alternatively a preset (generated, quick form)
   uint64_t seed = 0;
-  std::vector<int> frames;     // trajectory frames; empty = first, middle and last
+  std::vector<int> frames;  // trajectory frames; empty = first, middle and last
   std::string rig;
-  double scale = 0.25;         // of the rig's image size
+  double scale = 0.25;  // of the rig's image size
   int spp = 1;
   int threads = 0;
-  std::string out_png;         // default <scene_dir>/preview.png
-  int width = 0;               // > 0: the sheet is area-downscaled to at most this many pixels wide
+  std::string out_png;  // default <scene_dir>/preview.png
+  int width = 0;        // > 0: the sheet is area-downscaled to at most this many pixels wide
 };
 void RenderScenePreview(const PreviewOptions& options);
 
 // `rovo bench render`: prints a table of render speed, raw ray-cast speed and memory.
 struct RenderBenchOptions {
   std::string preset = "static_urban";
-  std::string scene_dir;       // instead of the preset
+  std::string scene_dir;  // instead of the preset
   uint64_t seed = 0;
   int frames = 3;
   double scale = 1.0;
   int threads = 0;
-  int spp = 0;                 // default-quality spp (0 = kDefaultSpp)
-  std::string write_dir;       // if set, also time full dataset writing into this folder
-  bool quality = false;        // also measure aliasing: error vs. a 32-spp reference and shimmer
-  bool breakdown = false;      // also time 1 spp without trilinear filtering and without textures
-  std::string cycles_timing;   // timing.json of scenes/blender/time_cycles_vs_rovo.py: print the Cycles ratio
+  int spp = 0;                // default-quality spp (0 = kDefaultSpp)
+  std::string write_dir;      // if set, also time full dataset writing into this folder
+  bool quality = false;       // also measure aliasing: error vs. a 32-spp reference and shimmer
+  bool breakdown = false;     // also time 1 spp without trilinear filtering and without textures
+  std::string cycles_timing;  // timing.json of scenes/blender/time_cycles_vs_rovo.py: print the Cycles ratio
 };
 void RunRenderBenchmark(const RenderBenchOptions& options);
 

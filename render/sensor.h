@@ -18,14 +18,13 @@
 //
 // Pure functions and plain structs; RenderDataset (render/render.cc) drives them.
 
-#include "datasets/dataset.h"
-
 #include <Eigen/Core>
-
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "datasets/dataset.h"
 
 namespace rovo {
 

@@ -7,9 +7,7 @@
 
 namespace rovo {
 
-float SrgbToLinear(float srgb) {
-  return srgb <= 0.04045f ? srgb / 12.92f : std::pow((srgb + 0.055f) / 1.055f, 2.4f);
-}
+float SrgbToLinear(float srgb) { return srgb <= 0.04045f ? srgb / 12.92f : std::pow((srgb + 0.055f) / 1.055f, 2.4f); }
 
 float LinearToSrgb(float linear) {
   linear = std::clamp(linear, 0.0f, 1.0f);
@@ -178,7 +176,9 @@ inline __m128i MulLo32(__m128i a, __m128i b) {
 }
 
 // a ? b : c per lane (a all-ones or all-zeros).
-inline __m128i Select(__m128i a, __m128i b, __m128i c) { return _mm_or_si128(_mm_and_si128(a, b), _mm_andnot_si128(a, c)); }
+inline __m128i Select(__m128i a, __m128i b, __m128i c) {
+  return _mm_or_si128(_mm_and_si128(a, b), _mm_andnot_si128(a, c));
+}
 
 }  // namespace
 
@@ -190,7 +190,8 @@ struct MipTexture::Footprint4 {
   alignas(16) float ax[4], ay[4];
 };
 
-__attribute__((always_inline)) inline void MipTexture::Address4(const Level* const level[4], __m128 u01, __m128 v01, Footprint4* fp) {
+__attribute__((always_inline)) inline void MipTexture::Address4(const Level* const level[4], __m128 u01, __m128 v01,
+                                                                Footprint4* fp) {
   // Transpose the lanes' (fwidth, fheight, width, height) into one register per field.
   __m128 fw = _mm_loadu_ps(&level[0]->fwidth), fh = _mm_loadu_ps(&level[1]->fwidth);
   __m128 wf = _mm_loadu_ps(&level[2]->fwidth), hf = _mm_loadu_ps(&level[3]->fwidth);
@@ -218,7 +219,8 @@ __attribute__((always_inline)) inline void MipTexture::Address4(const Level* con
     return _mm_or_si128(_mm_slli_epi32(_mm_srli_epi32(x, 2), 4), _mm_and_si128(x, three));
   };
   auto row = [&](__m128i y) {
-    return _mm_or_si128(_mm_slli_epi32(MulLo32(_mm_srli_epi32(y, 2), bx), 4), _mm_slli_epi32(_mm_and_si128(y, three), 2));
+    return _mm_or_si128(_mm_slli_epi32(MulLo32(_mm_srli_epi32(y, 2), bx), 4),
+                        _mm_slli_epi32(_mm_and_si128(y, three), 2));
   };
   const __m128i col_a = column(xa), col_b = column(xb), row_a = row(ya), row_b = row(yb);
   _mm_store_si128(reinterpret_cast<__m128i*>(fp->index[0]), _mm_add_epi32(row_a, col_a));
@@ -242,8 +244,8 @@ __attribute__((always_inline)) inline __m128 MipTexture::Filter(const Footprint4
   const uint64_t* texels = fp.texels[lane];
   const __m128i zero = _mm_setzero_si128();
   auto load = [&](int corner) {
-    return _mm_cvtepi32_ps(_mm_unpacklo_epi16(
-        _mm_loadl_epi64(reinterpret_cast<const __m128i*>(texels + fp.index[corner][lane])), zero));
+    return _mm_cvtepi32_ps(
+        _mm_unpacklo_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(texels + fp.index[corner][lane])), zero));
   };
   const __m128 t00 = load(0), t10 = load(1), t01 = load(2), t11 = load(3);
   const __m128 vax = _mm_set1_ps(fp.ax[lane]), vay = _mm_set1_ps(fp.ay[lane]);
@@ -252,8 +254,8 @@ __attribute__((always_inline)) inline __m128 MipTexture::Filter(const Footprint4
   return _mm_mul_ps(_mm_add_ps(top, _mm_mul_ps(vay, _mm_sub_ps(bottom, top))), _mm_set1_ps(1.0f / 65535.0f));
 }
 
-void MipTexture::SampleBatch(const MipTexture* const* textures, const float* u, const float* v, const float* lod,
-                             int n, __m128* out, bool trilinear) {
+void MipTexture::SampleBatch(const MipTexture* const* textures, const float* u, const float* v, const float* lod, int n,
+                             __m128* out, bool trilinear) {
   // Chunks of up to kChunk lookups: first every address (four lanes at a time) with a prefetch of
   // its texels, then the loads and filters, so that many cache misses overlap.
   constexpr int kChunk = 64;

@@ -13,15 +13,14 @@
 // texels_per_m from the triangle's UV-to-world area ratio. Texture coordinates wrap (repeat);
 // v = 0 is the top row of the image file.
 
-#include "scenes/scene.h"
+#include <emmintrin.h>
+#include <xmmintrin.h>
 
 #include <Eigen/Core>
-
 #include <cstdint>
 #include <vector>
 
-#include <emmintrin.h>
-#include <xmmintrin.h>
+#include "scenes/scene.h"
 
 namespace rovo {
 

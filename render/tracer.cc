@@ -1,7 +1,5 @@
 #include "render/tracer.h"
 
-#include "render/timing.h"
-
 #include <embree3/rtcore.h>
 #include <pmmintrin.h>
 #include <tbb/blocked_range.h>
@@ -19,6 +17,8 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "render/timing.h"
 
 namespace rovo {
 namespace {
@@ -66,8 +66,7 @@ __m128 FastLog2x4(__m128 x) {
   const __m128 m = _mm_sub_ps(
       _mm_castsi128_ps(_mm_or_si128(_mm_and_si128(bits, _mm_set1_epi32(0x007fffff)), _mm_set1_epi32(0x3f800000))),
       _mm_set1_ps(1.0f));
-  return _mm_add_ps(exponent,
-                    _mm_mul_ps(m, _mm_sub_ps(_mm_set1_ps(1.3465f), _mm_mul_ps(_mm_set1_ps(0.3465f), m))));
+  return _mm_add_ps(exponent, _mm_mul_ps(m, _mm_sub_ps(_mm_set1_ps(1.3465f), _mm_mul_ps(_mm_set1_ps(0.3465f), m))));
 }
 
 constexpr int kSunSamples = 64;
@@ -84,7 +83,6 @@ const std::array<uint8_t, 65536>& SrgbTable() {
   return table;
 }
 
-
 Eigen::Vector3f ToF(const Eigen::Vector3d& v) { return v.cast<float>(); }
 
 }  // namespace
@@ -100,8 +98,7 @@ void SetFlushDenormals() {
 Eigen::Vector2f CameraRays::SampleOffset(int s, int spp) {
   if (spp <= 1) return Eigen::Vector2f::Zero();
   const float n = static_cast<float>(spp);
-  return Eigen::Vector2f((s + 0.5f) / n - 0.5f,
-                         Wrap01(RadicalInverse2(static_cast<uint32_t>(s)) + 0.5f / n) - 0.5f);
+  return Eigen::Vector2f((s + 0.5f) / n - 0.5f, Wrap01(RadicalInverse2(static_cast<uint32_t>(s)) + 0.5f / n) - 0.5f);
 }
 
 CameraRays CameraRays::Make(const Camera& camera, int threads, int spp) {
@@ -162,9 +159,9 @@ CameraRays CameraRays::Make(const Camera& camera, int threads, int spp) {
             break;
           }
           // An isolated valid pixel: use the equidistant estimate max_fov / diameter.
-          rays.pixel_angle[i] = count > 0 ? sum / count
-                                          : static_cast<float>(camera.max_fov_deg * M_PI / 180.0 /
-                                                               std::max(camera.width, camera.height));
+          rays.pixel_angle[i] =
+              count > 0 ? sum / count
+                        : static_cast<float>(camera.max_fov_deg * M_PI / 180.0 / std::max(camera.width, camera.height));
         }
       }
     });
@@ -248,18 +245,18 @@ struct Tracer::Impl {
   RTCDevice device = nullptr;
   RTCScene static_scene = nullptr;
   RTCScene top = nullptr;
-  std::vector<RTCScene> mesh_scenes;        // per mesh, only for meshes of dynamic objects
-  std::vector<int> static_geom_object;      // static geomID -> object index
+  std::vector<RTCScene> mesh_scenes;    // per mesh, only for meshes of dynamic objects
+  std::vector<int> static_geom_object;  // static geomID -> object index
   unsigned static_instance_id = RTC_INVALID_GEOMETRY_ID;
-  std::vector<int> top_instance_object;     // top-level geomID -> object index (-1: static)
+  std::vector<int> top_instance_object;  // top-level geomID -> object index (-1: static)
   std::vector<RTCGeometry> dynamic_instances;
   std::vector<int> dynamic_objects;
   std::vector<Eigen::Matrix3f> object_rotation;  // world_from_object rotation (static: identity)
   // Everything shading reads about a triangle, in one 32-byte record (one cache line per hit
   // instead of loads from triangles, uvs, triangle_materials and the UV scale).
   struct TriangleShade {
-    float uv[6];              // u0, v0, u1, v1, u2, v2 (zero without uvs)
-    float texels_per_metre;   // sqrt(A_uv / A_object) * MipTexture::TexelsPerUv; < 0: untextured
+    float uv[6];             // u0, v0, u1, v1, u2, v2 (zero without uvs)
+    float texels_per_metre;  // sqrt(A_uv / A_object) * MipTexture::TexelsPerUv; < 0: untextured
     int32_t material;
   };
   std::vector<std::vector<TriangleShade>> mesh_shade;  // per mesh and triangle
@@ -275,7 +272,7 @@ struct Tracer::Impl {
   };
   std::vector<ShadeMaterial> shade_materials;
 
-  RTCScene trace_scene = nullptr;           // static_scene when nothing moves, else top
+  RTCScene trace_scene = nullptr;                        // static_scene when nothing moves, else top
   std::array<Eigen::Vector3f, kSunSamples> sun_samples;  // unit directions inside the sun disc
   Eigen::Vector3f sun_dir, sun_e1, sun_e2;
   float sun_disc_radius = 0.0f;  // tan(angular diameter / 2)
@@ -340,13 +337,14 @@ struct Tracer::Impl {
 
   void CheckDevice(const char* what) const {
     const RTCError err = rtcGetDeviceError(device);
-    if (err != RTC_ERROR_NONE) throw std::runtime_error(std::string("Embree error ") + std::to_string(err) + " in " + what);
+    if (err != RTC_ERROR_NONE)
+      throw std::runtime_error(std::string("Embree error ") + std::to_string(err) + " in " + what);
   }
 
   RTCGeometry MakeTriangles(const Mesh& mesh, const Rigid3* world_from_object, RTCBuildQuality quality) {
     RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
     float* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                                   3 * sizeof(float), mesh.positions.size()));
+                                                                  3 * sizeof(float), mesh.positions.size()));
     const Eigen::Matrix3f rot = world_from_object ? Eigen::Matrix3f(world_from_object->RotationMatrix().cast<float>())
                                                   : Eigen::Matrix3f(Eigen::Matrix3f::Identity());
     const Eigen::Vector3f trans = world_from_object ? ToF(world_from_object->translation) : Eigen::Vector3f::Zero();
@@ -357,7 +355,7 @@ struct Tracer::Impl {
       vertices[3 * i + 2] = p.z();
     }
     unsigned* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                        3 * sizeof(unsigned), mesh.triangles.size()));
+                                                                       3 * sizeof(unsigned), mesh.triangles.size()));
     for (size_t i = 0; i < mesh.triangles.size(); ++i) {
       for (int k = 0; k < 3; ++k) indices[3 * i + k] = static_cast<unsigned>(mesh.triangles[i][k]);
     }
@@ -396,7 +394,8 @@ void ValidateSceneIndices(const Scene& scene) {
                                   " out of range");
   for (const Object& obj : scene.objects)
     if (obj.mesh < 0 || obj.mesh >= static_cast<int>(scene.meshes.size()))
-      throw std::invalid_argument("object '" + obj.name + "': mesh index " + std::to_string(obj.mesh) + " out of range");
+      throw std::invalid_argument("object '" + obj.name + "': mesh index " + std::to_string(obj.mesh) +
+                                  " out of range");
 }
 
 }  // namespace
@@ -524,8 +523,8 @@ void Tracer::Impl::BuildTopScene() {
 // Lighting constants: sun frame and disc samples, sky mean, ground irradiance.
 void Tracer::Impl::SetUpLighting() {
   const Lighting& light = scene.lighting;
-  const Eigen::Vector3d s = light.direction_to_sun.norm() > 0 ? light.direction_to_sun.normalized()
-                                                              : Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d s =
+      light.direction_to_sun.norm() > 0 ? light.direction_to_sun.normalized() : Eigen::Vector3d::UnitZ();
   sun_dir = s.cast<float>();
   const Eigen::Vector3f helper = std::abs(sun_dir.z()) < 0.9f ? Eigen::Vector3f::UnitZ() : Eigen::Vector3f::UnitX();
   sun_e1 = sun_dir.cross(helper).normalized();
@@ -641,8 +640,10 @@ void Tracer::Impl::BuildLightGrid() {
       for (int cy = cy0; cy <= cy1; ++cy)
         for (int cx = cx0; cx <= cx1; ++cx) {
           const size_t c = static_cast<size_t>(cy) * g.nx + cx;
-          if (pass == 0) ++count[c + 1];
-          else g.items[g.cell_begin[c] + count[c]++] = i;
+          if (pass == 0)
+            ++count[c + 1];
+          else
+            g.items[g.cell_begin[c] + count[c]++] = i;
         }
     }
     if (pass == 0) {
@@ -732,9 +733,9 @@ struct alignas(64) TileBuffers {
   int pixel[kTilePixels];            // tile-local pixel index of each ray
   int shadow_pixel[kMaxShadowRays];  // tile-local pixel index of each shadow ray
   __m128 direct[kMaxShadowRays];     // the light each shadow ray lets through (sun: albedo * E_sun * cos / pi)
-  __m128 sum[kTilePixels];        // linear radiance sums per pixel
+  __m128 sum[kTilePixels];           // linear radiance sums per pixel
   int count[kTilePixels];
-  float pixel_time[kTilePixels];     // ray time of each pixel's ray in the current pass (CameraMotion)
+  float pixel_time[kTilePixels];  // ray time of each pixel's ray in the current pass (CameraMotion)
   // The hits of the current sample pass, compacted.
   int hit_ray[kTilePixels];
   Eigen::Vector3f normal[kTilePixels];  // unit, facing the ray
@@ -922,8 +923,8 @@ void GatherHits(const RenderJob& job, const TileRect& t, int n, TileBuffers& tb,
           const float f = 0.5f * job.rays.pixel_angle[t.Pixel(job, local)];
           const float s2 = job.sun_var + f * f;
           if (c2 < 50.0f * s2)
-            sky = _mm_add_ps(sky, _mm_mul_ps(job.sun_radiance,
-                                             _mm_set1_ps(std::exp(-c2 / (2.0f * s2)) * (0.5f * kInvPi) / s2)));
+            sky = _mm_add_ps(
+                sky, _mm_mul_ps(job.sun_radiance, _mm_set1_ps(std::exp(-c2 / (2.0f * s2)) * (0.5f * kInvPi) / s2)));
         }
         tb.sum[local] = _mm_add_ps(tb.sum[local], sky);
         ++tb.count[local];
@@ -1283,10 +1284,14 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
       image->linear.clear();
     }
     image->gray.clear();
-    if (settings.want_depth) image->depth.assign(num_pixels, 0.0f);
-    else image->depth.clear();
-    if (settings.want_mask) image->mask.assign(num_pixels, 0);
-    else image->mask.clear();
+    if (settings.want_depth)
+      image->depth.assign(num_pixels, 0.0f);
+    else
+      image->depth.clear();
+    if (settings.want_mask)
+      image->mask.assign(num_pixels, 0);
+    else
+      image->mask.clear();
   }
   const int spp = std::max(1, settings.spp);
   const Lighting& light = d.scene.lighting;

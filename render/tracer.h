@@ -68,16 +68,15 @@
 // always come from the pixel-centre ray. Every pixel's value depends only on its own samples, so
 // images are identical for any thread count.
 
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
 #include "datasets/camera.h"
 #include "datasets/rigid3.h"
 #include "render/texture.h"
 #include "scenes/scene.h"
-
-#include <Eigen/Core>
-
-#include <cstdint>
-#include <memory>
-#include <vector>
 
 namespace rovo {
 
@@ -117,7 +116,7 @@ inline constexpr int kMaxShadowedLights = 8;
 struct ShadeSettings {
   int spp = 1;
   bool shadows = true;
-  bool soft_shadows = true;     // sample the sun disc (Lighting::sun_angular_diameter_deg)
+  bool soft_shadows = true;  // sample the sun disc (Lighting::sun_angular_diameter_deg)
   bool textures = true;
   bool trilinear = true;        // texture lookups blend two mip levels; false = bilinear on the nearest level
   bool rotate_pattern = false;  // per-pixel hashed rotation of the sample pattern (quality study)
@@ -157,11 +156,11 @@ struct CameraMotion {
 struct CameraImage {
   int width = 0;
   int height = 0;
-  std::vector<uint8_t> rgb;      // sRGB, 3 bytes per pixel (empty with ShadeSettings::linear_output)
-  std::vector<float> linear;     // ShadeSettings::linear_output: linear RGB radiance, 3 floats per pixel
-  std::vector<uint8_t> gray;     // a grayscale sensor's output, 1 byte per pixel (render/sensor.h)
-  std::vector<float> depth;      // metres along the pixel-centre ray, 0 = no hit / outside FOV
-  std::vector<uint16_t> mask;    // Object::id of the pixel-centre hit, 0 = static or none
+  std::vector<uint8_t> rgb;    // sRGB, 3 bytes per pixel (empty with ShadeSettings::linear_output)
+  std::vector<float> linear;   // ShadeSettings::linear_output: linear RGB radiance, 3 floats per pixel
+  std::vector<uint8_t> gray;   // a grayscale sensor's output, 1 byte per pixel (render/sensor.h)
+  std::vector<float> depth;    // metres along the pixel-centre ray, 0 = no hit / outside FOV
+  std::vector<uint16_t> mask;  // Object::id of the pixel-centre hit, 0 = static or none
 };
 
 class Tracer {
@@ -186,8 +185,8 @@ class Tracer {
   // the calling task arena. Sets flush-to-zero / denormals-are-zero in every worker.
   // With `motion`, rays take their times and poses from it (CameraMotion) and world_from_cam is
   // the pose at motion->time_mid.
-  void Render(const CameraRays& rays, const Rigid3& world_from_cam, const ShadeSettings& settings,
-              CameraImage* image, const CameraMotion* motion = nullptr) const;
+  void Render(const CameraRays& rays, const Rigid3& world_from_cam, const ShadeSettings& settings, CameraImage* image,
+              const CameraMotion* motion = nullptr) const;
 
   double static_build_seconds() const { return static_build_seconds_; }
   size_t num_static_triangles() const { return num_static_triangles_; }

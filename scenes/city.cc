@@ -2,13 +2,6 @@
 
 #include "scenes/city.h"
 
-#include "rovo/version.h"
-#include "scenes/city_layout.h"
-#include "scenes/indoor.h"
-#include "scenes/mesh_builder.h"
-#include "scenes/rng.h"
-#include "scenes/texture_gen.h"
-
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -19,16 +12,56 @@
 #include <stdexcept>
 #include <utility>
 
+#include "rovo/version.h"
+#include "scenes/city_layout.h"
+#include "scenes/indoor.h"
+#include "scenes/mesh_builder.h"
+#include "scenes/rng.h"
+#include "scenes/texture_gen.h"
+
 namespace rovo {
 
 const std::vector<ScenePreset>& ScenePresets() {
   static const std::vector<ScenePreset> presets = [] {
     std::vector<ScenePreset> p(5);
-    p[0] = {"static_urban", "Static Urban: ~2 km city drive, no moving objects, sunny", 2000, 3000, "sunny", false, "rovo4", 60, 0.5};
-    p[1] = {"dynamic_urban", "Dynamic Urban: ~1.3 km fast drive on long blocks, heavy traffic", 1320, 1000, "sunny", true, "rovo4", 60, 0.5};
-    p[2] = {"cloudy_urban", "Cloudy Urban: ~350 m in a small town, overcast", 350, 300, "cloudy", false, "rovo4", 60, 0.5};
-    p[3] = {"sunset_urban", "Sunset Urban: the cloudy_urban streets at sunset (low warm sun)", 350, 300, "sunset", false, "rovo4", 60, 0.5};
-    p[4] = {"canyon_multifov", "4view-MultiFOV-like: ~440 m slow drive in a narrow urban canyon", 440, 2200, "sunny", false, "omnimvs4", 80, 0.5};
+    p[0] = {"static_urban",
+            "Static Urban: ~2 km city drive, no moving objects, sunny",
+            2000,
+            3000,
+            "sunny",
+            false,
+            "rovo4",
+            60,
+            0.5};
+    p[1] = {"dynamic_urban",
+            "Dynamic Urban: ~1.3 km fast drive on long blocks, heavy traffic",
+            1320,
+            1000,
+            "sunny",
+            true,
+            "rovo4",
+            60,
+            0.5};
+    p[2] = {
+        "cloudy_urban", "Cloudy Urban: ~350 m in a small town, overcast", 350, 300, "cloudy", false, "rovo4", 60, 0.5};
+    p[3] = {"sunset_urban",
+            "Sunset Urban: the cloudy_urban streets at sunset (low warm sun)",
+            350,
+            300,
+            "sunset",
+            false,
+            "rovo4",
+            60,
+            0.5};
+    p[4] = {"canyon_multifov",
+            "4view-MultiFOV-like: ~440 m slow drive in a narrow urban canyon",
+            440,
+            2200,
+            "sunny",
+            false,
+            "omnimvs4",
+            80,
+            0.5};
     return p;
   }();
   return presets;
@@ -38,11 +71,29 @@ const std::vector<ScenePreset>& HarderScenePresets() {
   static const std::vector<ScenePreset> presets = [] {
     std::vector<ScenePreset> p(3);
     p[0] = {"indoor_hall", "Indoor hall and corridor: plain walls, polished floor, ceiling lights, people near the rig",
-            128, 1000, "indoor", true, "rovo4", 80, 0.5, 10.0, "indoor"};
-    p[1] = {"suburban_road", "Suburban road: plain houses behind lawns, wide spacing, open sky, sparse features",
-            600, 600, "sunny", false, "rovo4", 60, 0.5};
-    p[2] = {"night_street", "The cloudy_urban streets at night: street lamps, headlights, dark sky (high gain)",
-            350, 300, "night", true, "rovo4", 60, 0.5};
+            128,           1000,
+            "indoor",      true,
+            "rovo4",       80,
+            0.5,           10.0,
+            "indoor"};
+    p[1] = {"suburban_road",
+            "Suburban road: plain houses behind lawns, wide spacing, open sky, sparse features",
+            600,
+            600,
+            "sunny",
+            false,
+            "rovo4",
+            60,
+            0.5};
+    p[2] = {"night_street",
+            "The cloudy_urban streets at night: street lamps, headlights, dark sky (high gain)",
+            350,
+            300,
+            "night",
+            true,
+            "rovo4",
+            60,
+            0.5};
     return p;
   }();
   return presets;
@@ -66,7 +117,6 @@ const ScenePreset& FindScenePreset(const std::string& name) {
 }
 
 namespace {
-
 
 // `high_sun_along_streets` (sunny only): a high sun 15-25 degrees off a street axis, so that light
 // reaches the floor of a narrow canyon in strips instead of only the upper floors.
@@ -230,8 +280,10 @@ struct Footprint {
 };
 bool Overlap(const Footprint& a, const Footprint& b) {
   if ((a.centre - b.centre).norm() > a.half_length + a.half_width + b.half_length + b.half_width) return false;
-  const Eigen::Vector2d axes[4] = {{std::cos(a.yaw), std::sin(a.yaw)}, {-std::sin(a.yaw), std::cos(a.yaw)},
-                                   {std::cos(b.yaw), std::sin(b.yaw)}, {-std::sin(b.yaw), std::cos(b.yaw)}};
+  const Eigen::Vector2d axes[4] = {{std::cos(a.yaw), std::sin(a.yaw)},
+                                   {-std::sin(a.yaw), std::cos(a.yaw)},
+                                   {std::cos(b.yaw), std::sin(b.yaw)},
+                                   {-std::sin(b.yaw), std::cos(b.yaw)}};
   const Eigen::Vector2d d = b.centre - a.centre;
   for (const Eigen::Vector2d& n : axes) {
     const double ra = a.half_length * std::abs(n.dot(axes[0])) + a.half_width * std::abs(n.dot(axes[1]));
@@ -421,7 +473,8 @@ void AddBuildingWalls(MeshBuilder& b, const BuildingPlan& p, int m_facade, int m
       const Eigen::Vector2d a = c[e], bb = c[(e + 1) % 4];
       double zs = z0;
       if (shops) {
-        b.Wall(a, bb, 0.0, kStorefrontHeightMetres, p.u_offset, kFacadeTileMetres, 1.0, kStorefrontHeightMetres, m_shop);
+        b.Wall(a, bb, 0.0, kStorefrontHeightMetres, p.u_offset, kFacadeTileMetres, 1.0, kStorefrontHeightMetres,
+               m_shop);
         zs = kStorefrontHeightMetres;
       }
       // v = 100 at z = 4 m: texture floor boundaries coincide with storey boundaries.
@@ -694,8 +747,10 @@ void AddHouse(MeshBuilder& b, const BuildingPlan& p, int m_wall, const HouseMate
     // the ground floor.
     const bool street = e == w.street;
     std::vector<double> at;
-    if (street) at = street_windows == 2 ? std::vector<double>{0.25, 0.75} : std::vector<double>{0.2, 0.5, 0.8};
-    else if (len > 7.0) at = {0.5};
+    if (street)
+      at = street_windows == 2 ? std::vector<double>{0.25, 0.75} : std::vector<double>{0.2, 0.5, 0.8};
+    else if (len > 7.0)
+      at = {0.5};
     for (int k = 0; k < storeys; ++k) {
       const double z0 = k * kHouseStoreyMetres + 0.9, z1 = z0 + 1.3;
       for (const double f : at) {
@@ -731,13 +786,16 @@ CityTextures GenerateTextures(Scene& scene, const CityStyle& st, uint64_t textur
   t.num_awnings = quick ? 3 : 6;
   std::vector<std::function<Texture()>> jobs;
   for (int i = 0; i < t.num_facades; ++i) {
-    if (st.houses) jobs.push_back([=] { return MakeHouseWallTexture(texture_seed, i); });
-    else jobs.push_back([=] { return MakeFacadeTexture(texture_seed, i); });
+    if (st.houses)
+      jobs.push_back([=] { return MakeHouseWallTexture(texture_seed, i); });
+    else
+      jobs.push_back([=] { return MakeFacadeTexture(texture_seed, i); });
   }
   for (int i = 0; i < t.num_storefronts; ++i) jobs.push_back([=] { return MakeStorefrontTexture(texture_seed, i); });
   const auto next = [&jobs] { return static_cast<int>(jobs.size()); };
   t.road = next();
-  for (int i = 0; i < 2; ++i) jobs.push_back([=] { return MakeRoadTexture(texture_seed, i, st.road_width_m, st.parking_lane_m); });
+  for (int i = 0; i < 2; ++i)
+    jobs.push_back([=] { return MakeRoadTexture(texture_seed, i, st.road_width_m, st.parking_lane_m); });
   t.intersection = next();
   jobs.push_back([=] { return MakeIntersectionTexture(texture_seed, st.road_width_m); });
   t.sidewalk = next();
@@ -1043,7 +1101,7 @@ void LightStreetLamps(Scene& scene, int mesh_light, int m_lamp) {
     if (scene.objects[o].mesh != mesh_light) continue;
     Light l;
     l.name = scene.objects[o].name + "_lamp";
-    l.position = Eigen::Vector3d(1.6, 0.0, 6.1);  // in the street light's frame (AddStreetLightMesh)
+    l.position = Eigen::Vector3d(1.6, 0.0, 6.1);           // in the street light's frame (AddStreetLightMesh)
     l.intensity = Eigen::Vector3f(0.035f, 0.03f, 0.024f);  // about 25 lux below on the day scale
     l.range = 30.0;
     l.object = static_cast<int>(o);

@@ -2,21 +2,21 @@
 // Procedural scenes: the paper's Table I presets (urban streets) and harder worlds (an indoor hall
 // and corridor, a low-texture suburban road, a night street).
 
-#include "scenes/scene.h"
-
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "scenes/scene.h"
+
 namespace rovo {
 
 struct ScenePreset {
-  std::string name;            // e.g. "static_urban"
+  std::string name;  // e.g. "static_urban"
   std::string description;
-  double path_length_m = 0;    // full form
-  int frames = 0;              // full form, at 10 Hz
-  std::string lighting;        // "sunny" | "cloudy" | "sunset" | "night" | "indoor"
-  bool traffic = false;        // moving objects (vehicles; people in indoor_hall)
+  double path_length_m = 0;  // full form
+  int frames = 0;            // full form, at 10 Hz
+  std::string lighting;      // "sunny" | "cloudy" | "sunset" | "night" | "indoor"
+  bool traffic = false;      // moving objects (vehicles; people in indoor_hall)
   std::string rig_preset = "rovo4";
   int quick_frames = 0;        // --quick form
   double quick_scale = 0.5;    // image scale for the --quick form
@@ -35,8 +35,7 @@ const ScenePreset& FindScenePreset(const std::string& name);
 
 // A procedural scene's header: metadata (generator, version, preset, seed, source), frame rate, rig
 // preset and rig trajectory.
-Scene ProceduralSceneHeader(const ScenePreset& preset, uint64_t seed, bool quick,
-                            Trajectory rig_trajectory);
+Scene ProceduralSceneHeader(const ScenePreset& preset, uint64_t seed, bool quick, Trajectory rig_trajectory);
 
 // Deterministic: the same (preset, seed, quick) gives the same scene, byte for byte.
 Scene GenerateScene(const std::string& preset, uint64_t seed, bool quick);

@@ -1,11 +1,11 @@
 #include "scenes/city_layout.h"
 
-#include "scenes/texture_gen.h"
-
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <stdexcept>
+
+#include "scenes/texture_gen.h"
 
 namespace rovo {
 namespace {
@@ -15,9 +15,9 @@ constexpr int kSamplesPerSpan = 16;
 constexpr double kMaxLateralAccel = 2.5;
 constexpr double kMaxForwardAccel = 2.0;
 constexpr double kMaxBrakeAccel = 2.5;
-constexpr double kTurnSlowdown = 0.4;      // at least this fraction slower in a tight turn
-constexpr double kTightTurnRadius = 8.0;   // metres
-constexpr double kSpeedSmoothing = 4.0;    // Gaussian sigma over arc length, metres
+constexpr double kTurnSlowdown = 0.4;     // at least this fraction slower in a tight turn
+constexpr double kTightTurnRadius = 8.0;  // metres
+constexpr double kSpeedSmoothing = 4.0;   // Gaussian sigma over arc length, metres
 constexpr double kMaxSpeed = 30.0;
 
 const Eigen::Vector2i kDirs[4] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
@@ -224,7 +224,8 @@ LanePath PathAlongRoute(const StreetGrid& grid, const GridRoute& route, double l
   // Turn radii: a right turn keeps its arc's midpoint >= kTurnCurbClearance inside the curb lines,
   // i.e. o + R (1 - 1/sqrt(2)) <= w/2 - clearance; a left turn is concentric (R + 2 o).
   const double k45 = 1.0 - 1.0 / std::sqrt(2.0);
-  const double r_right = std::clamp((0.5 * grid.road_width_m - kTurnCurbClearance - std::abs(lane_offset_m)) / k45, 2.0, 6.0);
+  const double r_right =
+      std::clamp((0.5 * grid.road_width_m - kTurnCurbClearance - std::abs(lane_offset_m)) / k45, 2.0, 6.0);
   const double r_left = r_right + 2.0 * std::abs(lane_offset_m);
   // Line-arc-line polyline (C1), densely sampled.
   std::vector<Eigen::Vector2d> dense{offset.front()};
@@ -290,7 +291,8 @@ bool PlanDrive(const LanePath& path, double s_begin, double length, int frames, 
     const int reach = 2 * half / 3;  // 2 sigma: the kernel's tails beyond carry 5% of its weight
     std::vector<double> dilated(n, 0.0);
     for (int i = 0; i < n; ++i)
-      for (int k = std::max(0, i - reach); k <= std::min(n - 1, i + reach); ++k) dilated[i] = std::max(dilated[i], curv[k]);
+      for (int k = std::max(0, i - reach); k <= std::min(n - 1, i + reach); ++k)
+        dilated[i] = std::max(dilated[i], curv[k]);
     curv.swap(dilated);
   }
   std::vector<double> kernel(2 * half + 1);
@@ -354,7 +356,8 @@ bool PlanDrive(const LanePath& path, double s_begin, double length, int frames, 
     const double a = std::clamp((target - t[i]) / std::max(1e-12, t[i + 1] - t[i]), 0.0, 1.0);
     profile->s[f] = grid_s[i] + a * (grid_s[i + 1] - grid_s[i]);
     profile->speed[f] = (v[i] + a * (v[i + 1] - v[i])) / scale;
-    profile->accel_longitudinal[f] = profile->speed[f] * (v[i + 1] - v[i]) / (scale * std::max(1e-12, grid_s[i + 1] - grid_s[i]));
+    profile->accel_longitudinal[f] =
+        profile->speed[f] * (v[i + 1] - v[i]) / (scale * std::max(1e-12, grid_s[i + 1] - grid_s[i]));
   }
   profile->s.front() = s_begin;
   profile->s.back() = s_begin + length;
@@ -395,9 +398,9 @@ BuildingPlan PlanBuilding(const CityStyle& st, const Box2& lots, int side, doubl
       p.footprint = {{lots.max.x() - d, a}, {lots.max.x(), b}}, p.facing = {1, 0};
       break;
   }
-  static const Eigen::Vector3f kPalette[] = {{1.0f, 0.93f, 0.8f},  {0.95f, 0.7f, 0.55f}, {0.85f, 0.85f, 0.85f},
-                                             {0.8f, 0.88f, 1.0f},  {1.0f, 0.85f, 0.55f}, {1.0f, 1.0f, 1.0f},
-                                             {0.75f, 0.6f, 0.5f},  {0.9f, 1.0f, 0.85f},  {1.0f, 0.8f, 0.8f}};
+  static const Eigen::Vector3f kPalette[] = {{1.0f, 0.93f, 0.8f}, {0.95f, 0.7f, 0.55f}, {0.85f, 0.85f, 0.85f},
+                                             {0.8f, 0.88f, 1.0f}, {1.0f, 0.85f, 0.55f}, {1.0f, 1.0f, 1.0f},
+                                             {0.75f, 0.6f, 0.5f}, {0.9f, 1.0f, 0.85f},  {1.0f, 0.8f, 0.8f}};
   // Whole storeys: a 4 m shop floor, 3.2 m upper floors, a 0.4 m parapet.
   const double h = rng.Uniform(st.height_min_m, st.height_max_m) * (rng.Bernoulli(0.1) ? 1.5 : 1.0);
   p.height = kStorefrontHeightMetres +
@@ -454,7 +457,7 @@ BuildingPlan PlanHouse(const CityStyle& st, const Box2& lots, int side, double a
       p.footprint = {{lots.max.x() - n1, a0}, {lots.max.x() - n0, a1}}, p.facing = {1, 0};
       break;
   }
-  static const Eigen::Vector3f kHouseColours[] = {{0.92f, 0.9f, 0.84f}, {0.85f, 0.8f, 0.7f}, {0.8f, 0.84f, 0.86f},
+  static const Eigen::Vector3f kHouseColours[] = {{0.92f, 0.9f, 0.84f},  {0.85f, 0.8f, 0.7f},   {0.8f, 0.84f, 0.86f},
                                                   {0.93f, 0.88f, 0.78f}, {0.75f, 0.78f, 0.72f}, {0.95f, 0.95f, 0.93f}};
   p.height = rng.Bernoulli(0.6) ? 2 * kHouseStoreyMetres : kHouseStoreyMetres;
   p.facade = rng.UniformInt(0, counts.facades - 1);

@@ -15,25 +15,24 @@
 // and curvature are continuous (the curvature step at each arc end is spread over ~3 control
 // spacings), and straights stay exactly straight (collinear control points).
 
+#include <Eigen/Core>
+#include <vector>
+
 #include "scenes/city.h"
 #include "scenes/rng.h"
-
-#include <Eigen/Core>
-
-#include <vector>
 
 namespace rovo {
 
 inline constexpr double kCurbHeight = 0.15;
 inline constexpr double kControlSpacing = 3.0;     // metres between B-spline control points
 inline constexpr double kTurnCurbClearance = 0.9;  // right-turn arc midpoint to the curb lines, metres
-inline constexpr double kRigHeight = 2.0;       // rig origin above the road (camera rig on a car roof)
+inline constexpr double kRigHeight = 2.0;          // rig origin above the road (camera rig on a car roof)
 
 // Per-preset look of the city.
 struct CityStyle {
   double block_min_m = 70, block_max_m = 110;
-  double road_width_m = 10.0;    // curb to curb
-  double parking_lane_m = 1.5;   // 0: none
+  double road_width_m = 10.0;   // curb to curb
+  double parking_lane_m = 1.5;  // 0: none
   double sidewalk_width_m = 3.0;
   double height_min_m = 9, height_max_m = 30;
   double lot_width_min_m = 8, lot_width_max_m = 24;
@@ -43,9 +42,9 @@ struct CityStyle {
   bool parked_cars = true;
   int facade_textures = 24, storefront_textures = 8;  // texture pool sizes (full form)
   int grid_streets_min = 6;                           // streets per axis at least
-  bool high_sun_along_streets = false;  // sunny: high sun near a street axis (canyons)
-  double tree_probability = 0.8;        // a tree between two street lights
-  double light_spacing_m = 28.0;        // street lights along each curb
+  bool high_sun_along_streets = false;                // sunny: high sun near a street axis (canyons)
+  double tree_probability = 0.8;                      // a tree between two street lights
+  double light_spacing_m = 28.0;                      // street lights along each curb
   // Suburban: detached houses (no shops) of house_width x house_depth set back from the sidewalk
   // behind lawns, one per lot, with plain walls (MakeHouseWallTexture) and few windows.
   bool houses = false;
@@ -64,16 +63,16 @@ struct Box2 {
 };
 
 struct BuildingPlan {
-  Box2 footprint;         // base box
-  double height = 10;     // top of the base box above the ground
+  Box2 footprint;      // base box
+  double height = 10;  // top of the base box above the ground
   bool has_setback = false;
-  Box2 upper_footprint;   // setback storey(s) on top, inside `footprint`
-  double upper_height = 0;  // top of the setback part
-  Eigen::Vector2d facing{0, -1};  // outward normal of the street-facing side
+  Box2 upper_footprint;            // setback storey(s) on top, inside `footprint`
+  double upper_height = 0;         // top of the setback part
+  Eigen::Vector2d facing{0, -1};   // outward normal of the street-facing side
   int facade = 0, storefront = 0;  // texture pool indices
   Eigen::Vector3f tint{1, 1, 1};
-  double u_offset = 0;             // metres, shifts the facade pattern
-  bool house = false;              // a detached house (CityStyle::houses): no shop floor, hipped roof
+  double u_offset = 0;  // metres, shifts the facade pattern
+  bool house = false;   // a detached house (CityStyle::houses): no shop floor, hipped roof
 };
 
 struct StreetGrid {
@@ -133,10 +132,10 @@ struct CityLayout {
   std::vector<BuildingPlan> buildings;
   GridRoute route;
   LanePath rig_path;
-  DriveProfile drive;    // per frame
+  DriveProfile drive;       // per frame
   double path_begin_s = 0;  // rig path arc length at frame 0
   double path_length_m = 0;
-  Trajectory trajectory;    // world_from_rig per frame
+  Trajectory trajectory;  // world_from_rig per frame
 
   // True if p (metres, world xy) is inside a building footprint grown by `margin`.
   bool InsideBuilding(const Eigen::Vector2d& p, double margin = 0.0) const;

@@ -1,16 +1,15 @@
 // `rovo scene generate`, `rovo scene info` and `rovo scene list`.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <string>
+
 #include "datasets/cli_groups.h"
 #include "datasets/trajectory.h"
 #include "scenes/city.h"
 #include "scenes/city_layout.h"
 #include "scenes/scene.h"
-
-#include <CLI/CLI.hpp>
-
-#include <chrono>
-#include <cstdio>
-#include <memory>
-#include <string>
 
 namespace rovo {
 namespace {
@@ -43,8 +42,9 @@ void PrintSceneSummary(const Scene& scene, const ScenePreset* nominal, bool quic
   }
   size_t texture_bytes = 0;
   const size_t bytes = SceneBytes(scene, &texture_bytes);
-  std::printf("preset       %s%s, seed %llu, lighting %s, rig %s\n", scene.metadata.preset.c_str(), quick ? " (quick)" : "",
-              static_cast<unsigned long long>(scene.metadata.seed), scene.lighting.preset.c_str(), scene.rig_preset.c_str());
+  std::printf("preset       %s%s, seed %llu, lighting %s, rig %s\n", scene.metadata.preset.c_str(),
+              quick ? " (quick)" : "", static_cast<unsigned long long>(scene.metadata.seed),
+              scene.lighting.preset.c_str(), scene.rig_preset.c_str());
   std::printf("hash         %s\n", SceneHash(scene).c_str());
   std::printf("meshes       %zu (%zu triangles; %zu placed in the world)\n", scene.meshes.size(), triangles, instanced);
   std::printf("objects      %zu (%zu moving)\n", scene.objects.size(), dynamic);
@@ -52,8 +52,8 @@ void PrintSceneSummary(const Scene& scene, const ScenePreset* nominal, bool quic
   std::printf("materials    %zu\n", scene.materials.size());
   std::printf("lights       %zu point/spot lights\n", scene.lights.size());
   std::printf("memory       %.1f MB\n", bytes / 1048576.0);
-  std::printf("path         %.1f m in %zu frames at %.0f Hz", PathLength(scene.rig_trajectory), scene.rig_trajectory.size(),
-              scene.frame_rate);
+  std::printf("path         %.1f m in %zu frames at %.0f Hz", PathLength(scene.rig_trajectory),
+              scene.rig_trajectory.size(), scene.frame_rate);
   if (nominal) {
     std::printf(" (preset: %.0f m, %d frames)", quick ? QuickPathLength(*nominal) : nominal->path_length_m,
                 quick ? nominal->quick_frames : nominal->frames);
@@ -94,7 +94,8 @@ void RunInfo(const std::string& dir) {
 }
 
 void RunList() {
-  std::printf("%-16s %7s %9s %7s %8s %7s %-9s  %s\n", "preset", "frames", "length_m", "quick", "scale", "traffic", "lighting", "description");
+  std::printf("%-16s %7s %9s %7s %8s %7s %-9s  %s\n", "preset", "frames", "length_m", "quick", "scale", "traffic",
+              "lighting", "description");
   for (const ScenePreset& p : AllScenePresets()) {
     std::printf("%-16s %7d %9.0f %7d %8.2f %7s %-9s  %s\n", p.name.c_str(), p.frames, p.path_length_m, p.quick_frames,
                 p.quick_scale, p.traffic ? "yes" : "no", p.lighting.c_str(), p.description.c_str());
@@ -117,7 +118,8 @@ void AddSceneCommands(CliGroups& groups) {
   gen->callback([opts] { RunGenerate(*opts); });
 
   auto info_dir = std::make_shared<std::string>();
-  CLI::App* info = groups.scene->add_subcommand("info", "Load a scene folder and print its size, path, lighting and load time");
+  CLI::App* info =
+      groups.scene->add_subcommand("info", "Load a scene folder and print its size, path, lighting and load time");
   info->add_option("dir", *info_dir, "Scene folder (scenes/FORMAT.md)")->required();
   info->callback([info_dir] { RunInfo(*info_dir); });
 

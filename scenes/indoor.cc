@@ -2,17 +2,17 @@
 
 #include "scenes/indoor.h"
 
-#include "datasets/rig.h"
-#include "scenes/mesh_builder.h"
-#include "scenes/rng.h"
-#include "scenes/texture_gen.h"
-
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
 #include <functional>
 #include <stdexcept>
+
+#include "datasets/rig.h"
+#include "scenes/mesh_builder.h"
+#include "scenes/rng.h"
+#include "scenes/texture_gen.h"
 
 namespace rovo {
 namespace {

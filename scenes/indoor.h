@@ -9,12 +9,11 @@
 // line-arc path and walks down the corridor's centre line; the quick form is the stretch around the
 // corridor entrance (half in the hall, half in the corridor).
 
+#include <Eigen/Core>
+#include <vector>
+
 #include "scenes/city.h"
 #include "scenes/city_layout.h"
-
-#include <Eigen/Core>
-
-#include <vector>
 
 namespace rovo {
 

@@ -2,15 +2,14 @@
 // Building blocks of the procedural generators (internal to scenes/): a triangle-mesh builder with
 // per-triangle materials and helpers that append materials, meshes and static objects to a Scene.
 
-#include "scenes/scene.h"
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
 #include <functional>
 #include <string>
+
+#include "scenes/scene.h"
 
 namespace rovo {
 

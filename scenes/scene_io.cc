@@ -1,11 +1,7 @@
 // Scene folder reader/writer and content hash (layout: scenes/FORMAT.md).
 
-#include "datasets/io.h"
-#include "scenes/scene.h"
-
 #include <OpenImageIO/imageio.h>
 #include <tbb/parallel_for.h>
-#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -13,8 +9,12 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
+
+#include "datasets/io.h"
+#include "scenes/scene.h"
 
 namespace rovo {
 namespace {
@@ -55,9 +55,7 @@ class Field {
     return Field(*it, file_, sub);
   }
   bool Has(const char* key) const { return value_.is_object() && value_.contains(key); }
-  Field operator[](size_t i) const {
-    return Field(value_.at(i), file_, path_ + "[" + std::to_string(i) + "]");
-  }
+  Field operator[](size_t i) const { return Field(value_.at(i), file_, path_ + "[" + std::to_string(i) + "]"); }
   size_t ArraySize() const {
     if (!value_.is_array()) Fail(file_, path_, "expected an array");
     return value_.size();
@@ -70,9 +68,11 @@ class Field {
   }
   int64_t Int(int64_t lo, int64_t hi) const {
     if (!value_.is_number_integer()) Fail(file_, path_, "expected an integer");
-    const int64_t v = value_.is_number_unsigned() ? static_cast<int64_t>(value_.get<uint64_t>()) : value_.get<int64_t>();
+    const int64_t v =
+        value_.is_number_unsigned() ? static_cast<int64_t>(value_.get<uint64_t>()) : value_.get<int64_t>();
     if (v < lo || v > hi) {
-      Fail(file_, path_, "value " + std::to_string(v) + " outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      Fail(file_, path_,
+           "value " + std::to_string(v) + " outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     }
     return v;
   }
@@ -106,7 +106,8 @@ Eigen::Quaterniond QuaternionFromXyzw(double x, double y, double z, double w, co
                                       const std::string& field) {
   Eigen::Quaterniond q(w, x, y, z);
   const double n = q.norm();
-  if (!std::isfinite(n) || std::abs(n - 1.0) > 1e-3) Fail(file, field, "quaternion is not unit (norm " + std::to_string(n) + ")");
+  if (!std::isfinite(n) || std::abs(n - 1.0) > 1e-3)
+    Fail(file, field, "quaternion is not unit (norm " + std::to_string(n) + ")");
   if (std::abs(n - 1.0) > 1e-9) q.coeffs() /= n;
   return q;
 }
@@ -234,7 +235,9 @@ void ReadPng(const std::string& path, Texture& texture, const std::string& json_
 
 class Hasher {
  public:
-  void Bytes(const void* data, size_t size) { state_ = std::strtoull(HashHex(data, size, state_).c_str(), nullptr, 16); }
+  void Bytes(const void* data, size_t size) {
+    state_ = std::strtoull(HashHex(data, size, state_).c_str(), nullptr, 16);
+  }
   void Str(const std::string& s) {
     U64(s.size());
     Bytes(s.data(), s.size());
@@ -350,12 +353,16 @@ void SaveScene(const Scene& scene, const std::string& dir) {
   for (size_t i = 0; i < scene.meshes.size(); ++i) {
     const Mesh& m = scene.meshes[i];
     const size_t nv = m.positions.size(), nt = m.triangles.size();
-    if (!m.uvs.empty() && m.uvs.size() != nv) throw std::runtime_error("SaveScene: mesh '" + m.name + "': uvs size != positions size");
+    if (!m.uvs.empty() && m.uvs.size() != nv)
+      throw std::runtime_error("SaveScene: mesh '" + m.name + "': uvs size != positions size");
     if (!m.triangle_materials.empty() && m.triangle_materials.size() != nt) {
       throw std::runtime_error("SaveScene: mesh '" + m.name + "': triangle_materials size != triangles size");
     }
-    json jm = {{"name", m.name}, {"material", m.material}, {"buffer", kGeometryFile},
-               {"vertex_count", nv}, {"triangle_count", nt}};
+    json jm = {{"name", m.name},
+               {"material", m.material},
+               {"buffer", kGeometryFile},
+               {"vertex_count", nv},
+               {"triangle_count", nt}};
     jm["positions_offset"] = geometry.size();
     AppendBytes(geometry, m.positions.data(), nv * 3 * sizeof(float));
     if (m.uvs.empty()) {
@@ -388,7 +395,7 @@ void SaveScene(const Scene& scene, const std::string& dir) {
       }
       jo["motion"] = {{"buffer", kMotionFile}, {"offset", motion.size()}, {"frames", frames}};
       for (const Rigid3& r : o.world_from_object_per_frame) {
-        const double rec[7] = {r.rotation.x(), r.rotation.y(), r.rotation.z(), r.rotation.w(),
+        const double rec[7] = {r.rotation.x(),    r.rotation.y(),    r.rotation.z(),   r.rotation.w(),
                                r.translation.x(), r.translation.y(), r.translation.z()};
         AppendBytes(motion, rec, sizeof(rec));
       }

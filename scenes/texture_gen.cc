@@ -1,12 +1,12 @@
 #include "scenes/texture_gen.h"
 
-#include "scenes/rng.h"
-
 #include <algorithm>
-#include <functional>
 #include <cmath>
+#include <functional>
 #include <string>
 #include <vector>
+
+#include "scenes/rng.h"
 
 namespace rovo {
 namespace {
@@ -52,7 +52,8 @@ class NoiseField {
       const int period_y = std::max(1, period_x * h / w);
       lattice.resize(static_cast<size_t>(period_x) * period_y);
       for (int y = 0; y < period_y; ++y)
-        for (int x = 0; x < period_x; ++x) lattice[static_cast<size_t>(y) * period_x + x] = Hash01(x, y, seed + 7919u * o);
+        for (int x = 0; x < period_x; ++x)
+          lattice[static_cast<size_t>(y) * period_x + x] = Hash01(x, y, seed + 7919u * o);
       for (int py = 0; py < h; ++py) {
         const float fy = (py + 0.5f) * period_y / h;
         const int y0 = static_cast<int>(fy);
@@ -172,7 +173,8 @@ void Crack(Canvas& c, SceneRng& rng, float x, float y, int steps, float step_px,
 
 // Glass pane with a vertical sky-reflection gradient, blotchy reflections and optional blinds.
 void Glass(Canvas& c, SceneRng& rng, int x0, int y0, int x1, int y1, uint64_t seed) {
-  const Color dark(0.10f + 0.05f * static_cast<float>(rng.Uniform()), 0.13f, 0.17f + 0.06f * static_cast<float>(rng.Uniform()));
+  const Color dark(0.10f + 0.05f * static_cast<float>(rng.Uniform()), 0.13f,
+                   0.17f + 0.06f * static_cast<float>(rng.Uniform()));
   const Color sky(0.55f, 0.62f, 0.70f);
   const float refl = static_cast<float>(rng.Uniform(0.1, 0.5));
   for (int y = y0; y < y1; ++y)
@@ -198,7 +200,8 @@ void Glass(Canvas& c, SceneRng& rng, int x0, int y0, int x1, int y1, uint64_t se
     // Lit room / interior objects: a few soft rectangles.
     for (int k = 0; k < 3; ++k) {
       const int ax = rng.UniformInt(x0, x1 - 4), ay = rng.UniformInt(y0 + (y1 - y0) / 2, y1 - 4);
-      c.Rect(ax, ay, std::min(x1, ax + rng.UniformInt(6, 30)), y1, Gray(static_cast<float>(rng.Uniform(0.2, 0.6))), 0.6f);
+      c.Rect(ax, ay, std::min(x1, ax + rng.UniformInt(6, 30)), y1, Gray(static_cast<float>(rng.Uniform(0.2, 0.6))),
+             0.6f);
     }
   }
 }
@@ -325,7 +328,9 @@ Texture MakeFacadeTexture(uint64_t seed, int index) {
         for (int k = 0; k < 4; ++k) c.Rect(x1 + 10, y0 + 15 + k * 6, x1 + 36, y0 + 17 + k * 6, Gray(0.45f));
       } else if (extra < 0.12 && sills) {
         const Color flowers(static_cast<float>(rng.Uniform(0.5, 0.9)), static_cast<float>(rng.Uniform(0.1, 0.5)), 0.2f);
-        for (int k = 0; k < win_w / 6; ++k) c.Disc(static_cast<float>(x0 + 3 + k * 6), static_cast<float>(y1 - 3), 3.0f, k % 2 ? flowers : Color(0.15f, 0.4f, 0.12f), 1.0f);
+        for (int k = 0; k < win_w / 6; ++k)
+          c.Disc(static_cast<float>(x0 + 3 + k * 6), static_cast<float>(y1 - 3), 3.0f,
+                 k % 2 ? flowers : Color(0.15f, 0.4f, 0.12f), 1.0f);
       }
     }
   }
@@ -371,8 +376,10 @@ Texture MakeStorefrontTexture(uint64_t seed, int index) {
         c.Rect(lx, by0 + 8, lx + lw, by0 + 12, ink);
         c.Rect(lx + lw / 2 - 2, by0 + 8, lx + lw / 2 + 2, by0 + 8 + lh, ink);
       } else {
-        c.Line(static_cast<float>(lx), static_cast<float>(by0 + 8 + lh), static_cast<float>(lx + lw / 2), static_cast<float>(by0 + 8), 2.0f, ink, 1.0f);
-        c.Line(static_cast<float>(lx + lw / 2), static_cast<float>(by0 + 8), static_cast<float>(lx + lw), static_cast<float>(by0 + 8 + lh), 2.0f, ink, 1.0f);
+        c.Line(static_cast<float>(lx), static_cast<float>(by0 + 8 + lh), static_cast<float>(lx + lw / 2),
+               static_cast<float>(by0 + 8), 2.0f, ink, 1.0f);
+        c.Line(static_cast<float>(lx + lw / 2), static_cast<float>(by0 + 8), static_cast<float>(lx + lw),
+               static_cast<float>(by0 + 8 + lh), 2.0f, ink, 1.0f);
       }
       lx += lw + rng.UniformInt(4, 9);
     }
@@ -384,7 +391,8 @@ Texture MakeStorefrontTexture(uint64_t seed, int index) {
     const Color frame = rng.Bernoulli(0.5) ? Gray(0.15f) : Gray(0.85f);
     Glass(c, rng, dx0, wy0 + 8, dx0 + door_w, H - 26, nseed + 10 + static_cast<uint64_t>(s));
     c.Frame(dx0, wy0 + 8, dx0 + door_w, H - 26, 8, frame);
-    c.Rect(dx0 + (door_left ? door_w - 18 : 10), (wy0 + H) / 2, dx0 + (door_left ? door_w - 14 : 14), (wy0 + H) / 2 + 30, Gray(0.7f));
+    c.Rect(dx0 + (door_left ? door_w - 18 : 10), (wy0 + H) / 2, dx0 + (door_left ? door_w - 14 : 14),
+           (wy0 + H) / 2 + 30, Gray(0.7f));
     const int wx0 = door_left ? dx0 + door_w + 12 : x + pil + 8, wx1 = door_left ? x + sw - 8 : dx0 - 12;
     if (wx1 - wx0 > 40) {
       Glass(c, rng, wx0, wy0, wx1, wy1, nseed + 20 + static_cast<uint64_t>(s));
@@ -397,7 +405,8 @@ Texture MakeStorefrontTexture(uint64_t seed, int index) {
       }
       c.Frame(wx0, wy0, wx1, wy1, 7, frame);
       const int panes = rng.UniformInt(1, 3);
-      for (int p = 1; p < panes; ++p) c.Rect(wx0 + (wx1 - wx0) * p / panes - 3, wy0, wx0 + (wx1 - wx0) * p / panes + 3, wy1, frame);
+      for (int p = 1; p < panes; ++p)
+        c.Rect(wx0 + (wx1 - wx0) * p / panes - 3, wy0, wx0 + (wx1 - wx0) * p / panes + 3, wy1, frame);
     }
     x += sw;
   }
@@ -429,8 +438,8 @@ Texture MakeRoadTexture(uint64_t seed, int index, double road_width_m, double pa
     c.Frame(px, py, px + pw, py + ph, 2, Gray(tone * 0.5f));
   }
   for (int k = 0; k < rng.UniformInt(6, 14); ++k) {
-    Crack(c, rng, static_cast<float>(rng.Uniform(0, N)), static_cast<float>(rng.Uniform(0, N)), rng.UniformInt(20, 80), 4.0f,
-          Gray(tone * 0.35f));
+    Crack(c, rng, static_cast<float>(rng.Uniform(0, N)), static_cast<float>(rng.Uniform(0, N)), rng.UniformInt(20, 80),
+          4.0f, Gray(tone * 0.35f));
   }
   for (int k = 0; k < rng.UniformInt(2, 6); ++k) {  // oil stains
     const float cx = static_cast<float>(rng.Uniform(0, N)), cy = static_cast<float>(rng.Uniform(0, N));
@@ -473,8 +482,9 @@ Texture MakeRoadTexture(uint64_t seed, int index, double road_width_m, double pa
     const float mx = static_cast<float>(rng.Uniform(0, N)), my = static_cast<float>(N * rng.Uniform(0.2, 0.4));
     c.Disc(mx, my, 0.32f * ppm, Gray(0.2f), 1.0f);
     c.Disc(mx, my, 0.28f * ppm, Gray(0.32f), 1.0f);
-    for (int k = -3; k <= 3; ++k) c.Rect(static_cast<int>(mx - 0.25f * ppm), static_cast<int>(my + k * 0.07f * ppm),
-                                         static_cast<int>(mx + 0.25f * ppm), static_cast<int>(my + k * 0.07f * ppm) + 3, Gray(0.18f));
+    for (int k = -3; k <= 3; ++k)
+      c.Rect(static_cast<int>(mx - 0.25f * ppm), static_cast<int>(my + k * 0.07f * ppm),
+             static_cast<int>(mx + 0.25f * ppm), static_cast<int>(my + k * 0.07f * ppm) + 3, Gray(0.18f));
   }
   return c.ToTexture("road_" + std::to_string(index));
 }
@@ -493,10 +503,12 @@ Texture MakeIntersectionTexture(uint64_t seed, double road_width_m) {
       c.At(x, y) = Gray(v);
     }
   for (int k = 0; k < 10; ++k) {
-    Crack(c, rng, static_cast<float>(rng.Uniform(0, N)), static_cast<float>(rng.Uniform(0, N)), rng.UniformInt(20, 60), 4.0f, Gray(0.1f));
+    Crack(c, rng, static_cast<float>(rng.Uniform(0, N)), static_cast<float>(rng.Uniform(0, N)), rng.UniformInt(20, 60),
+          4.0f, Gray(0.1f));
   }
   // Zebra crossings: 0.5 m stripes, 0.5 m gaps, 2.5 m long, inside a 3 m band on each edge.
-  const int band = static_cast<int>(3.0f * ppm), stripe = static_cast<int>(0.5f * ppm), len = static_cast<int>(2.5f * ppm);
+  const int band = static_cast<int>(3.0f * ppm), stripe = static_cast<int>(0.5f * ppm),
+            len = static_cast<int>(2.5f * ppm);
   const int inset = static_cast<int>(0.25f * ppm);
   for (int p = band; p + stripe <= N - band; p += 2 * stripe) {
     for (int y = inset; y < inset + len; ++y)
@@ -530,12 +542,12 @@ Texture MakeSidewalkTexture(uint64_t seed) {
     }
   for (int k = 0; k < 8; ++k) {
     const int sx = rng.UniformInt(0, 15) * slab, sy = rng.UniformInt(0, 15) * slab;
-    c.Line(static_cast<float>(sx + rng.UniformInt(2, slab)), static_cast<float>(sy + 2), static_cast<float>(sx + rng.UniformInt(2, slab)),
-           static_cast<float>(sy + slab - 1), 0.8f, Gray(0.2f), 0.8f);
+    c.Line(static_cast<float>(sx + rng.UniformInt(2, slab)), static_cast<float>(sy + 2),
+           static_cast<float>(sx + rng.UniformInt(2, slab)), static_cast<float>(sy + slab - 1), 0.8f, Gray(0.2f), 0.8f);
   }
   for (int k = 0; k < 120; ++k) {  // chewing gum, stains
-    c.Disc(static_cast<float>(rng.Uniform(0, N)), static_cast<float>(rng.Uniform(0, N)), static_cast<float>(rng.Uniform(1.5, 4)),
-           Gray(static_cast<float>(rng.Uniform(0.15, 0.4))), 0.8f);
+    c.Disc(static_cast<float>(rng.Uniform(0, N)), static_cast<float>(rng.Uniform(0, N)),
+           static_cast<float>(rng.Uniform(1.5, 4)), Gray(static_cast<float>(rng.Uniform(0.15, 0.4))), 0.8f);
   }
   return c.ToTexture("sidewalk");
 }
@@ -551,7 +563,8 @@ Texture MakeConcreteTexture(uint64_t seed) {
       const float v = 0.55f * (0.8f + 0.3f * noise(x, y)) * (0.85f + 0.3f * Hash01(x, y, nseed + 1));
       c.At(x, y) = Gray(v);
     }
-  for (int k = 0; k < 6; ++k) Crack(c, rng, static_cast<float>(rng.Uniform(0, N)), static_cast<float>(rng.Uniform(0, N)), 30, 3.0f, Gray(0.25f));
+  for (int k = 0; k < 6; ++k)
+    Crack(c, rng, static_cast<float>(rng.Uniform(0, N)), static_cast<float>(rng.Uniform(0, N)), 30, 3.0f, Gray(0.25f));
   return c.ToTexture("concrete");
 }
 
@@ -580,9 +593,9 @@ Texture MakeCarSideTexture(uint64_t seed) {
   const Color line = Gray(0.35f);
   for (int x : {int(W * 0.28), int(W * 0.52), int(W * 0.74)}) c.Rect(x, 6, x + 2, H - 22, line);  // door seams
   c.Rect(0, 4, W, 6, line);
-  c.Rect(0, H - 22, W, H, Gray(0.25f));  // sill / bumper strip
+  c.Rect(0, H - 22, W, H, Gray(0.25f));                                                // sill / bumper strip
   for (int x : {int(W * 0.44), int(W * 0.66)}) c.Rect(x, 24, x + 16, 29, Gray(0.2f));  // handles
-  for (float wx : {W * 0.17f, W * 0.83f}) {                                           // wheel arches
+  for (float wx : {W * 0.17f, W * 0.83f}) {                                            // wheel arches
     c.Disc(wx, H + 6.0f, 44.0f, Gray(0.1f), 1.0f);
   }
   c.Rect(W - 10, 30, W, 46, Color(0.9f, 0.6f, 0.1f));  // side marker
@@ -593,8 +606,8 @@ Texture MakeCarEndTexture(uint64_t seed) {
   SceneRng rng(SubSeed(seed, "car_end"));
   const int W = 256, H = 128;
   Canvas c(W, H, Gray(0.9f));
-  c.Rect(0, H - 30, W, H, Gray(0.25f));                          // bumper
-  c.Rect(W / 2 - 36, H - 56, W / 2 + 36, H - 36, Gray(0.95f));   // plate
+  c.Rect(0, H - 30, W, H, Gray(0.25f));                         // bumper
+  c.Rect(W / 2 - 36, H - 56, W / 2 + 36, H - 36, Gray(0.95f));  // plate
   c.Frame(W / 2 - 36, H - 56, W / 2 + 36, H - 36, 2, Gray(0.1f));
   for (int k = 0; k < 6; ++k) c.Rect(W / 2 - 30 + k * 10, H - 52, W / 2 - 25 + k * 10, H - 40, Gray(0.15f));
   const Color lamp = rng.Bernoulli(0.5) ? Color(0.95f, 0.95f, 0.85f) : Color(0.8f, 0.1f, 0.08f);
@@ -660,9 +673,8 @@ Texture MakeSignTexture(uint64_t seed, int kind) {
         if (inside(x + 0.5f - c, y + 0.5f - c)) img.At(x, y) = color;
   };
   auto octagon = [](float r) {
-    return [r](float x, float y) {
-      return std::abs(x) < r && std::abs(y) < r && std::abs(x) + std::abs(y) < r * 1.414f;
-    };
+    return
+        [r](float x, float y) { return std::abs(x) < r && std::abs(y) < r && std::abs(x) + std::abs(y) < r * 1.414f; };
   };
   auto disc = [](float r) { return [r](float x, float y) { return x * x + y * y < r * r; }; };
   switch (kind) {
@@ -714,8 +726,8 @@ Texture MakeFoliageTexture(uint64_t seed) {
   Canvas c(N, N, Color(0.12f, 0.25f, 0.08f));
   for (int k = 0; k < 1500; ++k) {
     const float g = static_cast<float>(rng.Uniform(0.5, 1.4));
-    c.Disc(static_cast<float>(rng.Uniform(0, N)), static_cast<float>(rng.Uniform(0, N)), static_cast<float>(rng.Uniform(1.5, 4.5)),
-           Color(0.18f * g, 0.38f * g, 0.12f * g), 1.0f);
+    c.Disc(static_cast<float>(rng.Uniform(0, N)), static_cast<float>(rng.Uniform(0, N)),
+           static_cast<float>(rng.Uniform(1.5, 4.5)), Color(0.18f * g, 0.38f * g, 0.12f * g), 1.0f);
   }
   return c.ToTexture("foliage");
 }

@@ -4,14 +4,14 @@
 // about 1.25 cm per texel on facades and about 1 cm on roads and sidewalks, with corners
 // (window frames, brick joints, slab joints, markings, cracks) that ORB/KLT can track.
 
-#include "scenes/scene.h"
-
 #include <cstdint>
+
+#include "scenes/scene.h"
 
 namespace rovo {
 
 // Physical sizes the generators assume (metres covered by one texture tile).
-inline constexpr double kFacadeTileMetres = 12.8;     // 1024 px wide, 4 floors of 3.2 m tall
+inline constexpr double kFacadeTileMetres = 12.8;  // 1024 px wide, 4 floors of 3.2 m tall
 inline constexpr double kFloorHeightMetres = 3.2;
 inline constexpr double kStorefrontHeightMetres = 4.0;  // 1024 x 320 px: 12.8 m x 4 m
 inline constexpr double kSidewalkTileMetres = 8.0;
@@ -28,8 +28,8 @@ int FacadeBays(uint64_t seed, int index);
 // 256 px tall and starts (256 - height) / 2 - 8 px below the top; horizontally it is centred in its
 // bay, window_width_fraction of the bay wide.
 struct FacadeLayout {
-  int style = 0;  // 0 brick, 1 plaster, 2 precast panels, 3 glass curtain wall
-  int bays = 3;   // window columns per 12.8 m tile
+  int style = 0;                        // 0 brick, 1 plaster, 2 precast panels, 3 glass curtain wall
+  int bays = 3;                         // window columns per 12.8 m tile
   double window_width_fraction = 0.5;   // of the bay width
   double window_height_fraction = 0.5;  // of the floor height
 };
@@ -42,12 +42,12 @@ Texture MakeStorefrontTexture(uint64_t seed, int index);
 Texture MakeRoadTexture(uint64_t seed, int index, double road_width_m, double parking_lane_m);
 // Intersection square of the road width: asphalt with zebra crossings along its four edges.
 Texture MakeIntersectionTexture(uint64_t seed, double road_width_m);
-Texture MakeSidewalkTexture(uint64_t seed);   // 0.5 m slabs, kSidewalkTileMetres per tile
-Texture MakeConcreteTexture(uint64_t seed);   // curbs, roofs (kRoofTileMetres per tile)
-Texture MakeGroundTexture(uint64_t seed);     // grass/dirt beyond the city
-Texture MakeCarSideTexture(uint64_t seed);    // 512 x 128: doors, handles, sills (4.4 m x 1.1 m)
-Texture MakeCarEndTexture(uint64_t seed);     // 256 x 128: grille, lights, plate
-Texture MakeCarGlassTexture(uint64_t seed);   // 256 x 64: dark glass with pillars
+Texture MakeSidewalkTexture(uint64_t seed);  // 0.5 m slabs, kSidewalkTileMetres per tile
+Texture MakeConcreteTexture(uint64_t seed);  // curbs, roofs (kRoofTileMetres per tile)
+Texture MakeGroundTexture(uint64_t seed);    // grass/dirt beyond the city
+Texture MakeCarSideTexture(uint64_t seed);   // 512 x 128: doors, handles, sills (4.4 m x 1.1 m)
+Texture MakeCarEndTexture(uint64_t seed);    // 256 x 128: grille, lights, plate
+Texture MakeCarGlassTexture(uint64_t seed);  // 256 x 64: dark glass with pillars
 Texture MakeBarkTexture(uint64_t seed);
 Texture MakeAwningTexture(uint64_t seed, int index);  // 256 x 64: striped or plain cloth, 1 texel ~1 cm
 // Road sign face, 256 x 256 px for a 0.6 m plate; kind in [0, kSignKinds): stop, give way, no
@@ -58,10 +58,10 @@ Texture MakeFoliageTexture(uint64_t seed);
 
 // ---- harder worlds: plain, low-contrast surfaces ----
 inline constexpr double kHouseStoreyMetres = 2.9;
-inline constexpr double kHouseWallTileMetres = 4.0;   // 512 px: about 8 mm per texel
+inline constexpr double kHouseWallTileMetres = 4.0;  // 512 px: about 8 mm per texel
 inline constexpr double kLawnTileMetres = 6.0;
 inline constexpr double kHallWallTileMetres = 4.0;
-inline constexpr double kHallFloorTileMetres = 4.8;   // 4 x 4 polished stone slabs of 1.2 m
+inline constexpr double kHallFloorTileMetres = 4.8;    // 4 x 4 polished stone slabs of 1.2 m
 inline constexpr double kHallCeilingTileMetres = 2.4;  // 4 x 4 acoustic panels of 0.6 m
 // Suburban house wall: smooth render (stucco) with only faint large-scale shading and fine grain
 // (RMS contrast a few percent), near white so the material tint sets the colour.

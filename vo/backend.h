@@ -13,6 +13,11 @@
 // consensus, and the first frame after a lost one, rebuild the map from inter-view triangulation at
 // the predicted pose (status "init", or "lost" when too few points triangulate).
 
+#include <map>
+#include <memory>
+#include <optional>
+#include <vector>
+
 #include "datasets/rigid3.h"
 #include "datasets/run.h"
 #include "vo/frontend.h"
@@ -21,11 +26,6 @@
 #include "vo/pose_refinement.h"
 #include "vo/ransac.h"
 #include "vo/triangulation.h"
-
-#include <map>
-#include <memory>
-#include <optional>
-#include <vector>
 
 namespace rovo {
 
@@ -37,13 +37,13 @@ struct BackendOptions {
   LocalBaOptions ba;                              // ba.optimize_extrinsics = OnlineExt
   KeyframeOptions keyframes;
   bool local_ba = true;
-  int window_keyframes = 6;          // sliding window size
-  int max_ba_landmarks = 800;        // bound on BA size (landmarks with most observations)
-  int min_features = 20;             // fewer features in all views: frame lost (e.g. black image)
-  int min_correspondences = 15;      // fewer 2D-3D correspondences: frame lost
-  double min_inlier_ratio = 0.15;    // below: no consensus
-  int min_init_landmarks = 15;       // inter-view points needed to (re)initialise
-  int max_unseen_frames = 2;         // landmarks unseen for longer are dropped
+  int window_keyframes = 6;        // sliding window size
+  int max_ba_landmarks = 800;      // bound on BA size (landmarks with most observations)
+  int min_features = 20;           // fewer features in all views: frame lost (e.g. black image)
+  int min_correspondences = 15;    // fewer 2D-3D correspondences: frame lost
+  double min_inlier_ratio = 0.15;  // below: no consensus
+  int min_init_landmarks = 15;     // inter-view points needed to (re)initialise
+  int max_unseen_frames = 2;       // landmarks unseen for longer are dropped
   // Keyframe BA on a second thread, beside the caller's work on the next frame (its front-end): the
   // solve starts at the end of ProcessFrame(k) and is joined and applied by FinishPendingBa, which
   // ProcessFrame(k + 1) calls first. Results equal the synchronous order exactly; the caller sees the
@@ -66,8 +66,8 @@ struct BackendOptions {
 };
 
 struct BackendFrameResult {
-  Rigid3 world_from_rig;     // with async_ba on a keyframe: before its BA (FinishPendingBa gives the refined one)
-  FrameRecord record;        // status, counts, errors (frame and timestamp filled by the caller)
+  Rigid3 world_from_rig;  // with async_ba on a keyframe: before its BA (FinishPendingBa gives the refined one)
+  FrameRecord record;     // status, counts, errors (frame and timestamp filled by the caller)
   double ms_ransac = 0, ms_refine = 0, ms_triangulate = 0, ms_ba = 0;  // ms_ba: synchronous BA only
   int ransac_hypotheses = 0;
   int num_landmarks = 0;

@@ -1,16 +1,16 @@
 // Micro-benchmarks of the back-end stages on synthetic rig data (no rendering):
 // P3P, one multi-view RANSAC (per hypothesis time in the counters), pose refinement, triangulation
 // and one local BA with online extrinsics.
+#include <benchmark/benchmark.h>
+
+#include <random>
+
 #include "tests/vo/synthetic_rig.h"
 #include "vo/local_ba.h"
 #include "vo/p3p.h"
 #include "vo/pose_refinement.h"
 #include "vo/ransac.h"
 #include "vo/triangulation.h"
-
-#include <benchmark/benchmark.h>
-
-#include <random>
 
 namespace rovo {
 namespace {
@@ -65,7 +65,8 @@ void BM_RefineRigPose(benchmark::State& state) {
   std::mt19937_64 rng(3);
   const auto c = Correspondences(rng, 300, 0.0);
   const auto cam_from_rig = test::SquareRigExtrinsics();
-  const Rigid3 start(Eigen::Quaterniond(Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitZ())), Eigen::Vector3d(0.05, 0, 0));
+  const Rigid3 start(Eigen::Quaterniond(Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitZ())),
+                     Eigen::Vector3d(0.05, 0, 0));
   for (auto _ : state) benchmark::DoNotOptimize(RefineRigPose(c, cam_from_rig, {}, start));
 }
 BENCHMARK(BM_RefineRigPose)->Unit(benchmark::kMillisecond);
@@ -86,7 +87,8 @@ void BM_LocalBa(benchmark::State& state) {
   std::mt19937_64 rng(4);
   LocalBaProblem base;
   base.cam_from_rig = test::SquareRigExtrinsics();
-  for (int i = 0; i < 6; ++i) base.rig_from_world.push_back(Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(-1.0 * i, 0, 0)));
+  for (int i = 0; i < 6; ++i)
+    base.rig_from_world.push_back(Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(-1.0 * i, 0, 0)));
   for (int k = 0; k < state.range(0); ++k) {
     const Eigen::Vector3d x = test::RandomPoint(rng, 4.0, 25.0);
     int cams = 0;
@@ -110,7 +112,10 @@ void BM_LocalBa(benchmark::State& state) {
     benchmark::DoNotOptimize(SolveLocalBa(p, options));
   }
 }
-BENCHMARK(BM_LocalBa)->ArgNames({"points", "online"})->ArgsProduct({{800, 1500}, {0, 1}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LocalBa)
+    ->ArgNames({"points", "online"})
+    ->ArgsProduct({{800, 1500}, {0, 1}})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace rovo

@@ -1,21 +1,20 @@
 // `rovo` subcommands of vo/: `rovo vo` (run the pipeline on a dataset) and `rovo bench vo`.
-#include "datasets/cli_groups.h"
-#include "datasets/rig.h"
-#include "vo/hybrid_projection.h"
-#include "vo/pipeline.h"
-#include "vo/projection_study.h"
-
 #include <CLI/CLI.hpp>
-#include <opencv2/core.hpp>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
-#include <thread>
+#include <opencv2/core.hpp>
 #include <stdexcept>
 #include <string>
+#include <thread>
+
+#include "datasets/cli_groups.h"
+#include "datasets/rig.h"
+#include "vo/hybrid_projection.h"
+#include "vo/pipeline.h"
+#include "vo/projection_study.h"
 
 namespace rovo {
 namespace {
@@ -49,11 +48,10 @@ double MachineReferenceWarpMs(int cores) {
   return ms[ms.size() / 2];
 }
 
-// --realtime: the two front-end settings that trade some accuracy for speed (docs/design-notes.md: warp extents). Measured
-// 2026-11-24 on full-size cloudy_urban (150 frames, idle, images in memory): front-end 63 -> 45.5-47 ms
-// wall per frame, whole pipeline 14.8 -> 19.8-20.4 frames/s; first 300 frames relative RMSE GTExt
-// cloudy_urban 0.012 -> 0.025 %, sunset_urban 0.020 -> 0.018 %, OnlineExt 0.012 -> 0.025 % and
-// 0.014 -> 0.012 %.
+// --realtime: the two front-end settings that trade some accuracy for speed (docs/design-notes.md: warp extents).
+// Measured 2026-11-24 on full-size cloudy_urban (150 frames, idle, images in memory): front-end 63 -> 45.5-47 ms wall
+// per frame, whole pipeline 14.8 -> 19.8-20.4 frames/s; first 300 frames relative RMSE GTExt cloudy_urban 0.012 ->
+// 0.025 %, sunset_urban 0.020 -> 0.018 %, OnlineExt 0.012 -> 0.025 % and 0.014 -> 0.012 %.
 constexpr double kRealtimeWarpBelowDeg = 25.0;
 constexpr int kRealtimeMaxNewFeatures = 150;
 
@@ -115,8 +113,7 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
       ->check(CLI::Range(0.0, 1000.0))
       ->capture_default_str();
   cmd->add_option_function<std::string>(
-         "--online-lens-scale",
-         [args](const std::string& v) { args->options.online_apply_lens_scale = v == "apply"; },
+         "--online-lens-scale", [args](const std::string& v) { args->options.online_apply_lens_scale = v == "apply"; },
          "OnlineExt: apply (default) | report. apply: when the start-up calibration converges with an angle scale of "
          "the lenses (a lens calibration that misjudges angles near the rim), the VO sees through lenses scaled by "
          "it; report: the dataset's lenses, the scale only in run.json")
@@ -153,9 +150,10 @@ void AddVoRunOptions(CLI::App* cmd, VoArgs* args) {
   cmd->add_option("--keyframe-distance", args->options.keyframe_distance_m,
                   "Rig travel in metres that makes a keyframe (and a local BA); 0: the default, recorded in run.json")
       ->check(CLI::Range(0.0, 100.0));
-  cmd->add_flag("--sync-ba", [args](int64_t) { args->options.async_ba = false; },
-                "Run each keyframe BA before the next frame's front-end instead of beside it (same GTExt/NoisyExt "
-                "result, slower; OnlineExt's front-end then sees the calibration one frame earlier)");
+  cmd->add_flag(
+      "--sync-ba", [args](int64_t) { args->options.async_ba = false; },
+      "Run each keyframe BA before the next frame's front-end instead of beside it (same GTExt/NoisyExt "
+      "result, slower; OnlineExt's front-end then sees the calibration one frame earlier)");
   cmd->add_flag("--realtime", args->realtime,
                 "Real-time profile for full-size live rigs: --warp-below 25 --max-new-features 150 unless given "
                 "(front-end about 28 % cheaper, trajectories slightly less accurate; docs/design-notes.md)");
@@ -185,10 +183,11 @@ void AddVoCommands(CliGroups& groups) {
   cmd->callback([args] {
     Finalise(args.get());
     const VoSummary s = RunVo(args->options);
-    std::printf("%d frames (%d ok, %d init, %d lost) in %.1f s (%.1f frames/s); mean inlier ratio %.1f%%, mean "
-                "reprojection error %.3f deg -> %s\n",
-                s.frames, s.frames_ok, s.frames_init, s.frames_lost, s.seconds, s.frames / std::max(s.seconds, 1e-9),
-                100.0 * s.mean_inlier_ratio, s.mean_reproj_error_deg, args->options.out_dir.c_str());
+    std::printf(
+        "%d frames (%d ok, %d init, %d lost) in %.1f s (%.1f frames/s); mean inlier ratio %.1f%%, mean "
+        "reprojection error %.3f deg -> %s\n",
+        s.frames, s.frames_ok, s.frames_init, s.frames_lost, s.seconds, s.frames / std::max(s.seconds, 1e-9),
+        100.0 * s.mean_inlier_ratio, s.mean_reproj_error_deg, args->options.out_dir.c_str());
     if (s.missing_images > 0) {
       std::printf("warning: %d image%s missing or unreadable in %d frame%s (frames.csv missing_cameras)\n",
                   s.missing_images, s.missing_images == 1 ? "" : "s", s.frames_with_missing_images,
@@ -198,9 +197,10 @@ void AddVoCommands(CliGroups& groups) {
 
   auto bench_args = std::make_shared<VoArgs>();
   CLI::App* bench = groups.bench->add_subcommand(
-      "vo", "Time the whole pipeline on a dataset (full image size) and print a table of mean ms per frame by stage, "
-            "with a machine reference taken before and after the run (full-size hybrid warps, one per core at once); "
-            "compare speeds only between runs whose references agree");
+      "vo",
+      "Time the whole pipeline on a dataset (full image size) and print a table of mean ms per frame by stage, "
+      "with a machine reference taken before and after the run (full-size hybrid warps, one per core at once); "
+      "compare speeds only between runs whose references agree");
   AddVoRunOptions(bench, bench_args.get());
   bench->add_option("--out", bench_args->options.out_dir, "Run folder to write (default: DATASET/../bench_vo_run)");
   bench->add_flag("--preload", bench_args->options.preload_images,
@@ -221,8 +221,9 @@ void AddVoCommands(CliGroups& groups) {
     // CPU = process CPU time of all threads (FrontendFrame::cpu_ms_*); measured for the front-end only. It
     // includes the image decoder and an async BA running meanwhile: use --preload --sync-ba for the
     // front-end's own CPU time.
-    std::printf("| stage                     | ms/frame | CPU ms/frame |\n"
-                "|---------------------------|---------:|-------------:|\n");
+    std::printf(
+        "| stage                     | ms/frame | CPU ms/frame |\n"
+        "|---------------------------|---------:|-------------:|\n");
     const double frontend_wall = t.warp + t.detect + t.track + t.match;
     const double frontend_cpu = t.cpu_warp + t.cpu_detect + t.cpu_track + t.cpu_match;
     const struct {
@@ -254,13 +255,15 @@ void AddVoCommands(CliGroups& groups) {
                                                    : "solved in line (--sync-ba)");
     std::printf("whole pipeline: %.2f frames/s (target 10 Hz)%s\n", t.total > 0 ? 1000.0 / t.total : 0.0,
                 options.preload_images ? ", images decoded beforehand" : ", images decoded on a second thread");
-    std::printf("machine reference: one full-size hybrid warp per core on %d core%s at once: %.2f ms before the run, "
-                "%.2f ms after\n",
-                cores, cores == 1 ? "" : "s", reference_before_ms, reference_after_ms);
+    std::printf(
+        "machine reference: one full-size hybrid warp per core on %d core%s at once: %.2f ms before the run, "
+        "%.2f ms after\n",
+        cores, cores == 1 ? "" : "s", reference_before_ms, reference_after_ms);
     const double reference_low_ms = std::min(reference_before_ms, reference_after_ms);
     if (std::abs(reference_after_ms - reference_before_ms) > 0.2 * reference_low_ms) {
-      std::printf("warning: the machine's speed changed by more than 20 %% during the run; repeat it before "
-                  "comparing\n");
+      std::printf(
+          "warning: the machine's speed changed by more than 20 %% during the run; repeat it before "
+          "comparing\n");
     }
   });
 

@@ -1,11 +1,11 @@
 #include "vo/extrinsic_bootstrap.h"
 
-#include "vo/local_ba.h"
-#include "vo/triangulation.h"
-
 #include <algorithm>
 #include <cmath>
 #include <map>
+
+#include "vo/local_ba.h"
+#include "vo/triangulation.h"
 
 namespace rovo {
 namespace {
@@ -71,7 +71,8 @@ ExtrinsicBootstrapReport CalibrateExtrinsicsFromFrame(const FrontendFrame& frame
       mean_dir.normalize();
       mean_origin /= static_cast<double>(rays.size());
       bool agree = true;
-      for (const Ray& r : rays) agree &= AngleBetween(r.direction_in_world, mean_dir) * 180.0 / M_PI <= 0.5 * options.max_error_deg;
+      for (const Ray& r : rays)
+        agree &= AngleBetween(r.direction_in_world, mean_dir) * 180.0 / M_PI <= 0.5 * options.max_error_deg;
       if (!agree) continue;
       double parallax = 0.0;
       for (size_t a = 0; a < rays.size(); ++a) {
@@ -118,13 +119,13 @@ ExtrinsicBootstrapReport CalibrateExtrinsicsFromFrame(const FrontendFrame& frame
   std::vector<double> errors_after;
   for (const LocalBaObservation& o : problem.observations) {
     errors_after.push_back(
-        AngleBetween(o.bearing_in_cam, problem.cam_from_rig[o.camera] * problem.points_in_world[o.point_index]) * 180.0 /
-        M_PI);
+        AngleBetween(o.bearing_in_cam, problem.cam_from_rig[o.camera] * problem.points_in_world[o.point_index]) *
+        180.0 / M_PI);
   }
   report.median_error_deg_after = Median(errors_after);
   for (int j = 0; j < num_cams; ++j) {
-    report.max_change_deg =
-        std::max(report.max_change_deg, RotationDistanceDeg(problem.cam_from_rig[j].rotation, cam_from_rig[j].rotation));
+    report.max_change_deg = std::max(report.max_change_deg,
+                                     RotationDistanceDeg(problem.cam_from_rig[j].rotation, cam_from_rig[j].rotation));
   }
   report.cam_from_rig = problem.cam_from_rig;
   report.usable = true;

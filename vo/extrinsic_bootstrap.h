@@ -18,31 +18,31 @@
 // of near and far points; the relative yaw only from far points, so what remains of it is left to
 // the online BA over time (multi-frame tracks fix it through each camera's own parallax).
 
+#include <vector>
+
 #include "datasets/rigid3.h"
 #include "vo/frontend.h"
-
-#include <vector>
 
 namespace rovo {
 
 struct ExtrinsicBootstrapOptions {
-  double max_error_deg = 10.0;     // rays of one track may disagree by this much (current uncertainty)
-  double far_distance_m = 200.0;   // depth given to near-parallel rays
-  double min_parallax_deg = 0.3;   // below: treated as a far point
-  int max_iterations = 30;         // Ceres iterations
-  double baseline_weight = 1000.0; // as LocalBaOptions
+  double max_error_deg = 10.0;      // rays of one track may disagree by this much (current uncertainty)
+  double far_distance_m = 200.0;    // depth given to near-parallel rays
+  double min_parallax_deg = 0.3;    // below: treated as a far point
+  int max_iterations = 30;          // Ceres iterations
+  double baseline_weight = 1000.0;  // as LocalBaOptions
   double multi_camera_weight = 1.0;
 };
 
 struct ExtrinsicBootstrapReport {
   bool usable = false;
-  int num_points = 0;               // shared tracks used
+  int num_points = 0;  // shared tracks used
   int num_observations = 0;
-  int points_per_pair_min = 0;      // fewest points in an overlap of ring neighbours
+  int points_per_pair_min = 0;           // fewest points in an overlap of ring neighbours
   double median_error_deg_before = 0.0;  // angular residual of the seeds under the old extrinsics
   double median_error_deg_after = 0.0;   // after the solve
-  double max_change_deg = 0.0;      // largest rotation change of a cam_from_rig
-  std::vector<Rigid3> cam_from_rig; // calibrated (camera 0 unchanged)
+  double max_change_deg = 0.0;           // largest rotation change of a cam_from_rig
+  std::vector<Rigid3> cam_from_rig;      // calibrated (camera 0 unchanged)
 };
 
 // `frame`: one front-end frame whose features carry unified track ids (inter-view matches).

@@ -1,8 +1,5 @@
 #include "vo/frontend.h"
-#include "vo/opencv_threads.h"
 
-#include <opencv2/core/utility.hpp>
-#include <opencv2/imgproc.hpp>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -10,11 +7,15 @@
 #include <chrono>
 #include <ctime>
 #include <mutex>
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
+
+#include "vo/opencv_threads.h"
 
 namespace rovo {
 namespace {
@@ -69,9 +70,9 @@ struct Frontend::Impl {
   std::vector<HybridProjection> projections;  // maps (rebuilt only past the threshold)
   std::vector<ViewTracker> trackers;
   std::vector<cv::Mat> warped, fisheye_gray;
-  std::vector<cv::Mat> static_masks;          // fisheye, per camera; empty: none
-  std::vector<cv::Mat> view_masks;            // warped: the lens' valid area and the static mask
-  std::vector<std::pair<int, int>> pairs;     // (camera, its right neighbour), each overlap once
+  std::vector<cv::Mat> static_masks;       // fisheye, per camera; empty: none
+  std::vector<cv::Mat> view_masks;         // warped: the lens' valid area and the static mask
+  std::vector<std::pair<int, int>> pairs;  // (camera, its right neighbour), each overlap once
   std::vector<ViewMatch> last_matches;
   uint64_t last_id = 0;
 
@@ -116,7 +117,8 @@ Frontend::Frontend(const Rig& rig, const FrontendOptions& options) : impl_(std::
   s.layouts = ComputeHybridLayouts(rig);
   s.projections.resize(rig.NumCameras());
   tbb::parallel_for(0, rig.NumCameras(), [&](int i) {
-    s.projections[i] = HybridProjection(rig.cameras[i].camera, rig.cameras[i].cam_from_rig, s.layouts[i], options.projection);
+    s.projections[i] =
+        HybridProjection(rig.cameras[i].camera, rig.cameras[i].cam_from_rig, s.layouts[i], options.projection);
   });
   s.trackers.assign(rig.NumCameras(), ViewTracker(TrackerOptionsFrom(s.options)));
   s.warped.resize(rig.NumCameras());
@@ -134,7 +136,8 @@ void Frontend::SetStaticMasks(const std::vector<cv::Mat>& fisheye_masks) {
   }
   for (size_t i = 0; i < fisheye_masks.size(); ++i) {
     const Camera& camera = s.rig.cameras[i].camera;
-    if (fisheye_masks[i].type() != CV_8UC1 || fisheye_masks[i].cols != camera.width || fisheye_masks[i].rows != camera.height) {
+    if (fisheye_masks[i].type() != CV_8UC1 || fisheye_masks[i].cols != camera.width ||
+        fisheye_masks[i].rows != camera.height) {
       throw std::invalid_argument("Frontend::SetStaticMasks: the mask of camera " + std::to_string(i) +
                                   " is not 8-bit single-channel of the camera's size");
     }
@@ -156,8 +159,8 @@ void Frontend::SetMatchingOptions(const InterviewMatchOptions& matching) { impl_
 void Frontend::SetExtrinsics(const std::vector<Rigid3>& cam_from_rig) {
   Impl& s = *impl_;
   if (static_cast<int>(cam_from_rig.size()) != s.rig.NumCameras()) {
-    throw std::invalid_argument("Frontend::SetExtrinsics: " + std::to_string(cam_from_rig.size()) +
-                                " extrinsics for " + std::to_string(s.rig.NumCameras()) + " cameras");
+    throw std::invalid_argument("Frontend::SetExtrinsics: " + std::to_string(cam_from_rig.size()) + " extrinsics for " +
+                                std::to_string(s.rig.NumCameras()) + " cameras");
   }
   const ScopedOpenCvThreads serial_opencv;
   s.rig = s.rig.WithExtrinsics(cam_from_rig);
@@ -247,8 +250,9 @@ void Frontend::Impl::CheckImages(const std::vector<cv::Mat>& fisheye_images) con
     const Camera& camera = rig.cameras[i].camera;
     if (fisheye_images[i].cols != camera.width || fisheye_images[i].rows != camera.height) {
       throw std::invalid_argument("Frontend::Process: image of camera " + std::to_string(i) + " is " +
-                                  std::to_string(fisheye_images[i].cols) + "x" + std::to_string(fisheye_images[i].rows) +
-                                  ", expected " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
+                                  std::to_string(fisheye_images[i].cols) + "x" +
+                                  std::to_string(fisheye_images[i].rows) + ", expected " +
+                                  std::to_string(camera.width) + "x" + std::to_string(camera.height));
     }
   }
 }

@@ -7,27 +7,26 @@
 // in two views at the same frame carries the same id in both, and a point that leaves one view and
 // continues in the next keeps its id. The back-end keys landmarks by track_id.
 
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <utility>
+#include <vector>
+
 #include "datasets/rig.h"
 #include "vo/hybrid_projection.h"
 #include "vo/interview_matching.h"
 #include "vo/tracking.h"
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
-
-#include <cstdint>
-#include <memory>
-#include <utility>
-#include <vector>
 
 namespace rovo {
 
 struct Feature {
   uint64_t track_id = 0;
   int camera = 0;
-  Eigen::Vector2f warped_px;        // in the camera's hybrid-projection image
-  Eigen::Vector3d bearing_in_cam;   // unit, exact (from the warped pixel through the model)
-  int age = 0;                      // frames this id has been tracked in this view
+  Eigen::Vector2f warped_px;       // in the camera's hybrid-projection image
+  Eigen::Vector3d bearing_in_cam;  // unit, exact (from the warped pixel through the model)
+  int age = 0;                     // frames this id has been tracked in this view
 };
 
 struct FrontendFrame {
@@ -44,10 +43,10 @@ struct FrontendFrame {
 };
 
 struct FrontendOptions {
-  int target_features_per_view = 600;   // KLT tracks + new detections per view
-  int max_new_features_per_view = 0;    // TrackerOptions::max_new_per_frame (0: no limit)
-  float min_feature_distance_px = 12;   // between features of one view (warped pixels)
-  int fast_threshold = 12;              // FAST-9 threshold of the detector
+  int target_features_per_view = 600;  // KLT tracks + new detections per view
+  int max_new_features_per_view = 0;   // TrackerOptions::max_new_per_frame (0: no limit)
+  float min_feature_distance_px = 12;  // between features of one view (warped pixels)
+  int fast_threshold = 12;             // FAST-9 threshold of the detector
   // KLT forward-backward round-trip error. 0.3 px instead of 1: drops the tracks that slide over the
   // texture (occlusion edges, strong perspective change). Measured 2026-11-21, full size, first 300
   // frames, GTExt (with refine_matches): relative RMSE cloudy 0.026 -> 0.021 %, sunset 0.028 -> 0.025 %,
@@ -59,17 +58,17 @@ struct FrontendOptions {
   // inlier ratio +1.2..2.1 points (mean of RANSAC seeds 0-3) and reprojection error -0.011..-0.016
   // deg (seed 0) in all four; mean relative RMSE over seeds 0-3: GTExt cloudy 0.073 -> 0.053 %,
   // OnlineExt cloudy 0.107 -> 0.073 %, OnlineExt sunset 0.104 -> 0.050 %, GTExt sunset 0.090 -> 0.116 %.
-  int klt_window_px = 15;               // KLT window side (warped pixels)
-  int klt_levels = 3;                   // KLT pyramid levels above the base
-  int klt_max_iterations = 20;          // KLT iterations per pyramid level (at most)
-  float klt_epsilon_px = 0.03f;         // KLT convergence: update below this (warped pixels)
+  int klt_window_px = 15;        // KLT window side (warped pixels)
+  int klt_levels = 3;            // KLT pyramid levels above the base
+  int klt_max_iterations = 20;   // KLT iterations per pyramid level (at most)
+  float klt_epsilon_px = 0.03f;  // KLT convergence: update below this (warped pixels)
   // Forward pass from the last displacement (TrackerOptions explains). With the independent
   // backward check (tracking.h), measured 2026-11-21 on full-size datasets, first 300 frames,
   // GTExt, against a forward pass from zero flow without it: relative RMSE dynamic_urban 0.051 -> 0.046 %,
   // canyon_multifov 0.245 -> 0.071 %, cloudy_urban 0.022 -> 0.016 %, sunset_urban 0.029 -> 0.021 %;
   // inlier ratio +0.4..2.0 points.
   bool klt_predict_flow = true;
-  int klt_predicted_levels = 0;         // levels of a predicted forward pass
+  int klt_predicted_levels = 0;  // levels of a predicted forward pass
   // ORB descriptors upright (TrackerOptions::upright_descriptors): the hybrid views agree on "up", so
   // rotation invariance only adds the intensity-centroid angle's noise. `rovo study projection`, half-size
   // cloudy_urban, 100 frames: descriptor distance along tracks 76.6 -> 53.6 (frame to frame 41.7 -> 22.8),
@@ -77,9 +76,9 @@ struct FrontendOptions {
   // docs/results.md; canyon_multifov GTExt 0.050 -> 0.038 %. The start-up calibration keeps oriented descriptors
   // (its views are rotated against each other by the extrinsic errors).
   bool upright_descriptors = true;
-  HybridProjectionOptions projection;   // warp geometry (focal, extents, rebuild threshold)
-  InterviewMatchOptions matching;       // inter-view filters
-  bool match_between_views = true;      // inter-view matching on/off (ablation)
+  HybridProjectionOptions projection;  // warp geometry (focal, extents, rebuild threshold)
+  InterviewMatchOptions matching;      // inter-view filters
+  bool match_between_views = true;     // inter-view matching on/off (ablation)
   // Sub-pixel refinement of new inter-view matches (RefineMatchPositions, interview_matching.h).
   // Measured on dynamic_urban full size, first 300 frames, GTExt: relative RMSE 0.077 -> 0.070 %,
   // inlier ratio 89.4 -> 89.9 %, reprojection error 0.078 -> 0.075 deg.

@@ -2,15 +2,15 @@
 // move by one pixel per frame. Reports ms per frame by stage as counters (warp, track, detect,
 // match), wall (ms_*) and process CPU time of all threads (cpu_ms_*), and the CPU time per frame
 // (cpu_ms). Run: build/vo/rovo_vo_benchmark --benchmark_filter=Frontend
+#include <benchmark/benchmark.h>
+
+#include <ctime>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
 #include "datasets/rig.h"
 #include "vo/frontend.h"
 #include "vo/interview_matching.h"
-
-#include <benchmark/benchmark.h>
-#include <opencv2/imgproc.hpp>
-
-#include <ctime>
-#include <vector>
 
 namespace rovo {
 namespace {
@@ -22,7 +22,8 @@ cv::Mat Texture(int width, int height, uint64_t seed) {
   cv::GaussianBlur(image, image, cv::Size(0, 0), 2.0);
   cv::normalize(image, image, 0, 255, cv::NORM_MINMAX);
   for (int k = 0; k < 3000; ++k) {
-    cv::rectangle(image, cv::Rect(rng.uniform(0, width), rng.uniform(0, height), rng.uniform(8, 50), rng.uniform(8, 50)),
+    cv::rectangle(image,
+                  cv::Rect(rng.uniform(0, width), rng.uniform(0, height), rng.uniform(8, 50), rng.uniform(8, 50)),
                   cv::Scalar(rng.uniform(0, 255)), cv::FILLED);
   }
   return image;

@@ -1,12 +1,12 @@
 #include "vo/hybrid_projection.h"
 
-#include <Eigen/SVD>
-#include <opencv2/imgproc.hpp>
 #include <tbb/parallel_for.h>
 
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <string>
 
@@ -99,15 +99,14 @@ std::vector<HybridLayout> ComputeHybridLayouts(const std::vector<Camera>& camera
     const Eigen::Vector3d right = forward.cross(up);
     layout.up_in_rig = up;
     layout.forward_in_rig = forward;
-    layout.left_normal_in_rig =
-        PlaneNormal(centres[layout.left_neighbour] - centres[i], up, forward, right, -1.0, i);
-    layout.right_normal_in_rig =
-        PlaneNormal(centres[layout.right_neighbour] - centres[i], up, forward, right, +1.0, i);
+    layout.left_normal_in_rig = PlaneNormal(centres[layout.left_neighbour] - centres[i], up, forward, right, -1.0, i);
+    layout.right_normal_in_rig = PlaneNormal(centres[layout.right_neighbour] - centres[i], up, forward, right, +1.0, i);
     const double psi_left = SignedAngle(layout.left_normal_in_rig, forward, right);
     const double psi_right = SignedAngle(layout.right_normal_in_rig, forward, right);
     if (psi_left > psi_right + 1e-9) {
-      throw std::invalid_argument("hybrid projection: camera " + std::to_string(i) +
-                                  ": left plane lies to the right of the right plane (rig not arranged around a centre)");
+      throw std::invalid_argument(
+          "hybrid projection: camera " + std::to_string(i) +
+          ": left plane lies to the right of the right plane (rig not arranged around a centre)");
     }
   }
   return layouts;
@@ -331,8 +330,8 @@ void HybridProjection::BuildMaps() {
 void HybridProjection::Warp(const cv::Mat& fisheye, cv::Mat* warped) const {
   if (fisheye.cols != camera_.width || fisheye.rows != camera_.height) {
     throw std::invalid_argument("hybrid projection: image is " + std::to_string(fisheye.cols) + "x" +
-                                std::to_string(fisheye.rows) + ", camera is " + std::to_string(camera_.width) +
-                                "x" + std::to_string(camera_.height));
+                                std::to_string(fisheye.rows) + ", camera is " + std::to_string(camera_.width) + "x" +
+                                std::to_string(camera_.height));
   }
   cv::remap(fisheye, *warped, map_fixed_, map_frac_, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
 }

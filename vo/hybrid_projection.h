@@ -41,31 +41,30 @@
 // tracked features are then carried over exactly through their bearings:
 // new.WarpedFromBearing(old.BearingFromWarped(px)).
 
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
+
 #include "datasets/camera.h"
 #include "datasets/rig.h"
 #include "datasets/rigid3.h"
 
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
-
-#include <optional>
-#include <vector>
-
 namespace rovo {
 
 struct HybridProjectionOptions {
-  double focal_px = 0.0;               // warped focal length; 0 = automatic (see above)
-  double focal_scale = 1.0;            // multiplies the automatic focal length
-  double max_plane_angle_deg = 65.0;   // each plane spans at most this far beyond its tangent point
+  double focal_px = 0.0;                 // warped focal length; 0 = automatic (see above)
+  double focal_scale = 1.0;              // multiplies the automatic focal length
+  double max_plane_angle_deg = 65.0;     // each plane spans at most this far beyond its tangent point
   double vertical_fov_above_deg = 50.0;  // the warp reaches this far above the rig plane
   double vertical_fov_below_deg = 50.0;  // and this far below it
-  double rebuild_threshold_deg = 1.0;  // see "Online extrinsics" above
+  double rebuild_threshold_deg = 1.0;    // see "Online extrinsics" above
 };
 
 // The rig-level layout of one camera's hybrid projection, in the RIG frame.
 struct HybridLayout {
-  Eigen::Vector3d up_in_rig;       // rig-plane normal
-  Eigen::Vector3d forward_in_rig;  // unit, orthogonal to up (psi = 0)
+  Eigen::Vector3d up_in_rig;                                // rig-plane normal
+  Eigen::Vector3d forward_in_rig;                           // unit, orthogonal to up (psi = 0)
   Eigen::Vector3d left_normal_in_rig, right_normal_in_rig;  // plane normals m_L, m_R
   int left_neighbour = -1, right_neighbour = -1;
 };
@@ -149,13 +148,13 @@ class HybridProjection {
   HybridProjectionOptions options_;
   // Virtual frame in the camera frame.
   Eigen::Matrix3d rig_from_cam_rotation_ = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d up_, forward_, right_;           // right = forward x up
-  Eigen::Vector3d normal_left_, normal_right_;     // plane normals m_L, m_R
-  Eigen::Vector3d tangent_left_, tangent_right_;   // in-plane horizontal axes (m x up)
+  Eigen::Vector3d up_, forward_, right_;          // right = forward x up
+  Eigen::Vector3d normal_left_, normal_right_;    // plane normals m_L, m_R
+  Eigen::Vector3d tangent_left_, tangent_right_;  // in-plane horizontal axes (m x up)
   double psi_left_ = 0, psi_right_ = 0;
   double focal_ = 0, cx_ = 0, cy_ = 0;
   int width_ = 0, height_ = 0;
-  cv::Mat map_x_, map_y_;      // CV_32FC1
+  cv::Mat map_x_, map_y_;         // CV_32FC1
   cv::Mat map_fixed_, map_frac_;  // CV_16SC2 + CV_16UC1 (cv::convertMaps)
   cv::Mat valid_mask_;
 };

@@ -1,11 +1,11 @@
 #include "vo/image_loader.h"
 
-#include "datasets/dataset.h"
-
-#include <opencv2/imgcodecs.hpp>
 #include <tbb/parallel_for.h>
 
+#include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
+
+#include "datasets/dataset.h"
 
 namespace rovo {
 
@@ -24,8 +24,8 @@ LoadedFrame LoadFrameImages(const std::string& dataset_dir, const Rig& rig, int 
       image = cv::Mat::zeros(cam.camera.height, cam.camera.width, CV_8UC1);
     } else if (image.cols != cam.camera.width || image.rows != cam.camera.height) {
       wrong_size[j] = path + ": image is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
-                      " but dataset.json rig.cameras[" + cam.name + "] says " + std::to_string(cam.camera.width) +
-                      "x" + std::to_string(cam.camera.height);
+                      " but dataset.json rig.cameras[" + cam.name + "] says " + std::to_string(cam.camera.width) + "x" +
+                      std::to_string(cam.camera.height);
     }
   });
   for (int j = 0; j < n; ++j) {
@@ -43,11 +43,12 @@ std::vector<cv::Mat> LoadStaticMasks(const std::string& dataset_dir, const Rig& 
   for (const RigCamera& cam : rig.cameras) {
     const std::string path = StaticMaskPath(dataset_dir, cam.name);
     cv::Mat mask = cv::imread(path, cv::IMREAD_GRAYSCALE);
-    if (mask.empty()) throw std::runtime_error(path + ": static mask missing or unreadable (dataset.json has_static_masks)");
+    if (mask.empty())
+      throw std::runtime_error(path + ": static mask missing or unreadable (dataset.json has_static_masks)");
     if (mask.cols != cam.camera.width || mask.rows != cam.camera.height) {
-      throw std::runtime_error(path + ": static mask is " + std::to_string(mask.cols) + "x" + std::to_string(mask.rows) +
-                               " but camera " + cam.name + " is " + std::to_string(cam.camera.width) + "x" +
-                               std::to_string(cam.camera.height));
+      throw std::runtime_error(path + ": static mask is " + std::to_string(mask.cols) + "x" +
+                               std::to_string(mask.rows) + " but camera " + cam.name + " is " +
+                               std::to_string(cam.camera.width) + "x" + std::to_string(cam.camera.height));
     }
     masks.push_back(mask);
   }

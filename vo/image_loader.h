@@ -2,13 +2,12 @@
 // Reading a dataset frame's images for the VO: one decoder call per view, in parallel, and a
 // prefetcher that decodes frame f + 1 on a second thread while frame f is processed.
 
-#include "datasets/rig.h"
-
-#include <opencv2/core.hpp>
-
 #include <future>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
+
+#include "datasets/rig.h"
 
 namespace rovo {
 

@@ -1,12 +1,11 @@
 #include "vo/interview_matching.h"
 
-#include <opencv2/core/hal/intrin.hpp>
-#include <opencv2/imgproc.hpp>
-#include <opencv2/video/tracking.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <opencv2/core/hal/intrin.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
 #include <stdexcept>
 
 namespace rovo {
@@ -34,8 +33,8 @@ std::optional<Eigen::Vector2d> ClosestRayParameters(const Eigen::Vector3d& centr
   return Eigen::Vector2d((p - c * q) / denominator, (c * p - q) / denominator);
 }
 
-bool PositiveDisparity(const Eigen::Vector3d& centre_a, const Eigen::Vector3d& bearing_a, const Eigen::Vector3d& centre_b,
-                       const Eigen::Vector3d& bearing_b) {
+bool PositiveDisparity(const Eigen::Vector3d& centre_a, const Eigen::Vector3d& bearing_a,
+                       const Eigen::Vector3d& centre_b, const Eigen::Vector3d& bearing_b) {
   const auto lambdas = ClosestRayParameters(centre_a, bearing_a, centre_b, bearing_b);
   return lambdas && lambdas->x() > 0 && lambdas->y() > 0;
 }
@@ -133,7 +132,8 @@ bool LoadReference(const cv::Mat& image, const Eigen::Vector2d& p, int side, Ref
 
 // ZNCC of the reference with the patch around the nearest pixel of p in `image`; nullopt when that
 // patch leaves the image or is flat.
-std::optional<double> ZnccWithReference(const ReferencePatch& reference, const cv::Mat& image, const Eigen::Vector2d& p) {
+std::optional<double> ZnccWithReference(const ReferencePatch& reference, const cv::Mat& image,
+                                        const Eigen::Vector2d& p) {
   const int side = reference.side;
   int x0, y0;
   if (!PatchCorner(image, p, side, &x0, &y0)) return std::nullopt;
@@ -143,9 +143,9 @@ std::optional<double> ZnccWithReference(const ReferencePatch& reference, const c
     // One 16-byte load per row, the bytes beyond `side` masked to zero (the reference's padding is
     // zero too): the same integer sums as the scalar loop below. Per lane at most 16 rows * 4 * 255^2
     // < 2^31 (products) and 16 rows * 2 * 255 < 2^16 (sums).
-    static const uint8_t kMask[2 * kSimdSide] = {255, 255, 255, 255, 255, 255, 255, 255, 255, 255, 255,
-                                                 255, 255, 255, 255, 255};  // then 16 zeros
-    const cv::v_uint8x16 keep = cv::v_load(kMask + kSimdSide - side);  // `side` bytes 255, then 0
+    static const uint8_t kMask[2 * kSimdSide] = {255, 255, 255, 255, 255, 255, 255, 255,
+                                                 255, 255, 255, 255, 255, 255, 255, 255};  // then 16 zeros
+    const cv::v_uint8x16 keep = cv::v_load(kMask + kSimdSide - side);                      // `side` bytes 255, then 0
     cv::v_int32x4 ab4 = cv::v_setzero_s32(), bb4 = cv::v_setzero_s32();
     cv::v_uint16x8 sum8 = cv::v_setzero_u16();
     const int16_t* a = reference.padded.data();
@@ -190,7 +190,8 @@ std::vector<std::optional<double>> ZnccAtPixels(const cv::Mat& image_a, cv::Poin
   std::vector<std::optional<double>> zncc(b.size());
   ReferencePatch reference;
   if (!LoadReference(image_a, Eigen::Vector2d(a.x, a.y), patch_px, &reference)) return zncc;
-  for (size_t k = 0; k < b.size(); ++k) zncc[k] = ZnccWithReference(reference, image_b, Eigen::Vector2d(b[k].x, b[k].y));
+  for (size_t k = 0; k < b.size(); ++k)
+    zncc[k] = ZnccWithReference(reference, image_b, Eigen::Vector2d(b[k].x, b[k].y));
   return zncc;
 }
 
@@ -216,7 +217,8 @@ bool UniqueAlongEpipolarCurve(const cv::Mat& patch_image, cv::Point2f patch_cent
   // Directions every pixel (1 / f rad) along the curve; pixels exact every kKnot steps, linear between.
   constexpr int kKnot = 4;
   const double step = 1.0 / focal_px;
-  const int half_steps = static_cast<int>(std::ceil(options.uniqueness_range_deg * M_PI / 180.0 / step / kKnot)) * kKnot;
+  const int half_steps =
+      static_cast<int>(std::ceil(options.uniqueness_range_deg * M_PI / 180.0 / step / kKnot)) * kKnot;
   const int count = 2 * half_steps + 1;
   const auto direction = [&](int k) {
     const double angle = (k - half_steps) * step;
@@ -225,7 +227,8 @@ bool UniqueAlongEpipolarCurve(const cv::Mat& patch_image, cv::Point2f patch_cent
   std::vector<std::optional<Eigen::Vector2d>> knots(count / kKnot + 1);
   for (int k = 0; k < count; k += kKnot) {
     const Eigen::Vector3d d = direction(k);
-    if (PositiveDisparity(centre_fixed, bearing_fixed, centre_moving, d)) knots[k / kKnot] = view.pixel_from_direction_in_rig(d);
+    if (PositiveDisparity(centre_fixed, bearing_fixed, centre_moving, d))
+      knots[k / kKnot] = view.pixel_from_direction_in_rig(d);
   }
   const float nan = std::numeric_limits<float>::quiet_NaN();
   std::vector<float> score(count, nan), distance(count, nan);
@@ -271,7 +274,8 @@ bool UniqueAlongEpipolarCurve(const cv::Mat& patch_image, cv::Point2f patch_cent
     if (score[k] >= limit - 0.3 && distance[k] > options.uniqueness_exclusion_px + 1.5) {
       const int knot = k / kKnot;
       const double t = static_cast<double>(k % kKnot) / kKnot;
-      const Eigen::Vector2d px = t == 0.0 ? *knots[knot] : Eigen::Vector2d((1.0 - t) * *knots[knot] + t * *knots[knot + 1]);
+      const Eigen::Vector2d px =
+          t == 0.0 ? *knots[knot] : Eigen::Vector2d((1.0 - t) * *knots[knot] + t * *knots[knot + 1]);
       if (refined(px) >= limit) return false;
     }
   }
@@ -350,7 +354,8 @@ std::vector<InterviewMatch> MatchViews(const PairGeometry& pair, const MatchView
         continue;
       }
       if (options.use_positive_disparity &&
-          !PositiveDisparity(a.centre_in_rig, a.bearings_in_rig[i], b.centre_in_rig, b.bearings_in_rig[j])) continue;
+          !PositiveDisparity(a.centre_in_rig, a.bearings_in_rig[i], b.centre_in_rig, b.bearings_in_rig[j]))
+        continue;
       best_a[i].Offer(j, distance);
       best_b[j].Offer(i, distance);
     }

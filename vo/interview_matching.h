@@ -31,15 +31,14 @@
 //                    that exclusion radius and the 3x3 pixels of the match. The same scan runs in the
 //                    other direction (b's patch along a's curve). Needs pixel_from_direction_in_rig.
 
-#include "datasets/rigid3.h"
-#include "vo/tracking.h"
-
 #include <Eigen/Core>
-#include <opencv2/core.hpp>
-
 #include <functional>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <vector>
+
+#include "datasets/rigid3.h"
+#include "vo/tracking.h"
 
 namespace rovo {
 
@@ -49,13 +48,13 @@ struct InterviewMatchOptions {
   double max_orientation_diff_deg = 30.0;
   double max_epipolar_angle_deg = 0.5;
   double min_zncc = 0.7;
-  int zncc_patch_px = 11;       // odd side of the ZNCC patch
-  double max_ratio = 0.9;       // best / second-best descriptor distance (1 = off)
-  double uniqueness_range_deg = 20.0;   // filter 8: scan half-range along the epipolar curve
-  double uniqueness_margin = 0.02;      // filter 8: rival peak must stay below z0 - margin
-  double uniqueness_exclusion_px = 4.0; // filter 8: peaks this close to the match are the match
-  bool use_zncc = true;         // ablation switches (the projection study turns filters off)
-  bool use_uniqueness = true;   // filter 8 (needs use_zncc and pixel_from_direction_in_rig)
+  int zncc_patch_px = 11;                // odd side of the ZNCC patch
+  double max_ratio = 0.9;                // best / second-best descriptor distance (1 = off)
+  double uniqueness_range_deg = 20.0;    // filter 8: scan half-range along the epipolar curve
+  double uniqueness_margin = 0.02;       // filter 8: rival peak must stay below z0 - margin
+  double uniqueness_exclusion_px = 4.0;  // filter 8: peaks this close to the match are the match
+  bool use_zncc = true;                  // ablation switches (the projection study turns filters off)
+  bool use_uniqueness = true;            // filter 8 (needs use_zncc and pixel_from_direction_in_rig)
   bool use_y_distance = true;
   bool use_mutual = true;
   bool use_positive_disparity = true;
@@ -94,8 +93,8 @@ double EpipolarAngle(const Eigen::Vector3d& centre_a, const Eigen::Vector3d& bea
 // nullopt for (nearly) parallel rays.
 std::optional<Eigen::Vector2d> ClosestRayParameters(const Eigen::Vector3d& centre_a, const Eigen::Vector3d& bearing_a,
                                                     const Eigen::Vector3d& centre_b, const Eigen::Vector3d& bearing_b);
-bool PositiveDisparity(const Eigen::Vector3d& centre_a, const Eigen::Vector3d& bearing_a, const Eigen::Vector3d& centre_b,
-                       const Eigen::Vector3d& bearing_b);
+bool PositiveDisparity(const Eigen::Vector3d& centre_a, const Eigen::Vector3d& bearing_a,
+                       const Eigen::Vector3d& centre_b, const Eigen::Vector3d& bearing_b);
 
 // Rectified-like y of a direction for a plane normal m: -(d . up) / (d . m); nullopt when d . m <= 0.
 std::optional<double> RectifiedY(const Eigen::Vector3d& bearing, const Eigen::Vector3d& up, const Eigen::Vector3d& m);
@@ -133,7 +132,7 @@ std::vector<InterviewMatch> MatchViews(const PairGeometry& pair, const MatchView
 // max_round_trip_px of from[k]; nullopt otherwise, also near an image border (the caller keeps the
 // detection). 8-bit gray images, of any sizes.
 struct SubpixelMatchOptions {
-  int window_px = 15;              // KLT window side
+  int window_px = 15;  // KLT window side
   int max_iterations = 30;
   double epsilon_px = 0.01;
   double max_shift_px = 2.0;

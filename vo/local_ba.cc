@@ -292,10 +292,9 @@ void AddExtrinsicPriors(const LocalBaProblem& problem, const LocalBaOptions& opt
     for (int j = 1; j < num_cams; ++j) {
       if (!cam_used[j]) continue;
       ceres_problem->AddResidualBlock(
-          ExtrinsicPriorCost::Create(options.extrinsic_anchor[j],
-                                     options.extrinsic_anchor_deg * M_PI / 180.0 / options.observation_sigma_rad,
-                                     (options.extrinsic_anchor_m > 0.0 ? options.extrinsic_anchor_m : 1.0) /
-                                         options.observation_sigma_rad),
+          ExtrinsicPriorCost::Create(
+              options.extrinsic_anchor[j], options.extrinsic_anchor_deg * M_PI / 180.0 / options.observation_sigma_rad,
+              (options.extrinsic_anchor_m > 0.0 ? options.extrinsic_anchor_m : 1.0) / options.observation_sigma_rad),
           nullptr, cams[j].data());
     }
   }
@@ -334,8 +333,8 @@ LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& option
   const auto camera_free = [&](int j) { return options.optimize_extrinsics && j != 0; };
   std::vector<char> pose_used(num_poses, 0), cam_used(num_cams, 0), point_used(problem.points_in_world.size(), 0);
   for (const LocalBaObservation& o : problem.observations) {
-    const bool multi =
-        o.point_index < static_cast<int>(problem.point_num_cameras.size()) && problem.point_num_cameras[o.point_index] >= 2;
+    const bool multi = o.point_index < static_cast<int>(problem.point_num_cameras.size()) &&
+                       problem.point_num_cameras[o.point_index] >= 2;
     ceres::LossFunction* loss = multi ? &loss_multi : &loss_single;
     double* point = problem.points_in_world[o.point_index].data();
     if (camera_free(o.camera)) {

@@ -16,13 +16,13 @@
 // Gauge: the oldest rig pose (index 0) is fixed; camera 0's cam_from_rig is fixed (rig.h).
 // Parametrisation: one 6-vector block per pose and extrinsic, (angle-axis in radians, translation);
 // Ceres DENSE_SCHUR with landmarks eliminated first (its <2, 3, 6> specialisation). Bounded time:
-// max_iterations (and an optional wall-time limit, which trades determinism for latency). Deterministic for a fixed input with num_threads = 1.
-
-#include "datasets/rigid3.h"
+// max_iterations (and an optional wall-time limit, which trades determinism for latency). Deterministic for a fixed
+// input with num_threads = 1.
 
 #include <Eigen/Core>
-
 #include <vector>
+
+#include "datasets/rigid3.h"
 
 namespace ceres {
 class CostFunction;
@@ -51,7 +51,7 @@ struct LocalBaOptions {
   // bearing noise so that both terms are in units of standard deviations.
   double observation_sigma_rad = 0.001;
   int max_iterations = 10;
-  double max_time_s = 0.0;           // 0: no wall-time limit (deterministic)
+  double max_time_s = 0.0;  // 0: no wall-time limit (deterministic)
   int num_threads = 1;
   void Check() const;
 };
@@ -64,12 +64,12 @@ struct LocalBaObservation {
 };
 
 struct LocalBaProblem {
-  std::vector<Rigid3> rig_from_world;          // window poses, [0] = oldest (fixed)
-  std::vector<Rigid3> cam_from_rig;            // [0] fixed
+  std::vector<Rigid3> rig_from_world;  // window poses, [0] = oldest (fixed)
+  std::vector<Rigid3> cam_from_rig;    // [0] fixed
   std::vector<Eigen::Vector3d> points_in_world;
-  std::vector<int> point_num_cameras;          // distinct cameras per point (weights)
+  std::vector<int> point_num_cameras;  // distinct cameras per point (weights)
   std::vector<LocalBaObservation> observations;
-  std::vector<double> baseline_lengths;        // L0 of ring pair (j, j+1 mod N); empty = from cam_from_rig
+  std::vector<double> baseline_lengths;  // L0 of ring pair (j, j+1 mod N); empty = from cam_from_rig
 };
 
 struct LocalBaReport {

@@ -92,9 +92,9 @@ void LandmarkMap::Cull(int min_last_seen_frame, int min_observation_frame) {
       continue;
     }
     auto& obs = it->second.observations;
-    obs.erase(std::remove_if(obs.begin(), obs.end(),
-                             [&](const Observation& o) { return o.frame < min_observation_frame; }),
-              obs.end());
+    obs.erase(
+        std::remove_if(obs.begin(), obs.end(), [&](const Observation& o) { return o.frame < min_observation_frame; }),
+        obs.end());
     ++it;
   }
 }

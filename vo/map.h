@@ -11,7 +11,6 @@
 // window; outlier points are removed by the pipeline.
 
 #include <Eigen/Core>
-
 #include <cstdint>
 #include <map>
 #include <vector>
@@ -31,8 +30,8 @@ struct Landmark {
   std::vector<Observation> observations;  // in insertion (frame) order
   int first_seen_frame = 0;
   int last_seen_frame = 0;
-  int triangulated_frame = -1;            // frame at which point_in_world was (re)computed
-  int outlier_count = 0;                  // consecutive frames rejected by the RANSAC
+  int triangulated_frame = -1;  // frame at which point_in_world was (re)computed
+  int outlier_count = 0;        // consecutive frames rejected by the RANSAC
 
   // Number of distinct cameras among the observations.
   int NumCameras() const;
@@ -67,10 +66,10 @@ class LandmarkMap {
 
 // Keyframe policy: a frame becomes a keyframe when any of these holds since the last keyframe.
 struct KeyframeOptions {
-  int max_frame_gap = 5;               // frames
-  double min_translation_m = 1.0;      // rig travel
-  double min_rotation_deg = 10.0;      // rig rotation
-  double min_tracked_fraction = 0.6;   // landmarks of the last keyframe still observed
+  int max_frame_gap = 5;              // frames
+  double min_translation_m = 1.0;     // rig travel
+  double min_rotation_deg = 10.0;     // rig rotation
+  double min_tracked_fraction = 0.6;  // landmarks of the last keyframe still observed
   void Check() const;
 };
 

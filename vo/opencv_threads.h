@@ -7,9 +7,8 @@
 // already run in parallel under TBB, and OpenCV's nested loops only added task overhead (measured: 4 x
 // 5 remaps on 2 threads took ~20 % more wall and CPU time than with OpenCV serial inside each view).
 
-#include <opencv2/core.hpp>
-
 #include <mutex>
+#include <opencv2/core.hpp>
 
 namespace rovo {
 

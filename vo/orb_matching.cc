@@ -27,7 +27,8 @@ struct TopTwo {
 using OrbWords = std::array<uint64_t, 4>;  // one 256-bit ORB descriptor
 
 std::vector<OrbWords> DescriptorWords(const cv::Mat& desc) {
-  if (desc.type() != CV_8U || desc.cols != 32) throw std::invalid_argument("MutualRatioOrbMatches: descriptors must be 32-byte CV_8U rows");
+  if (desc.type() != CV_8U || desc.cols != 32)
+    throw std::invalid_argument("MutualRatioOrbMatches: descriptors must be 32-byte CV_8U rows");
   std::vector<OrbWords> out(desc.rows);
   for (int i = 0; i < desc.rows; ++i) std::memcpy(out[i].data(), desc.ptr<uint8_t>(i), 32);
   return out;

@@ -8,7 +8,6 @@
 // (orb_matching_benchmark.cc). Results are the same except where two candidates tie at distance 0.
 
 #include <opencv2/core.hpp>
-
 #include <utility>
 #include <vector>
 

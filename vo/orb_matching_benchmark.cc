@@ -1,10 +1,11 @@
 // MutualRatioOrbMatches against the two cv::BFMatcher::knnMatch calls it replaces (the reference, in
 // the same run), on 6000 x 6000 descriptors as in the start-up calibration's later passes.
 // Run: build/vo/rovo_vo_benchmark --benchmark_filter=OrbMatch
-#include "vo/orb_matching.h"
-
 #include <benchmark/benchmark.h>
+
 #include <opencv2/features2d.hpp>
+
+#include "vo/orb_matching.h"
 
 namespace rovo {
 namespace {

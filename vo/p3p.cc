@@ -2,7 +2,6 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
-
 #include <algorithm>
 #include <cmath>
 #include <optional>

@@ -23,12 +23,11 @@
 // Assumptions: the three world points are not collinear, the three bearings are distinct. Returns
 // up to 4 solutions (0 for degenerate input), each with lambda_i > 0.
 
-#include "datasets/rigid3.h"
-
 #include <Eigen/Core>
-
 #include <array>
 #include <vector>
+
+#include "datasets/rigid3.h"
 
 namespace rovo {
 

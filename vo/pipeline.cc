@@ -1,13 +1,5 @@
 #include "vo/pipeline.h"
 
-#include "datasets/dataset.h"
-#include "datasets/io.h"
-#include "datasets/lens_angle_scale.h"
-#include "datasets/progress.h"
-#include "vo/image_loader.h"
-#include "vo/startup_calibration.h"
-#include "rovo/version.h"
-
 #include <tbb/global_control.h>
 
 #include <algorithm>
@@ -20,6 +12,14 @@
 #include <string>
 #include <vector>
 
+#include "datasets/dataset.h"
+#include "datasets/io.h"
+#include "datasets/lens_angle_scale.h"
+#include "datasets/progress.h"
+#include "rovo/version.h"
+#include "vo/image_loader.h"
+#include "vo/startup_calibration.h"
+
 namespace rovo {
 
 ExtrinsicsMode ExtrinsicsModeFromName(const std::string& name) {
@@ -31,9 +31,12 @@ ExtrinsicsMode ExtrinsicsModeFromName(const std::string& name) {
 
 std::string ExtrinsicsModeName(ExtrinsicsMode mode) {
   switch (mode) {
-    case ExtrinsicsMode::kGroundTruth: return "gt";
-    case ExtrinsicsMode::kNoisy: return "noisy";
-    case ExtrinsicsMode::kOnline: return "online";
+    case ExtrinsicsMode::kGroundTruth:
+      return "gt";
+    case ExtrinsicsMode::kNoisy:
+      return "noisy";
+    case ExtrinsicsMode::kOnline:
+      return "online";
   }
   return "gt";
 }
@@ -155,9 +158,9 @@ Rig LensesForVo(const VoOptions& options, const Rig& rig, const StartupCalibrati
 // Sums of per-frame stage times -> means per frame.
 void AverageStageTimes(int frames, int total_hypotheses, VoStageTimes* ms) {
   const double n = std::max(1, frames);
-  for (double* v : {&ms->warp, &ms->detect, &ms->track, &ms->match, &ms->cpu_warp, &ms->cpu_detect, &ms->cpu_track,
-                    &ms->cpu_match, &ms->load, &ms->ransac, &ms->refine, &ms->triangulate, &ms->ba, &ms->ba_wait,
-                    &ms->backend_total, &ms->total}) {
+  for (double* v :
+       {&ms->warp, &ms->detect, &ms->track, &ms->match, &ms->cpu_warp, &ms->cpu_detect, &ms->cpu_track, &ms->cpu_match,
+        &ms->load, &ms->ransac, &ms->refine, &ms->triangulate, &ms->ba, &ms->ba_wait, &ms->backend_total, &ms->total}) {
     *v /= n;
   }
   ms->ransac_us_per_hypothesis = total_hypotheses > 0 ? ms->ransac * n * 1000.0 / total_hypotheses : 0.0;

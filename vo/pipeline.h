@@ -7,10 +7,10 @@
 // ahead on a second thread) -> Frontend (frontend.h) -> VoBackend (backend.h), starting at the
 // ground-truth first pose (identity without ground truth); the run folder is written at the end.
 
-#include "vo/backend.h"
-
 #include <cstdint>
 #include <string>
+
+#include "vo/backend.h"
 
 namespace rovo {
 
@@ -21,19 +21,19 @@ std::string ExtrinsicsModeName(ExtrinsicsMode mode);
 
 struct VoOptions {
   std::string dataset_dir;
-  std::string out_dir;             // run folder
+  std::string out_dir;  // run folder
   ExtrinsicsMode mode = ExtrinsicsMode::kGroundTruth;
-  int noise_set = 0;               // which perturbed set of dataset.json (noisy/online)
+  int noise_set = 0;  // which perturbed set of dataset.json (noisy/online)
   // A fresh perturbation draw instead of a stored set (noisy/online): when draw_seed >= 0 the starting
   // extrinsics are PerturbExtrinsics(ground-truth rig, draw_sigma_deg, 0, draw_seed) (datasets/rig.h),
   // the paper's protocol (roll, pitch, yaw of every camera, camera 0 included; centres kept).
   int64_t draw_seed = -1;
   double draw_sigma_deg = 5.0;
-  uint64_t seed = 0;               // RANSAC seed
-  int threads = 0;                 // 0 = all cores
+  uint64_t seed = 0;  // RANSAC seed
+  int threads = 0;    // 0 = all cores
   int frame_begin = 0;
-  int frame_end = -1;              // -1 = to the end
-  std::string sampling = "pps";    // "pps" | "uniform" (ablation)
+  int frame_end = -1;                // -1 = to the end
+  std::string sampling = "pps";      // "pps" | "uniform" (ablation)
   std::string ransac = "multiview";  // "multiview" | "single-view" (ablation)
   bool quiet = false;
   // OnlineExt: a bound on the starting extrinsics' rotation error between cameras (degrees). It
@@ -64,8 +64,8 @@ struct VoOptions {
   // 82 -> 49 %, back to 78 % with BackendOptions::online_settle_frames).
   double ransac_tau_deg = 0.2;
   // Back-end settings exposed on the command line; <= 0 keeps BackendOptions' default.
-  double keyframe_distance_m = 0.0;      // KeyframeOptions::min_translation_m
-  int online_settle_frames = -1;         // BackendOptions::online_settle_frames (< 0: its default)
+  double keyframe_distance_m = 0.0;  // KeyframeOptions::min_translation_m
+  int online_settle_frames = -1;     // BackendOptions::online_settle_frames (< 0: its default)
   // FrontendOptions::max_new_features_per_view (0: no limit). 150 saves about a fifth of the front-end's
   // CPU (206 -> 162 CPU-ms per full-size frame) at some accuracy: measured 2026-11-22 on whole
   // sequences, OnlineExt relative RMSE worse on all five presets (mean 0.018 -> 0.024 %), GTExt 3 better
@@ -79,20 +79,20 @@ struct VoOptions {
   // full-size front-end about 18 % cheaper with neutral accuracy over 300 frames, but at the quick
   // forms' half size those features track and matter (quick cloudy_urban OnlineExt 0.052 -> 0.086 %).
   double warp_below_deg = 50.0;
-  bool async_ba = true;                  // BackendOptions::async_ba (same trajectory in GTExt/NoisyExt)
-  bool preload_images = false;           // decode all frames before the loop (timing without PNG decoding)
+  bool async_ba = true;         // BackendOptions::async_ba (same trajectory in GTExt/NoisyExt)
+  bool preload_images = false;  // decode all frames before the loop (timing without PNG decoding)
 };
 
 // Mean wall time per processed frame, by stage, in milliseconds.
 struct VoStageTimes {
-  double warp = 0, detect = 0, track = 0, match = 0;  // front-end (FrontendFrame::ms_*)
+  double warp = 0, detect = 0, track = 0, match = 0;                  // front-end (FrontendFrame::ms_*)
   double cpu_warp = 0, cpu_detect = 0, cpu_track = 0, cpu_match = 0;  // front-end CPU, all threads (cpu_ms_*)
   double load = 0;  // waiting for the images (read on a second thread while the previous frame runs)
   double ransac = 0, refine = 0, triangulate = 0, backend_total = 0;
   double ba = 0;       // keyframe BA solve (on its own thread with async BA)
   double ba_wait = 0;  // time the pipeline waited for an async BA to finish
   double ransac_us_per_hypothesis = 0;
-  double total = 0;                                     // whole frame incl. loading
+  double total = 0;  // whole frame incl. loading
 };
 
 struct VoSummary {
@@ -101,11 +101,11 @@ struct VoSummary {
   int frames_lost = 0;
   double seconds = 0.0;
   int frames_init = 0;
-  int frames_with_missing_images = 0;    // frames where some camera's image was missing or unreadable
-  int missing_images = 0;                // (frame, camera) images missing or unreadable
-  double mean_inlier_ratio = 0.0;        // over "ok" frames
-  double mean_reproj_error_deg = 0.0;    // over "ok" frames
-  double lens_angle_scale = 1.0;         // applied to the dataset's lenses (VoOptions::online_apply_lens_scale)
+  int frames_with_missing_images = 0;  // frames where some camera's image was missing or unreadable
+  int missing_images = 0;              // (frame, camera) images missing or unreadable
+  double mean_inlier_ratio = 0.0;      // over "ok" frames
+  double mean_reproj_error_deg = 0.0;  // over "ok" frames
+  double lens_angle_scale = 1.0;       // applied to the dataset's lenses (VoOptions::online_apply_lens_scale)
   VoStageTimes stage_ms;
 };
 

@@ -13,7 +13,9 @@ namespace {
 struct FixedPointBearingCost {
   FixedPointBearingCost(const Eigen::Vector3d& bearing_in_cam, const Eigen::Vector3d& point_in_world,
                         const Rigid3& cam_from_rig)
-      : bearing(bearing_in_cam), point(point_in_world), cam_rotation(cam_from_rig.RotationMatrix()),
+      : bearing(bearing_in_cam),
+        point(point_in_world),
+        cam_rotation(cam_from_rig.RotationMatrix()),
         cam_translation(cam_from_rig.translation) {}
 
   template <typename T>

@@ -7,10 +7,10 @@
 // Parametrisation: rig_from_world as angle-axis (radians) + translation, solved by Ceres
 // (Levenberg-Marquardt, dense QR over 6 unknowns). Ceres runs single-threaded here: deterministic.
 
+#include <vector>
+
 #include "datasets/rigid3.h"
 #include "vo/ransac.h"
-
-#include <vector>
 
 namespace rovo {
 
@@ -25,7 +25,7 @@ struct PoseRefinementResult {
   int num_residuals = 0;
   double initial_cost = 0.0;  // Ceres cost (robustified)
   double final_cost = 0.0;
-  bool usable = false;        // Ceres reported a usable solution
+  bool usable = false;  // Ceres reported a usable solution
 };
 
 // inliers[j][i] selects camera j's correspondence i (same shape as correspondences); an empty

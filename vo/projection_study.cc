@@ -1,5 +1,24 @@
 #include "vo/projection_study.h"
 
+#include <OpenImageIO/imageio.h>
+#include <tbb/parallel_for.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <unordered_map>
+
 #include "datasets/cli_groups.h"
 #include "datasets/dataset.h"
 #include "datasets/io.h"
@@ -9,25 +28,6 @@
 #include "vo/hybrid_projection.h"
 #include "vo/interview_matching.h"
 #include "vo/tracking.h"
-
-#include <CLI/CLI.hpp>
-#include <OpenImageIO/imageio.h>
-#include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
-#include <tbb/parallel_for.h>
-
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <functional>
-#include <limits>
-#include <memory>
-#include <optional>
-#include <set>
-#include <sstream>
-#include <stdexcept>
-#include <unordered_map>
 
 namespace rovo {
 namespace {
@@ -67,9 +67,9 @@ float DepthAt(const cv::Mat& depth, const Eigen::Vector2d& px) {
 
 }  // namespace
 
-int GroundTruthMatchVerdict(const Rig& rig, int camera_a, const Eigen::Vector3d& bearing_a, const Eigen::Vector2d& fisheye_a,
-                            int camera_b, const Eigen::Vector2d& fisheye_b, const cv::Mat& depth_a, const cv::Mat& depth_b,
-                            double inlier_px, double* error_px) {
+int GroundTruthMatchVerdict(const Rig& rig, int camera_a, const Eigen::Vector3d& bearing_a,
+                            const Eigen::Vector2d& fisheye_a, int camera_b, const Eigen::Vector2d& fisheye_b,
+                            const cv::Mat& depth_a, const cv::Mat& depth_b, double inlier_px, double* error_px) {
   if (error_px) *error_px = std::numeric_limits<double>::infinity();
   const float centre_range = DepthAt(depth_a, fisheye_a);
   if (!(centre_range > 0.0f) || !std::isfinite(centre_range)) return -1;
@@ -173,11 +173,11 @@ struct TrackHistory {
 struct Arm {
   std::vector<ViewTracker> trackers;
   std::vector<std::unordered_map<uint64_t, TrackHistory>> history;  // per camera, live tracks only
-  std::vector<std::set<uint64_t>> contributing;                      // per camera: ids that contributed
+  std::vector<std::set<uint64_t>> contributing;                     // per camera: ids that contributed
   double first_sum = 0, age_sum = 0, step_sum = 0;
   int64_t first_pairs = 0, step_pairs = 0;
-  int64_t matches = 0, inliers = 0;          // epipolar-consistent mutual-NN matches
-  int64_t raw_matches = 0, raw_inliers = 0;  // all mutual-NN matches (descriptors only)
+  int64_t matches = 0, inliers = 0;              // epipolar-consistent mutual-NN matches
+  int64_t raw_matches = 0, raw_inliers = 0;      // all mutual-NN matches (descriptors only)
   int64_t chain_matches = 0, chain_inliers = 0;  // the front-end's filter chain on this arm's images
   std::vector<int64_t> error_bins = std::vector<int64_t>(kErrorBins, 0);
   std::vector<DrawnMatch> drawn;  // last frame, first pair
@@ -502,7 +502,8 @@ void WriteStudyTable(const StudySetup& setup, const DatasetInfo& info, const Fro
      << " features per view. rovo " << ROVO_VERSION << ".\n\n";
   md << "| | Original fisheye | Hybrid projection (ours) | Paper: fisheye / hybrid |\n|---|---|---|---|\n";
   std::snprintf(line, sizeof(line),
-                "| Descriptor distance (mean Hamming, track's first frame vs each later frame) | %.2f | %.2f | 124.85 / 35.27 |\n",
+                "| Descriptor distance (mean Hamming, track's first frame vs each later frame) | %.2f | %.2f | 124.85 "
+                "/ 35.27 |\n",
                 result.hamming_fisheye, result.hamming_hybrid);
   md << line;
   std::snprintf(line, sizeof(line), "| Descriptor distance (mean Hamming, frame t vs t+1) | %.2f | %.2f | - |\n",
@@ -519,13 +520,13 @@ void WriteStudyTable(const StudySetup& setup, const DatasetInfo& info, const Fro
      << cell(result.raw_inliers_fisheye, result.raw_matches_fisheye) << " | "
      << cell(result.raw_inliers_hybrid, result.raw_matches_hybrid) << " | - |\n";
   md << "| Inter-view inlier ratio %, the same matches kept when epipolar-consistent | "
-     << cell(result.inliers_fisheye, result.matches_fisheye) << " | " << cell(result.inliers_hybrid, result.matches_hybrid)
-     << " | 21.53 / 73.16 |\n";
+     << cell(result.inliers_fisheye, result.matches_fisheye) << " | "
+     << cell(result.inliers_hybrid, result.matches_hybrid) << " | 21.53 / 73.16 |\n";
   md << "| Inter-view inlier ratio %, the front-end's filter chain on the same overlap features | "
      << cell(result.chain_inliers_fisheye, result.chain_matches_fisheye) << " | "
      << cell(result.chain_inliers_hybrid, result.chain_matches_hybrid) << " | - |\n";
-  md << "| Inter-view inlier ratio %, the front-end itself | - | " << cell(result.inliers_frontend, result.matches_frontend)
-     << " | - |\n\n";
+  md << "| Inter-view inlier ratio %, the front-end itself | - | "
+     << cell(result.inliers_frontend, result.matches_frontend) << " | - |\n\n";
   std::snprintf(line, sizeof(line),
                 "Ratios: descriptor distance hybrid/fisheye = %.3f (target <= 0.35); inlier ratio hybrid/fisheye = "
                 "%.2f (target >= 3, hybrid >= 80%%); correct matches of the filter chain hybrid/fisheye = %.2f.\n\n",
@@ -587,7 +588,8 @@ void WriteStudyJson(const StudySetup& setup, const DatasetInfo& info, const Stud
   json["inlier_px"] = options.inlier_px;
   json["upright_descriptors"] = options.upright_descriptors;
   json["error_bin_edges_px"] = std::vector<double>(std::begin(kErrorBinEdges), std::end(kErrorBinEdges));
-  const auto arm_json = [&](const Arm& arm, double hamming, double step, double age, int64_t tracks, double ratio_value) {
+  const auto arm_json = [&](const Arm& arm, double hamming, double step, double age, int64_t tracks,
+                            double ratio_value) {
     return nlohmann::json{{"mean_hamming_first_vs_later", hamming},
                           {"mean_hamming_consecutive", step},
                           {"tracked_pairs", arm.first_pairs},
@@ -688,8 +690,9 @@ void AddProjectionStudyCommand(CliGroups& groups) {
       "drawings. Needs a dataset rendered with --depth.");
   cmd->add_option("dataset", options->dataset_dir, "Dataset folder (with depth/)")->required();
   cmd->add_option("--out", options->out_dir, "Output folder")->required();
-  cmd->add_option("--frames", options->frames, "Frames to use from the start")->capture_default_str()->check(
-      CLI::Range(2, 1000000));
+  cmd->add_option("--frames", options->frames, "Frames to use from the start")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 1000000));
   cmd->add_option("--features", options->features_per_view, "Tracker target features per view")
       ->capture_default_str()
       ->check(CLI::Range(10, 100000));
@@ -715,13 +718,13 @@ void AddProjectionStudyCommand(CliGroups& groups) {
   cmd->add_flag("--quiet", options->quiet, "No progress output");
   cmd->callback([options] {
     const ProjectionStudyResult r = RunProjectionStudy(*options);
-    std::printf("descriptor distance (first vs later): fisheye %.2f, hybrid %.2f (%lld / %lld pairs)\n", r.hamming_fisheye,
-                r.hamming_hybrid, static_cast<long long>(r.tracked_pairs_fisheye),
+    std::printf("descriptor distance (first vs later): fisheye %.2f, hybrid %.2f (%lld / %lld pairs)\n",
+                r.hamming_fisheye, r.hamming_hybrid, static_cast<long long>(r.tracked_pairs_fisheye),
                 static_cast<long long>(r.tracked_pairs_hybrid));
     std::printf("inter-view inlier ratio: fisheye %.2f%% (%lld), hybrid %.2f%% (%lld), front-end %.2f%% (%lld)\n",
-                100.0 * r.InlierRatioFisheye(), static_cast<long long>(r.matches_fisheye), 100.0 * r.InlierRatioHybrid(),
-                static_cast<long long>(r.matches_hybrid), 100.0 * r.InlierRatioFrontend(),
-                static_cast<long long>(r.matches_frontend));
+                100.0 * r.InlierRatioFisheye(), static_cast<long long>(r.matches_fisheye),
+                100.0 * r.InlierRatioHybrid(), static_cast<long long>(r.matches_hybrid),
+                100.0 * r.InlierRatioFrontend(), static_cast<long long>(r.matches_frontend));
     std::printf("wrote %s/table.md\n", options->out_dir.c_str());
   });
 }

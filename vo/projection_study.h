@@ -23,16 +23,15 @@
 // matches of part (b)) and matches_frontend.png (the front-end's accepted matches), each one
 // neighbour pair of the last frame (green = inlier, red = outlier).
 
+#include <Eigen/Core>
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
 #include "datasets/rig.h"
 #include "vo/frontend.h"
 #include "vo/interview_matching.h"
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
-
-#include <cstdint>
-#include <string>
-#include <vector>
 
 namespace rovo {
 
@@ -64,10 +63,10 @@ int FrontendMatchVerdict(const Frontend& frontend, const Rig& rig, const Fronten
 struct ProjectionStudyOptions {
   std::string dataset_dir;
   std::string out_dir;
-  int frames = 100;             // frames used from the start (fewer if the dataset is shorter)
-  int features_per_view = 500;  // tracker target per view (4 views: the paper's 2000 features)
-  double epipolar_deg = 1.0;    // epipolar consistency for part (b)
-  double inlier_px = 2.0;       // ground-truth reprojection tolerance, fisheye pixels
+  int frames = 100;                         // frames used from the start (fewer if the dataset is shorter)
+  int features_per_view = 500;              // tracker target per view (4 views: the paper's 2000 features)
+  double epipolar_deg = 1.0;                // epipolar consistency for part (b)
+  double inlier_px = 2.0;                   // ground-truth reprojection tolerance, fisheye pixels
   InterviewMatchOptions frontend_matching;  // filters of the front-end column (defaults = the front-end's)
   // TrackerOptions::upright_descriptors for both arms and the front-end column (default: the front-end's).
   bool upright_descriptors = FrontendOptions{}.upright_descriptors;
@@ -76,22 +75,24 @@ struct ProjectionStudyOptions {
 
 struct ProjectionStudyResult {
   int frames = 0;
-  double hamming_fisheye = 0, hamming_hybrid = 0;  // mean Hamming distance, first frame vs later
+  double hamming_fisheye = 0, hamming_hybrid = 0;               // mean Hamming distance, first frame vs later
   int64_t tracked_pairs_fisheye = 0, tracked_pairs_hybrid = 0;  // (track, later frame) pairs
-  double hamming_step_fisheye = 0, hamming_step_hybrid = 0;  // mean Hamming distance, t vs t+1
-  double mean_age_fisheye = 0, mean_age_hybrid = 0;          // mean frames since the first, over the pairs
-  int64_t features_fisheye = 0, features_hybrid = 0;  // distinct tracks that contributed
-  int64_t raw_matches_fisheye = 0, raw_inliers_fisheye = 0;  // (b), all mutual-NN matches (descriptors only)
+  double hamming_step_fisheye = 0, hamming_step_hybrid = 0;     // mean Hamming distance, t vs t+1
+  double mean_age_fisheye = 0, mean_age_hybrid = 0;             // mean frames since the first, over the pairs
+  int64_t features_fisheye = 0, features_hybrid = 0;            // distinct tracks that contributed
+  int64_t raw_matches_fisheye = 0, raw_inliers_fisheye = 0;     // (b), all mutual-NN matches (descriptors only)
   int64_t raw_matches_hybrid = 0, raw_inliers_hybrid = 0;
   int64_t chain_matches_fisheye = 0, chain_inliers_fisheye = 0;  // (b), the front-end's filter chain
   int64_t chain_matches_hybrid = 0, chain_inliers_hybrid = 0;
-  int64_t matches_fisheye = 0, inliers_fisheye = 0;   // (b), epipolar-consistent matches
+  int64_t matches_fisheye = 0, inliers_fisheye = 0;  // (b), epipolar-consistent matches
   int64_t matches_hybrid = 0, inliers_hybrid = 0;
-  int64_t matches_frontend = 0, inliers_frontend = 0; // front-end's full filters (hybrid)
+  int64_t matches_frontend = 0, inliers_frontend = 0;  // front-end's full filters (hybrid)
   double RawInlierRatioFisheye() const {
     return raw_matches_fisheye ? double(raw_inliers_fisheye) / raw_matches_fisheye : 0.0;
   }
-  double RawInlierRatioHybrid() const { return raw_matches_hybrid ? double(raw_inliers_hybrid) / raw_matches_hybrid : 0.0; }
+  double RawInlierRatioHybrid() const {
+    return raw_matches_hybrid ? double(raw_inliers_hybrid) / raw_matches_hybrid : 0.0;
+  }
   double ChainInlierRatioFisheye() const {
     return chain_matches_fisheye ? double(chain_inliers_fisheye) / chain_matches_fisheye : 0.0;
   }

@@ -1,11 +1,11 @@
 #include "vo/ransac.h"
 
-#include "vo/p3p.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+
+#include "vo/p3p.h"
 
 namespace rovo {
 
@@ -22,12 +22,14 @@ RansacViews RansacViewsFromName(const std::string& name) {
 }
 
 void MultiViewRansacOptions::Check() const {
-  if (!(tau_rad > 0.0 && tau_rad < M_PI)) throw std::invalid_argument("MultiViewRansacOptions.tau_rad must be in (0, pi)");
+  if (!(tau_rad > 0.0 && tau_rad < M_PI))
+    throw std::invalid_argument("MultiViewRansacOptions.tau_rad must be in (0, pi)");
   if (min_iterations < 1) throw std::invalid_argument("MultiViewRansacOptions.min_iterations must be >= 1");
   if (max_iterations < min_iterations) {
     throw std::invalid_argument("MultiViewRansacOptions.max_iterations must be >= min_iterations");
   }
-  if (!(confidence > 0.0 && confidence < 1.0)) throw std::invalid_argument("MultiViewRansacOptions.confidence must be in (0, 1)");
+  if (!(confidence > 0.0 && confidence < 1.0))
+    throw std::invalid_argument("MultiViewRansacOptions.confidence must be in (0, 1)");
   if (min_inliers < 3) throw std::invalid_argument("MultiViewRansacOptions.min_inliers must be >= 3");
 }
 
@@ -154,8 +156,8 @@ MultiViewRansacReport MultiViewP3PRansac(const std::vector<std::vector<BearingPo
       int inliers = 0;
       for (int j = 0; j < num_views; ++j) {
         if (!scored[j]) continue;
-        const ViewScore s = ScoreView(correspondences[j], cam_from_rig[j] * rig_from_world, options.tau_rad, cos_tau,
-                                      nullptr);
+        const ViewScore s =
+            ScoreView(correspondences[j], cam_from_rig[j] * rig_from_world, options.tau_rad, cos_tau, nullptr);
         score += s.score;
         inliers += s.inliers;
       }

@@ -17,14 +17,13 @@
 // Determinism: std::mt19937_64 seeded by Options::seed with our own uniform helpers, so the result is
 // the same on every platform for a given seed.
 
-#include "datasets/rigid3.h"
-
 #include <Eigen/Core>
-
 #include <cstdint>
 #include <random>
 #include <string>
 #include <vector>
+
+#include "datasets/rigid3.h"
 
 namespace rovo {
 
@@ -39,11 +38,11 @@ ViewSampling ViewSamplingFromName(const std::string& name);  // "pps" | "uniform
 RansacViews RansacViewsFromName(const std::string& name);    // "multiview" | "single-view"
 
 struct MultiViewRansacOptions {
-  double tau_rad = 0.01;          // inlier threshold and truncation of the cost (0.57 deg)
-  int min_iterations = 20;        // at least this many hypotheses draws
-  int max_iterations = 1000;      // hard bound on draws
-  double confidence = 0.999;      // for the adaptive iteration bound
-  int min_inliers = 10;           // fewer: no consensus
+  double tau_rad = 0.01;      // inlier threshold and truncation of the cost (0.57 deg)
+  int min_iterations = 20;    // at least this many hypotheses draws
+  int max_iterations = 1000;  // hard bound on draws
+  double confidence = 0.999;  // for the adaptive iteration bound
+  int min_inliers = 10;       // fewer: no consensus
   ViewSampling sampling = ViewSampling::kPps;
   RansacViews views = RansacViews::kMultiView;
   uint64_t seed = 0;
@@ -51,17 +50,17 @@ struct MultiViewRansacOptions {
 };
 
 struct MultiViewRansacReport {
-  bool success = false;                  // a pose with >= min_inliers inliers was found
+  bool success = false;  // a pose with >= min_inliers inliers was found
   Rigid3 rig_from_world;
-  double score = 0.0;                    // best sum of max(0, tau - angle)
+  double score = 0.0;  // best sum of max(0, tau - angle)
   int num_inliers = 0;
-  int num_correspondences = 0;           // scored correspondences (all views, or the single view)
+  int num_correspondences = 0;  // scored correspondences (all views, or the single view)
   double inlier_ratio = 0.0;
-  int num_iterations = 0;                // draws
-  int num_hypotheses = 0;                // P3P solutions scored
+  int num_iterations = 0;                  // draws
+  int num_hypotheses = 0;                  // P3P solutions scored
   std::vector<std::vector<char>> inliers;  // [camera][i], 1 = inlier of the best pose
-  std::vector<int> view_draws;           // how often each view was chosen
-  int single_view = -1;                  // the view used in kSingleView mode
+  std::vector<int> view_draws;             // how often each view was chosen
+  int single_view = -1;                    // the view used in kSingleView mode
 };
 
 // correspondences[j] are camera j's; cam_from_rig.size() must equal correspondences.size().

@@ -1,9 +1,11 @@
 #include "vo/ring_calibration.h"
 
-#include "vo/orb_matching.h"
-
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
@@ -11,11 +13,9 @@
 #include <opengv/relative_pose/methods.hpp>
 #include <opengv/sac/Ransac.hpp>
 #include <opengv/sac_problems/relative_pose/RotationOnlySacProblem.hpp>
-
-#include <algorithm>
-#include <cmath>
-#include <numeric>
 #include <stdexcept>
+
+#include "vo/orb_matching.h"
 
 namespace rovo {
 namespace {
@@ -50,14 +50,16 @@ struct ViewGeometry {
 ViewGeometry MakeViewGeometry(const Rig& rig, int a, int b, const RingCalibrationOptions& options) {
   Eigen::Vector3d m = CameraAxisInRig(rig.cameras[a].cam_from_rig) + CameraAxisInRig(rig.cameras[b].cam_from_rig);
   m.z() = 0.0;
-  if (m.norm() < 1e-6) throw std::invalid_argument("ring calibration: cameras " + std::to_string(a) + " and " +
-                                                   std::to_string(b) + " face opposite ways (no overlap direction)");
+  if (m.norm() < 1e-6)
+    throw std::invalid_argument("ring calibration: cameras " + std::to_string(a) + " and " + std::to_string(b) +
+                                " face opposite ways (no overlap direction)");
   m.normalize();
   ViewGeometry g;
   g.rig_from_view.col(0) = m;
   g.rig_from_view.col(2) = Eigen::Vector3d::UnitZ();
   g.rig_from_view.col(1) = Eigen::Vector3d::UnitZ().cross(m);
-  const double native = std::min(PixelsPerRadianAt90(rig.cameras[a].camera), PixelsPerRadianAt90(rig.cameras[b].camera));
+  const double native =
+      std::min(PixelsPerRadianAt90(rig.cameras[a].camera), PixelsPerRadianAt90(rig.cameras[b].camera));
   g.focal = std::max(options.min_view_focal_px, native);
   if (options.dense_view_focal_px > 0.0) {
     g.focal = std::max(g.focal, std::min(options.dense_view_focal_px, options.dense_view_max_upsampling * native));
@@ -92,16 +94,17 @@ ViewSide MakeViewSide(const RigCamera& cam, int camera, const ViewGeometry& g, c
   for (int v = 0; v < g.height; ++v) {
     const double lat = g.Latitude(v), cos_lat = std::cos(lat), sin_lat = std::sin(lat);
     for (int u = 0; u < g.width; ++u) {
-      const Eigen::Vector3d d_cam = cam_from_view * Eigen::Vector3d(cos_lat * cos_lon[u], cos_lat * sin_lon[u], sin_lat);
+      const Eigen::Vector3d d_cam =
+          cam_from_view * Eigen::Vector3d(cos_lat * cos_lon[u], cos_lat * sin_lon[u], sin_lat);
       const auto px = cam.camera.Project(d_cam);  // nullopt outside the field of view
       const bool inside = px && px->x() >= 1.0 && px->y() >= 1.0 && px->x() <= cam.camera.width - 2.0 &&
                           px->y() <= cam.camera.height - 2.0;
       s.map_x.at<float>(v, u) = inside ? static_cast<float>(px->x()) : -1.0f;
       s.map_y.at<float>(v, u) = inside ? static_cast<float>(px->y()) : -1.0f;
       if (!inside) continue;
-      const bool masked_out = !static_mask.empty() &&
-                              static_mask.at<uint8_t>(static_cast<int>(std::lround(px->y())),
-                                                      static_cast<int>(std::lround(px->x()))) == 0;
+      const bool masked_out =
+          !static_mask.empty() &&
+          static_mask.at<uint8_t>(static_cast<int>(std::lround(px->y())), static_cast<int>(std::lround(px->x()))) == 0;
       s.valid.at<uint8_t>(v, u) = masked_out ? 0 : 255;
     }
   }
@@ -195,7 +198,8 @@ std::vector<Eigen::Quaterniond> AverageRing(const std::vector<RingPairEstimate>&
   for (const RingPairEstimate& p : pairs) {
     if (!p.usable) continue;
     auto* cost = new ceres::AutoDiffCostFunction<PairRotationError, 3, 4, 4>(new PairRotationError(p.camb_from_cama));
-    problem.AddResidualBlock(cost, new ceres::ScaledLoss(nullptr, static_cast<double>(p.inliers), ceres::TAKE_OWNERSHIP),
+    problem.AddResidualBlock(cost,
+                             new ceres::ScaledLoss(nullptr, static_cast<double>(p.inliers), ceres::TAKE_OWNERSHIP),
                              rotations[p.camera_a].coeffs().data(), rotations[p.camera_b].coeffs().data());
   }
   ceres::Solver::Options options;
@@ -214,9 +218,11 @@ void RingCalibrationOptions::Check() const {
       !(view_half_height_deg > 0.0 && view_half_height_deg < 90.0)) {
     throw std::invalid_argument("RingCalibrationOptions: view extents must be in (0, 90) deg");
   }
-  if (!(max_ratio > 0.0 && max_ratio <= 1.0)) throw std::invalid_argument("RingCalibrationOptions: max_ratio in (0, 1]");
+  if (!(max_ratio > 0.0 && max_ratio <= 1.0))
+    throw std::invalid_argument("RingCalibrationOptions: max_ratio in (0, 1]");
   if (!(inlier_threshold_deg > 0.0) || ransac_iterations < 1 || min_inliers < 5 || orb_features < 10) {
-    throw std::invalid_argument("RingCalibrationOptions: threshold, iterations, min_inliers or orb_features out of range");
+    throw std::invalid_argument(
+        "RingCalibrationOptions: threshold, iterations, min_inliers or orb_features out of range");
   }
 }
 
@@ -231,8 +237,8 @@ std::vector<std::pair<int, int>> RingPairs(const Rig& rig) {
   const int count = n >= 3 ? n : n - 1;
   for (int k = 0; k < count; ++k) {
     const int a = order[k], b = order[(k + 1) % n];
-    const double apart = AngleBetween(CameraAxisInRig(rig.cameras[a].cam_from_rig),
-                                      CameraAxisInRig(rig.cameras[b].cam_from_rig)) / kDeg;
+    const double apart =
+        AngleBetween(CameraAxisInRig(rig.cameras[a].cam_from_rig), CameraAxisInRig(rig.cameras[b].cam_from_rig)) / kDeg;
     const double reach = 0.5 * (rig.cameras[a].camera.max_fov_deg + rig.cameras[b].camera.max_fov_deg);
     if (apart < reach - 10.0) pairs.emplace_back(std::min(a, b), std::max(a, b));
   }
@@ -296,11 +302,13 @@ void RingCalibrator::AddFrame(const std::vector<cv::Mat>& images) {
     }
     const double max_prior = std::cos(o.max_prior_angle_deg * kDeg);
     std::vector<cv::Point2f> points_a, points_b;
-    for (const auto& [i, j] : MutualRatioOrbMatches(descriptors[0], descriptors[1], o.max_ratio, o.max_descriptor_distance)) {
+    for (const auto& [i, j] :
+         MutualRatioOrbMatches(descriptors[0], descriptors[1], o.max_ratio, o.max_descriptor_distance)) {
       points_a.push_back(keypoints[0][i].pt);
       points_b.push_back(keypoints[1][j].pt);
     }
-    if (o.refine_matches) RefineMatchesKlt(p.last_view[0], p.last_view[1], o.klt_normalize_sigma_px, &points_a, &points_b);
+    if (o.refine_matches)
+      RefineMatchesKlt(p.last_view[0], p.last_view[1], o.klt_normalize_sigma_px, &points_a, &points_b);
     for (size_t k = 0; k < points_a.size(); ++k) {
       const Eigen::Vector3d d_a = p.geometry.DirectionInRig(points_a[k].x, points_a[k].y);
       const Eigen::Vector3d d_b = p.geometry.DirectionInRig(points_b[k].x, points_b[k].y);
@@ -345,9 +353,10 @@ bool InFrontOfBoth(const Eigen::Vector3d& ray_a, const Eigen::Vector3d& ray_b, c
 
 // R_ab minimising the robust epipolar residuals of the matches `used` for the baseline direction
 // `baseline_in_a`, from `start`.
-Eigen::Quaterniond RefineWithBaseline(const opengv::bearingVectors_t& bearings_a, const opengv::bearingVectors_t& bearings_b,
-                                      const std::vector<int>& used, const Eigen::Vector3d& baseline_in_a,
-                                      Eigen::Quaterniond start, double scale_rad) {
+Eigen::Quaterniond RefineWithBaseline(const opengv::bearingVectors_t& bearings_a,
+                                      const opengv::bearingVectors_t& bearings_b, const std::vector<int>& used,
+                                      const Eigen::Vector3d& baseline_in_a, Eigen::Quaterniond start,
+                                      double scale_rad) {
   ceres::Problem problem;
   problem.AddParameterBlock(start.coeffs().data(), 4, new ceres::EigenQuaternionManifold);
   for (int k : used) {
@@ -458,7 +467,8 @@ T RingEpipolarResidual(const T* q_a, const T* q_b, const Eigen::Matrix<T, 3, 1>&
 
 // RingEpipolarResidual with the lenses as given.
 struct RingEpipolarError {
-  RingEpipolarError(const Eigen::Vector3d& bearing_a, const Eigen::Vector3d& bearing_b, const Eigen::Vector3d& baseline_in_rig)
+  RingEpipolarError(const Eigen::Vector3d& bearing_a, const Eigen::Vector3d& bearing_b,
+                    const Eigen::Vector3d& baseline_in_rig)
       : bearing_a(bearing_a), bearing_b(bearing_b), baseline_in_rig(baseline_in_rig) {}
   template <typename T>
   bool operator()(const T* q_a, const T* q_b, T* residual) const {
@@ -475,7 +485,8 @@ struct ScaledRingEpipolarError {
       : bearing_a(bearing_a), bearing_b(bearing_b), baseline_in_rig(baseline_in_rig) {}
   template <typename T>
   bool operator()(const T* q_a, const T* q_b, const T* kappa, T* residual) const {
-    residual[0] = RingEpipolarResidual<T>(q_a, q_b, bearing_a.Scaled(kappa[0]), bearing_b.Scaled(kappa[0]), baseline_in_rig);
+    residual[0] =
+        RingEpipolarResidual<T>(q_a, q_b, bearing_a.Scaled(kappa[0]), bearing_b.Scaled(kappa[0]), baseline_in_rig);
     return true;
   }
   OffAxisBearing bearing_a, bearing_b;
@@ -523,8 +534,8 @@ Eigen::Vector3d PairBaselineInRig(const PairState& p, const Rig& rig) {
 // |RingEpipolarResidual| of bearings `b_a`, `b_b` (already scaled) of pair `p` under `model`.
 double RingResidual(const PairState& p, const Eigen::Vector3d& b_a, const Eigen::Vector3d& b_b,
                     const Eigen::Vector3d& baseline_in_rig, const RingModel& model) {
-  return std::abs(RingEpipolarResidual<double>(model.rotations[p.a].coeffs().data(), model.rotations[p.b].coeffs().data(),
-                                               b_a, b_b, baseline_in_rig));
+  return std::abs(RingEpipolarResidual<double>(model.rotations[p.a].coeffs().data(),
+                                               model.rotations[p.b].coeffs().data(), b_a, b_b, baseline_in_rig));
 }
 
 // |RingEpipolarResidual| of match `i` of pair `p` under `model`.
@@ -572,8 +583,9 @@ RingModel RefineRing(const std::vector<PairState>& pairs, const std::vector<std:
   AddRingResiduals(pairs, inliers, rig, scale_rad, angle_scale_sigma > 0.0, &model, &problem);
   // Priors as strong as ten matches at the Cauchy scale for an error of one sigma.
   const double weight = std::sqrt(10.0) * scale_rad / (prior_sigma_deg * kDeg);
-  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<RotationPrior, 3, 4>(new RotationPrior(model.rotations[0], weight)),
-                           nullptr, model.rotations[0].coeffs().data());
+  problem.AddResidualBlock(
+      new ceres::AutoDiffCostFunction<RotationPrior, 3, 4>(new RotationPrior(model.rotations[0], weight)), nullptr,
+      model.rotations[0].coeffs().data());
   if (angle_scale_sigma > 0.0) {
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<AngleScalePrior, 1, 1>(
                                  new AngleScalePrior(std::sqrt(10.0) * scale_rad / angle_scale_sigma)),
@@ -632,7 +644,10 @@ struct CommonRotationError {
   CommonRotationError(const Eigen::Quaterniond& cam_a_from_rig, const Eigen::Quaterniond& cam_b_from_rig,
                       const Eigen::Vector3d& bearing_a, const Eigen::Vector3d& bearing_b,
                       const Eigen::Vector3d& baseline_in_rig)
-      : qa(cam_a_from_rig), qb(cam_b_from_rig), bearing_a(bearing_a), bearing_b(bearing_b),
+      : qa(cam_a_from_rig),
+        qb(cam_b_from_rig),
+        bearing_a(bearing_a),
+        bearing_b(bearing_b),
         baseline_in_rig(baseline_in_rig) {}
   template <typename T>
   bool operator()(const T* q_turn, T* residual) const {
@@ -656,10 +671,11 @@ RingModel FitCommonRotation(const std::vector<PairState>& pairs, const Rig& rig,
   for (const PairState& p : pairs) {
     const Eigen::Vector3d baseline = PairBaselineInRig(p, rig);
     for (size_t i = 0; i < p.bearings_a.size(); ++i) {
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<CommonRotationError, 1, 4>(new CommonRotationError(
-                                   model.rotations[p.a], model.rotations[p.b], ScaledBearing(p.bearings_a[i], model.kappa),
-                                   ScaledBearing(p.bearings_b[i], model.kappa), baseline)),
-                               new ceres::CauchyLoss(scale_rad), turn.coeffs().data());
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<CommonRotationError, 1, 4>(new CommonRotationError(
+              model.rotations[p.a], model.rotations[p.b], ScaledBearing(p.bearings_a[i], model.kappa),
+              ScaledBearing(p.bearings_b[i], model.kappa), baseline)),
+          new ceres::CauchyLoss(scale_rad), turn.coeffs().data());
       ++residuals;
     }
   }
@@ -719,7 +735,8 @@ double PairDisagreementDeg(const PairState& p, const std::vector<int>& inliers, 
     scaled_a[i] = ScaledBearing(p.bearings_a[i], model.kappa);
     scaled_b[i] = ScaledBearing(p.bearings_b[i], model.kappa);
   }
-  const Eigen::Quaterniond own = RefineWithBaseline(scaled_a, scaled_b, inliers, baseline_in_a, joint_a_from_b, scale_rad);
+  const Eigen::Quaterniond own =
+      RefineWithBaseline(scaled_a, scaled_b, inliers, baseline_in_a, joint_a_from_b, scale_rad);
   return RotationDistanceDeg(own, joint_a_from_b);
 }
 
@@ -774,7 +791,7 @@ std::string PairCounts(const std::vector<RingPairEstimate>& pairs) {
 
 struct JointSolution {
   RingModel model;
-  std::vector<std::vector<int>> inliers;      // per pair
+  std::vector<std::vector<int>> inliers;  // per pair
   int total_inliers = -1;
 };
 
@@ -871,7 +888,8 @@ RingCalibrationReport RingCalibrator::Solve() const {
   report.frames = impl_->frames;
   report.cam_from_rig = rig.Extrinsics();
   std::vector<std::vector<int>> inliers(impl_->pairs.size());
-  for (size_t k = 0; k < impl_->pairs.size(); ++k) report.pairs.push_back(EstimatePair(impl_->pairs[k], rig, o, &inliers[k]));
+  for (size_t k = 0; k < impl_->pairs.size(); ++k)
+    report.pairs.push_back(EstimatePair(impl_->pairs[k], rig, o, &inliers[k]));
   std::vector<Eigen::Quaterniond> rotations;
   if (!ChainFromCameraZero(report.pairs, n, &rotations)) {
     report.reason = "too few overlap matches to connect every camera to camera 0" + PairCounts(report.pairs);
@@ -920,8 +938,8 @@ RingCalibrationReport RingCalibrator::Solve() const {
         std::max(report.max_pair_disagreement_deg, PairDisagreementDeg(impl_->pairs[k], inliers[k], rig, model, scale));
   }
   if (report.uncertainty_deg < 0.0 || report.uncertainty_deg > o.max_uncertainty_deg) {
-    report.reason = "the overlaps leave a camera's rotation uncertain (one sigma " + std::to_string(report.uncertainty_deg) +
-                    " deg > " + std::to_string(o.max_uncertainty_deg) + ")";
+    report.reason = "the overlaps leave a camera's rotation uncertain (one sigma " +
+                    std::to_string(report.uncertainty_deg) + " deg > " + std::to_string(o.max_uncertainty_deg) + ")";
     return report;
   }
   if (report.max_pair_disagreement_deg > o.max_pair_disagreement_deg) {
@@ -938,8 +956,9 @@ RingCalibrationReport RingCalibrator::Solve() const {
   report.centres_turned = o.turn_centres;
   report.centres_known = o.turn_centres && report.common_turn_sigma_deg >= 0.0 &&
                          report.common_turn_sigma_deg <= o.max_common_turn_sigma_deg;
-  const Eigen::Quaterniond rig_turn = report.centres_turned ? (cam0_from_rig.inverse() * model.rotations[0]).normalized()
-                                                            : Eigen::Quaterniond::Identity();
+  const Eigen::Quaterniond rig_turn = report.centres_turned
+                                          ? (cam0_from_rig.inverse() * model.rotations[0]).normalized()
+                                          : Eigen::Quaterniond::Identity();
   const Eigen::Vector3d centre0 = CameraPositionInRig(rig.cameras[0].cam_from_rig);
   for (int j = 1; j < n; ++j) {
     const Eigen::Vector3d centre = centre0 + rig_turn * (CameraPositionInRig(rig.cameras[j].cam_from_rig) - centre0);

@@ -29,14 +29,13 @@
 // common turn of the cameras against their centres (camera 0's own error, seen through the
 // baselines' directions) turns the other centres about camera 0's instead (turn_centres).
 
-#include "datasets/rig.h"
-#include "datasets/rigid3.h"
-
-#include <opencv2/core.hpp>
-
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
+
+#include "datasets/rig.h"
+#include "datasets/rigid3.h"
 
 namespace rovo {
 
@@ -48,24 +47,24 @@ struct RingCalibrationOptions {
   // lenses' own (the start-up's later passes: more corners where the lens holds them).
   double dense_view_focal_px = 0.0;
   double dense_view_max_upsampling = 1.25;
-  int orb_features = 3000;             // per overlap view
+  int orb_features = 3000;  // per overlap view
   int orb_fast_threshold = 10;
-  bool refine_matches = false;         // KLT sub-pixel refinement of the matches (aligned views only)
-  double klt_normalize_sigma_px = 10.0; // KLT on locally contrast-normalised views (window sigma); 0: raw
-  double max_ratio = 0.8;              // best / second-best Hamming distance
+  bool refine_matches = false;           // KLT sub-pixel refinement of the matches (aligned views only)
+  double klt_normalize_sigma_px = 10.0;  // KLT on locally contrast-normalised views (window sigma); 0: raw
+  double max_ratio = 0.8;                // best / second-best Hamming distance
   int max_descriptor_distance = 80;
-  double max_prior_angle_deg = 40.0;   // gross-outlier bound on the nominal rig-frame bearings
-  double max_parallax_deg = 5.0;       // rotation-only RANSAC threshold (parallax of near points)
-  bool reselect_all = true;            // final inliers from every match, not only the RANSAC's
-  double inlier_threshold_deg = 0.4;   // epipolar residual of an inlier (and the Cauchy scale)
+  double max_prior_angle_deg = 40.0;  // gross-outlier bound on the nominal rig-frame bearings
+  double max_parallax_deg = 5.0;      // rotation-only RANSAC threshold (parallax of near points)
+  bool reselect_all = true;           // final inliers from every match, not only the RANSAC's
+  double inlier_threshold_deg = 0.4;  // epipolar residual of an inlier (and the Cauchy scale)
   int ransac_iterations = 2000;
-  int min_inliers = 25;                // fewer: the pair is not estimated
-  double max_loop_error_deg = 12.0;    // larger loop-closure error of the pairs: not converged
+  int min_inliers = 25;                    // fewer: the pair is not estimated
+  double max_loop_error_deg = 12.0;        // larger loop-closure error of the pairs: not converged
   double max_pair_disagreement_deg = 0.5;  // a pair further from the joint ring solution: not converged
-  bool require_closed_ring = true;     // every ring pair estimated (the loop checks them), else not converged
-  double max_uncertainty_deg = 0.25;   // one sigma of the worst camera (RingUncertaintyDeg) above: not converged
-  int joint_rounds = 2;                // inliers re-selected by the joint solution, then refined again
-  double prior_sigma_deg = 5.0;        // joint refinement: camera 0's prior (the common rotation)
+  bool require_closed_ring = true;         // every ring pair estimated (the loop checks them), else not converged
+  double max_uncertainty_deg = 0.25;       // one sigma of the worst camera (RingUncertaintyDeg) above: not converged
+  int joint_rounds = 2;                    // inliers re-selected by the joint solution, then refined again
+  double prior_sigma_deg = 5.0;            // joint refinement: camera 0's prior (the common rotation)
   // > 0: the joint refinement also estimates one angle scale 1 + kappa of every lens's off-axis angle
   // around a closed ring, kappa with this prior standard deviation (a real lens calibration that
   // understates angles near the rim leaves the ring open by degrees); 0: the lenses as given.
@@ -84,11 +83,11 @@ struct RingCalibrationOptions {
 
 struct RingPairEstimate {
   int camera_a = 0, camera_b = 0;
-  int matches = 0;                     // pooled over frames, after the ratio, mutual and prior checks
+  int matches = 0;  // pooled over frames, after the ratio, mutual and prior checks
   int inliers = 0;
   bool usable = false;
   Eigen::Quaterniond camb_from_cama = Eigen::Quaterniond::Identity();  // R_ba
-  double change_deg = 0.0;             // angle between R_ba and the nominal one
+  double change_deg = 0.0;                                             // angle between R_ba and the nominal one
   // Median |epipolar residual| of the final inliers under the given extrinsics and under the result
   // (degrees; -1 when the ring did not converge): how much better the result explains the overlaps.
   double median_residual_deg_given = -1.0, median_residual_deg_result = -1.0;
@@ -96,27 +95,27 @@ struct RingPairEstimate {
 
 struct RingCalibrationReport {
   bool converged = false;
-  std::string reason;                  // why not, when not converged
+  std::string reason;  // why not, when not converged
   int frames = 0;
   std::vector<RingPairEstimate> pairs;
-  double loop_error_deg = -1.0;        // < 0: the ring is not closed (a pair missing, or N < 3)
+  double loop_error_deg = -1.0;            // < 0: the ring is not closed (a pair missing, or N < 3)
   double max_pair_disagreement_deg = 0.0;  // largest angle between a pair's own and the joint rotation
-  double uncertainty_deg = -1.0;       // one sigma of the worst-determined camera (RingUncertaintyDeg)
-  double angle_scale = 1.0;            // the lenses' off-axis angle scale of the joint solution
-  double common_turn_deg = 0.0;        // the joint solution's common turn of the cameras against their centres
-  double common_turn_sigma_deg = -1.0; // its one sigma from the matches alone (no prior); < 0: not computed
-  bool centres_turned = false;         // the centres took that turn (turn_centres)
-  bool centres_known = false;          // ... and the matches know it (max_common_turn_sigma_deg)
-  std::vector<Rigid3> cam_from_rig;    // calibrated (camera 0 unchanged; the centres turned about it)
+  double uncertainty_deg = -1.0;           // one sigma of the worst-determined camera (RingUncertaintyDeg)
+  double angle_scale = 1.0;                // the lenses' off-axis angle scale of the joint solution
+  double common_turn_deg = 0.0;            // the joint solution's common turn of the cameras against their centres
+  double common_turn_sigma_deg = -1.0;     // its one sigma from the matches alone (no prior); < 0: not computed
+  bool centres_turned = false;             // the centres took that turn (turn_centres)
+  bool centres_known = false;              // ... and the matches know it (max_common_turn_sigma_deg)
+  std::vector<Rigid3> cam_from_rig;        // calibrated (camera 0 unchanged; the centres turned about it)
 };
 
 // How well one calibration explains a ring pair's overlap matches (RingCalibrator::Fit).
 struct RingPairFit {
   int camera_a = 0, camera_b = 0;
-  int matches = 0;                     // pooled over frames, after the ratio, mutual and prior checks
-  int inliers = 0;                     // epipolar residual below the inlier threshold, in front of both
-  double median_residual_deg = -1.0;   // median |epipolar residual| of those inliers; -1: none
-  std::vector<double> residuals_deg;   // |epipolar residual| of every match
+  int matches = 0;                    // pooled over frames, after the ratio, mutual and prior checks
+  int inliers = 0;                    // epipolar residual below the inlier threshold, in front of both
+  double median_residual_deg = -1.0;  // median |epipolar residual| of those inliers; -1: none
+  std::vector<double> residuals_deg;  // |epipolar residual| of every match
 };
 
 // Ring neighbours: the cameras sorted by the yaw of their nominal optical axis, each paired with the

@@ -1,17 +1,16 @@
 #include "vo/startup_calibration.h"
 
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
 #include "datasets/lens_angle_scale.h"
 #include "vo/extrinsic_bootstrap.h"
 #include "vo/frontend.h"
 #include "vo/local_ba.h"
 #include "vo/opencv_threads.h"
-
-#include <Eigen/SVD>
-
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <stdexcept>
 
 namespace rovo {
 namespace {
@@ -43,7 +42,8 @@ std::vector<Rigid3> RefineOnShot(const Rig& rig, std::vector<Rigid3> cam_from_ri
     FrontendOptions probe_options;
     probe_options.upright_descriptors = false;
     Frontend probe(rig.WithExtrinsics(cam_from_rig), probe_options);
-    probe.SetMatchingOptions(LoosenedMatching(probe.options().matching, uncertainty_deg, probe.projection(0).focal_px()));
+    probe.SetMatchingOptions(
+        LoosenedMatching(probe.options().matching, uncertainty_deg, probe.projection(0).focal_px()));
     const FrontendFrame frame = probe.Process(images);
     ExtrinsicBootstrapOptions bopt;
     bopt.max_error_deg = uncertainty_deg;
@@ -78,8 +78,8 @@ void PrintRing(const RingCalibrationReport& ring) {
 }
 
 RingCalibrationReport RunRingPass(const Rig& rig, const std::vector<Rigid3>& cam_from_rig,
-                                  const std::vector<std::vector<cv::Mat>>& shots, const std::vector<cv::Mat>& static_masks,
-                                  const RingCalibrationOptions& options) {
+                                  const std::vector<std::vector<cv::Mat>>& shots,
+                                  const std::vector<cv::Mat>& static_masks, const RingCalibrationOptions& options) {
   RingCalibrator ring(rig.WithExtrinsics(cam_from_rig), static_masks, options);
   for (const auto& images : shots) ring.AddFrame(images);
   return ring.Solve();
@@ -118,7 +118,8 @@ Eigen::Quaterniond ChordalMean(const Eigen::Matrix3d& sum) {
 RingCalibrationReport AverageOverPlacements(const Rig& rig, RingCalibrationReport last,
                                             const std::vector<std::vector<cv::Mat>>& shots,
                                             const std::vector<cv::Mat>& static_masks,
-                                            const StartupCalibrationOptions& options, int* averaged, double* spread_deg) {
+                                            const StartupCalibrationOptions& options, int* averaged,
+                                            double* spread_deg) {
   const RingCalibrationOptions pass_options = options.ring_passes > 1 ? LaterPassOptions(options) : options.ring;
   const size_t n = last.cam_from_rig.size();
   auto camj_from_cam0 = [](const RingCalibrationReport& r, size_t j) {
@@ -138,7 +139,8 @@ RingCalibrationReport AverageOverPlacements(const Rig& rig, RingCalibrationRepor
     // Like a later pass, a placement must confirm the result (max_pass_change_deg) and its lens
     // decision (the angle scale kept or left at 1), else it is left out.
     double change = 0.0;
-    for (size_t j = 1; j < n; ++j) change = std::max(change, RotationDistanceDeg(camj_from_cam0(r, j), camj_from_cam0(last, j)));
+    for (size_t j = 1; j < n; ++j)
+      change = std::max(change, RotationDistanceDeg(camj_from_cam0(r, j), camj_from_cam0(last, j)));
     const bool same_lenses = (r.angle_scale == 1.0) == (last.angle_scale == 1.0);
     if (change <= options.max_pass_change_deg && same_lenses) results.push_back(std::move(r));
   }
@@ -185,8 +187,9 @@ RingCalibrationReport RunRingPasses(const Rig& rig, const std::vector<Rigid3>& c
     const double change = LargestChangeDeg(last.cam_from_rig, next.cam_from_rig);
     if (change > options.max_pass_change_deg) {
       next.converged = false;
-      next.reason = "pass " + std::to_string(pass) + ", with the overlap views placed by the pass before, moved a camera " +
-                    std::to_string(change) + " deg (> " + std::to_string(options.max_pass_change_deg) +
+      next.reason = "pass " + std::to_string(pass) +
+                    ", with the overlap views placed by the pass before, moved a camera " + std::to_string(change) +
+                    " deg (> " + std::to_string(options.max_pass_change_deg) +
                     "): the overlaps do not determine the extrinsics";
     }
     last = std::move(next);
@@ -197,12 +200,14 @@ RingCalibrationReport RunRingPasses(const Rig& rig, const std::vector<Rigid3>& c
 // The ring passes, and when they fail and options.rescue is set, the rescue passes; a converged last
 // pass is averaged over options.placements view placements.
 RingCalibrationReport RunRingStage(const Rig& rig, const std::vector<Rigid3>& cam_from_rig,
-                                   const std::vector<std::vector<cv::Mat>>& shots, const std::vector<cv::Mat>& static_masks,
-                                   const StartupCalibrationOptions& options, bool quiet, StartupCalibrationReport* report) {
+                                   const std::vector<std::vector<cv::Mat>>& shots,
+                                   const std::vector<cv::Mat>& static_masks, const StartupCalibrationOptions& options,
+                                   bool quiet, StartupCalibrationReport* report) {
   StartupCalibrationOptions used = options;
   RingCalibrationReport ring = RunRingPasses(rig, cam_from_rig, shots, static_masks, used, quiet);
   if (!ring.converged && options.rescue) {
-    if (!quiet) std::fprintf(stderr, "vo online: start-up ring calibration failed; rescue with more and weaker features\n");
+    if (!quiet)
+      std::fprintf(stderr, "vo online: start-up ring calibration failed; rescue with more and weaker features\n");
     used.ring.orb_features = options.rescue_orb_features;
     used.ring.orb_fast_threshold = options.rescue_orb_fast_threshold;
     report->rescued = true;
@@ -260,27 +265,28 @@ nlohmann::json StartupCalibrationReport::ToJson() const {
   return {{"converged", converged},
           {"status", status},
           {"shots", shots},
-          {"ring", {{"converged", ring.converged},
-                    {"reason", ring.reason},
-                    {"loop_error_deg", ring.loop_error_deg},
-                    {"angle_scale", ring.angle_scale},
-                    {"common_turn_deg", ring.common_turn_deg},
-                    {"common_turn_sigma_deg", ring.common_turn_sigma_deg},
-                    {"centres_turned", ring.centres_turned},
-                    {"centres_known", ring.centres_known},
-                    {"uncertainty_deg", ring.uncertainty_deg},
-                    {"rescued", rescued},
-                    {"failure_before_rescue", ring_failure},
-                    {"placements_averaged", placements_averaged},
-                    {"placement_spread_deg", placement_spread_deg},
-                    {"pairs", pairs}}},
+          {"ring",
+           {{"converged", ring.converged},
+            {"reason", ring.reason},
+            {"loop_error_deg", ring.loop_error_deg},
+            {"angle_scale", ring.angle_scale},
+            {"common_turn_deg", ring.common_turn_deg},
+            {"common_turn_sigma_deg", ring.common_turn_sigma_deg},
+            {"centres_turned", ring.centres_turned},
+            {"centres_known", ring.centres_known},
+            {"uncertainty_deg", ring.uncertainty_deg},
+            {"rescued", rescued},
+            {"failure_before_rescue", ring_failure},
+            {"placements_averaged", placements_averaged},
+            {"placement_spread_deg", placement_spread_deg},
+            {"pairs", pairs}}},
           {"refinement_rounds", round_list},
           {"cam_from_rig", extrinsics}};
 }
 
 StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Rigid3>& cam_from_rig,
-                                            const std::function<LoadedFrame(int)>& load, int first_frame,
-                                            int end_frame, const std::vector<cv::Mat>& static_masks,
+                                            const std::function<LoadedFrame(int)>& load, int first_frame, int end_frame,
+                                            const std::vector<cv::Mat>& static_masks,
                                             const StartupCalibrationOptions& options, bool quiet) {
   const ScopedOpenCvThreads serial_opencv;  // another run's front-end may be in the same process
   StartupCalibrationReport report;
@@ -291,7 +297,8 @@ StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Ri
     if (frame >= end_frame) break;
     LoadedFrame loaded = load(frame);
     if (!loaded.missing_cameras.empty()) {
-      if (!quiet) std::fprintf(stderr, "vo online: start-up calibration skips frame %d: %s\n", frame, loaded.problems.c_str());
+      if (!quiet)
+        std::fprintf(stderr, "vo online: start-up calibration skips frame %d: %s\n", frame, loaded.problems.c_str());
       continue;
     }
     shots.push_back(std::move(loaded.images));
@@ -312,14 +319,16 @@ StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Ri
   }
   if (!report.ring.converged) {
     report.cam_from_rig = refined;
-    report.status = "ring stage failed (" + report.ring.reason + ")" +
-                    (options.refine ? "; the loose-filter refinement alone may be wrong" : "; starting extrinsics kept");
+    report.status =
+        "ring stage failed (" + report.ring.reason + ")" +
+        (options.refine ? "; the loose-filter refinement alone may be wrong" : "; starting extrinsics kept");
     return report;
   }
   const double moved = LargestChangeDeg(refined, start);
   if (moved > options.max_refine_change_deg) {
     report.cam_from_rig = start;
-    report.status = "refinement moved a camera " + std::to_string(moved) + " deg from the ring result; ring result kept";
+    report.status =
+        "refinement moved a camera " + std::to_string(moved) + " deg from the ring result; ring result kept";
     return report;
   }
   report.cam_from_rig = refined;

@@ -19,33 +19,32 @@
 // refinement runs alone from `fallback_prior_deg`, and the report says "not converged" with the
 // reason: the caller writes it to run.json and stderr.
 
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
 #include "datasets/rig.h"
 #include "datasets/rigid3.h"
 #include "vo/image_loader.h"
 #include "vo/ring_calibration.h"
 
-#include <nlohmann/json.hpp>
-#include <opencv2/core.hpp>
-
-#include <functional>
-#include <string>
-#include <vector>
-
 namespace rovo {
 
 struct StartupCalibrationOptions {
-  int shots = 1;                      // synchronous shots pooled by the ring stage
-  int shot_spacing = 10;              // frames between two shots
+  int shots = 1;          // synchronous shots pooled by the ring stage
+  int shot_spacing = 10;  // frames between two shots
   RingCalibrationOptions ring;
-  int ring_passes = 2;                // > 1: the ring stage again with views placed by the previous result
-  bool refine_second_pass = true;     // KLT sub-pixel matches in the later passes (their views are aligned)
+  int ring_passes = 2;             // > 1: the ring stage again with views placed by the previous result
+  bool refine_second_pass = true;  // KLT sub-pixel matches in the later passes (their views are aligned)
   // The later passes detect more and weaker corners (at least these) on denser views (up to
   // later_view_focal_px where the lenses hold it: RingCalibrationOptions::dense_view_focal_px): with
   // the views aligned, more matches make the result depend less on which corners were found.
   int later_orb_features = 6000;
   int later_orb_fast_threshold = 5;
   double later_view_focal_px = 450.0;
-  double max_pass_change_deg = 0.5;   // a later pass moving a camera further: not converged
+  double max_pass_change_deg = 0.5;  // a later pass moving a camera further: not converged
   // The last pass again from placements - 1 other view placements (every camera's turned by
   // placement_jitter_deg about a fixed axis), the converged results within max_pass_change_deg of the
   // first and with its lens decision (angle scale estimated or left at 1) averaged: which corners a
@@ -57,9 +56,9 @@ struct StartupCalibrationOptions {
   bool rescue = true;
   int rescue_orb_features = 6000;
   int rescue_orb_fast_threshold = 5;
-  bool refine = false;                // stage 2 (off: measured worse than the ring stage alone)
-  double refine_start_deg = 2.0;      // stage 2's first uncertainty after a converged ring stage
-  double fallback_prior_deg = 15.0;   // stage 2's first uncertainty when the ring stage fails
+  bool refine = false;               // stage 2 (off: measured worse than the ring stage alone)
+  double refine_start_deg = 2.0;     // stage 2's first uncertainty after a converged ring stage
+  double fallback_prior_deg = 15.0;  // stage 2's first uncertainty when the ring stage fails
   int refine_rounds = 6;
   // A refinement that moves a camera further than this from the ring stage's result is not trusted
   // (the ring result is kept and the report says so).
@@ -77,26 +76,26 @@ struct StartupRound {
 
 struct StartupCalibrationReport {
   bool converged = false;
-  std::string status;                 // "converged", or why not
-  std::vector<int> shots;             // frames used by the ring stage
+  std::string status;      // "converged", or why not
+  std::vector<int> shots;  // frames used by the ring stage
   // The ring passes' result (of the rescue when it ran). With placements averaged, cam_from_rig (as
   // cam_j_from_cam0 behind the first placement's camera 0) and angle_scale are their average; pairs,
   // loop error and uncertainty are the first placement's.
   RingCalibrationReport ring;
-  bool rescued = false;               // the ring passes failed and the rescue ran
-  std::string ring_failure;           // why the ring passes failed, when the rescue ran
-  int placements_averaged = 0;        // converged view placements averaged (StartupCalibrationOptions::placements)
-  double placement_spread_deg = -1.0; // largest angle of one of them from their mean (cam_j_from_cam0)
-  std::vector<StartupRound> rounds;   // stage 2
-  std::vector<Rigid3> cam_from_rig;   // the result (the start when nothing could be done)
+  bool rescued = false;                // the ring passes failed and the rescue ran
+  std::string ring_failure;            // why the ring passes failed, when the rescue ran
+  int placements_averaged = 0;         // converged view placements averaged (StartupCalibrationOptions::placements)
+  double placement_spread_deg = -1.0;  // largest angle of one of them from their mean (cam_j_from_cam0)
+  std::vector<StartupRound> rounds;    // stage 2
+  std::vector<Rigid3> cam_from_rig;    // the result (the start when nothing could be done)
   nlohmann::json ToJson() const;
 };
 
 // `rig`: lenses and names; `cam_from_rig`: the starting extrinsics. `load(frame)` returns a frame's
 // images; the shots are first_frame, first_frame + shot_spacing, ... below end_frame.
 StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Rigid3>& cam_from_rig,
-                                            const std::function<LoadedFrame(int)>& load, int first_frame,
-                                            int end_frame, const std::vector<cv::Mat>& static_masks,
+                                            const std::function<LoadedFrame(int)>& load, int first_frame, int end_frame,
+                                            const std::vector<cv::Mat>& static_masks,
                                             const StartupCalibrationOptions& options, bool quiet);
 
 }  // namespace rovo

@@ -1,12 +1,11 @@
 #include "vo/tracking.h"
 
-#include <opencv2/features2d.hpp>
-#include <opencv2/imgproc.hpp>
-#include <opencv2/video/tracking.hpp>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
 #include <stdexcept>
 
 namespace rovo {
@@ -235,10 +234,10 @@ void ViewTracker::DetectAndDescribe(const std::function<uint64_t()>& next_id) {
               [](const cv::KeyPoint& a, const cv::KeyPoint& b) { return a.response > b.response; });
     OccupancyGrid grid(image_.cols, image_.rows, options_.min_feature_distance_px);
     for (const TrackedPoint& p : points_) grid.Add(p.px);
-    const size_t limit = points_.empty() || options_.max_new_per_frame <= 0
-                             ? options_.target_features
-                             : std::min(options_.target_features,
-                                        static_cast<int>(points_.size()) + options_.max_new_per_frame);
+    const size_t limit =
+        points_.empty() || options_.max_new_per_frame <= 0
+            ? options_.target_features
+            : std::min(options_.target_features, static_cast<int>(points_.size()) + options_.max_new_per_frame);
     for (const cv::KeyPoint& kp : corners) {
       if (points_.size() >= limit) break;
       if (!MaskAt(detect_mask_, kp.pt) || !grid.Free(kp.pt)) continue;

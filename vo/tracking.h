@@ -9,26 +9,25 @@
 // Works on any 8-bit gray image with a validity mask: the hybrid-warped views, or (for the
 // projection study) the raw fisheye images.
 
-#include <opencv2/core.hpp>
-
 #include <cstdint>
 #include <functional>
+#include <opencv2/core.hpp>
 #include <vector>
 
 namespace rovo {
 
 struct TrackerOptions {
-  int target_features = 600;         // per view; re-detect when fewer are tracked
+  int target_features = 600;  // per view; re-detect when fewer are tracked
   // At most this many new detections per frame while the view has tracks (0: no limit, fill to
   // target_features). About four in five fresh detections die at their first KLT step (README, known limitations), so a
   // limit saves tracking work; a view without tracks (first frame, after a loss) still fills up.
   int max_new_per_frame = 0;
   float min_feature_distance_px = 12.0f;  // between any two features (detections and tracks)
-  int fast_threshold = 12;           // FAST-9 intensity threshold
-  int klt_window_px = 15;            // KLT window side (FrontendOptions explains the choice)
-  int klt_levels = 3;                // pyramid levels above the base
-  int klt_max_iterations = 20;       // LK iterations per pyramid level (at most)
-  float klt_epsilon_px = 0.03f;      // LK stops a level when its update is below this (pixels)
+  int fast_threshold = 12;                // FAST-9 intensity threshold
+  int klt_window_px = 15;                 // KLT window side (FrontendOptions explains the choice)
+  int klt_levels = 3;                     // pyramid levels above the base
+  int klt_max_iterations = 20;            // LK iterations per pyramid level (at most)
+  float klt_epsilon_px = 0.03f;           // LK stops a level when its update is below this (pixels)
   // Forward-backward check: the backward pass tracks the forward result back into the previous
   // image from scratch (all levels, no initial guess), and the track is kept when it lands within
   // this distance of where it started (FrontendOptions explains the value). Starting the backward
@@ -41,7 +40,7 @@ struct TrackerOptions {
   // levels. false: every track uses all levels from its position.
   bool klt_predict_flow = true;
   int klt_predicted_levels = 0;
-  int border_px = 20;                // features keep this distance from invalid pixels and image edges (ORB patch)
+  int border_px = 20;  // features keep this distance from invalid pixels and image edges (ORB patch)
   // ORB descriptors at angle 0 (upright BRIEF) instead of at the intensity-centroid orientation;
   // angle_deg is still computed (the inter-view orientation filter). Rectified-like views agree on
   // "up", so they need no rotation invariance; raw fisheye views do not agree.
@@ -55,7 +54,7 @@ struct TrackedPoint {
   cv::Point2f flow;     // displacement in the last Track (valid when age > 0)
   float angle_deg = 0;  // ORB orientation (intensity centroid), degrees in [0, 360)
   bool has_descriptor = false;
-  cv::Mat descriptor;   // 1x32 CV_8U (ORB), a view into ViewTracker's descriptor matrix
+  cv::Mat descriptor;  // 1x32 CV_8U (ORB), a view into ViewTracker's descriptor matrix
 };
 
 class ViewTracker {

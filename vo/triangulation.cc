@@ -1,10 +1,9 @@
 #include "vo/triangulation.h"
 
-#include "datasets/rigid3.h"
-
 #include <Eigen/Dense>
-
 #include <cmath>
+
+#include "datasets/rigid3.h"
 
 namespace rovo {
 
@@ -23,7 +22,8 @@ std::optional<TriangulatedPoint> TriangulateRays(const std::vector<Ray>& rays, c
   Eigen::Matrix3d lhs = Eigen::Matrix3d::Zero();
   Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
   for (const Ray& ray : rays) {
-    const Eigen::Matrix3d proj = Eigen::Matrix3d::Identity() - ray.direction_in_world * ray.direction_in_world.transpose();
+    const Eigen::Matrix3d proj =
+        Eigen::Matrix3d::Identity() - ray.direction_in_world * ray.direction_in_world.transpose();
     lhs += proj;
     rhs += proj * ray.origin_in_world;
   }

@@ -12,7 +12,6 @@
 //   error: every ray's angle to X below max_error_deg; distance: |X - o_k| <= max_distance.
 
 #include <Eigen/Core>
-
 #include <optional>
 #include <vector>
 
@@ -32,13 +31,14 @@ struct TriangulationOptions {
 
 struct TriangulatedPoint {
   Eigen::Vector3d point_in_world;
-  double parallax_deg = 0.0;     // largest pairwise angle between ray directions
-  double max_error_deg = 0.0;    // largest angular residual
+  double parallax_deg = 0.0;   // largest pairwise angle between ray directions
+  double max_error_deg = 0.0;  // largest angular residual
 };
 
-std::optional<TriangulatedPoint> TriangulateRays(const std::vector<Ray>& rays, const TriangulationOptions& options = {});
+std::optional<TriangulatedPoint> TriangulateRays(const std::vector<Ray>& rays,
+                                                 const TriangulationOptions& options = {});
 inline std::optional<TriangulatedPoint> TriangulateTwoRays(const Ray& a, const Ray& b,
-                                                            const TriangulationOptions& options = {}) {
+                                                           const TriangulationOptions& options = {}) {
   return TriangulateRays({a, b}, options);
 }
 

@@ -1,13 +1,12 @@
 // The `rovo` command: parses the command line and hands off to the parts' commands.
 
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
 #include "datasets/cli_groups.h"
 #include "eval/calibration_study.h"
 #include "rovo/version.h"
-
-#include <CLI/CLI.hpp>
-
-#include <cstdio>
-#include <exception>
 
 int main(int argc, char** argv) {
   CLI::App app{"rovo " ROVO_VERSION

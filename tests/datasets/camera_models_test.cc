@@ -2,16 +2,16 @@
 // FOV (including points behind the image plane) at several depths, in float and double, and the
 // templates instantiated with ceres::Jet.
 #include "datasets/camera_models.h"
-#include "datasets/ocam.h"
 
 #include <ceres/jet.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
-
 #include <cmath>
 #include <string>
 #include <vector>
+
+#include "datasets/ocam.h"
 
 namespace rovo {
 namespace {
@@ -30,12 +30,11 @@ struct ModelCase {
 // A lens that reaches 220 degrees on a 1600x1532 sensor, for each model.
 std::vector<ModelCase> Cases() {
   const double f_equidistant = 1600.0 / 2.0 / (110.0 * kDeg) * 0.95;
-  const Camera ocam_identity = MakeOcamCamera(1600, 1532, 811.7, 756.2, 1.0, 0.0, 0.0,
-                                              {-392.2, 0.0, 0.00127, -1.746e-6, 2.258e-9}, 220.0);
-  const Camera ocam_affine = MakeOcamCamera(1600, 1532, 811.661, 756.215, 0.999876, -2.91382e-4, -1.66556e-4,
-                                            {-392.21983020642324, 0.0, 0.0012707685299884767,
-                                             -1.7456026867522776e-6, 2.257655719602505e-9},
-                                            220.0);
+  const Camera ocam_identity =
+      MakeOcamCamera(1600, 1532, 811.7, 756.2, 1.0, 0.0, 0.0, {-392.2, 0.0, 0.00127, -1.746e-6, 2.258e-9}, 220.0);
+  const Camera ocam_affine = MakeOcamCamera(
+      1600, 1532, 811.661, 756.215, 0.999876, -2.91382e-4, -1.66556e-4,
+      {-392.21983020642324, 0.0, 0.0012707685299884767, -1.7456026867522776e-6, 2.257655719602505e-9}, 220.0);
   return {
       {"equidistant", CameraModelId::kEquidistant, {f_equidistant, f_equidistant, 799.5, 765.5, 0, 0, 0, 0}, 110, 1e-6},
       {"equidistant_k",
@@ -61,9 +60,12 @@ template <typename T>
 bool ImgFromCam(CameraModelId model, const std::vector<T>& params, const T* point, T* uv) {
   const int n = static_cast<int>(params.size());
   switch (model) {
-    case CameraModelId::kEquidistant: return EquidistantModel::ImgFromCam(params.data(), n, point, uv);
-    case CameraModelId::kDoubleSphere: return DoubleSphereModel::ImgFromCam(params.data(), n, point, uv);
-    case CameraModelId::kOcam: return OcamModel::ImgFromCam(params.data(), n, point, uv);
+    case CameraModelId::kEquidistant:
+      return EquidistantModel::ImgFromCam(params.data(), n, point, uv);
+    case CameraModelId::kDoubleSphere:
+      return DoubleSphereModel::ImgFromCam(params.data(), n, point, uv);
+    case CameraModelId::kOcam:
+      return OcamModel::ImgFromCam(params.data(), n, point, uv);
     case CameraModelId::kExtendedUnified:
       return ExtendedUnifiedModel::ImgFromCam(params.data(), n, point, uv);
   }
@@ -74,9 +76,12 @@ template <typename T>
 bool CamFromImg(CameraModelId model, const std::vector<T>& params, const T* uv, T* bearing) {
   const int n = static_cast<int>(params.size());
   switch (model) {
-    case CameraModelId::kEquidistant: return EquidistantModel::CamFromImg(params.data(), n, uv, bearing);
-    case CameraModelId::kDoubleSphere: return DoubleSphereModel::CamFromImg(params.data(), n, uv, bearing);
-    case CameraModelId::kOcam: return OcamModel::CamFromImg(params.data(), n, uv, bearing);
+    case CameraModelId::kEquidistant:
+      return EquidistantModel::CamFromImg(params.data(), n, uv, bearing);
+    case CameraModelId::kDoubleSphere:
+      return DoubleSphereModel::CamFromImg(params.data(), n, uv, bearing);
+    case CameraModelId::kOcam:
+      return OcamModel::CamFromImg(params.data(), n, uv, bearing);
     case CameraModelId::kExtendedUnified:
       return ExtendedUnifiedModel::CamFromImg(params.data(), n, uv, bearing);
   }
@@ -277,12 +282,12 @@ TEST(CameraModels, ExtendedUnifiedWithBetaOneIsTheUnifiedModel) {
 // Ocam against its definition, written out independently: the bearing of a pixel is
 // normalize(A^-1 (uv - c), -poly(rho)).
 TEST(CameraModels, OcamUnprojectFollowsTheDefinition) {
-  const std::vector<double> params = {811.661, 756.215, 0.999876, -2.91382e-4, -1.66556e-4,
-                                      -392.2, 0.0, 0.00127, -1.746e-6, 2.258e-9, 1.0};
+  const std::vector<double> params = {811.661, 756.215, 0.999876,  -2.91382e-4, -1.66556e-4, -392.2,
+                                      0.0,     0.00127, -1.746e-6, 2.258e-9,    1.0};
   Eigen::Matrix2d affine;
   affine << params[2], params[3], params[4], 1.0;
   for (const Eigen::Vector2d& uv : {Eigen::Vector2d(100.5, 700.0), Eigen::Vector2d(1500.0, 20.0),
-                                   Eigen::Vector2d(811.661, 756.215), Eigen::Vector2d(900.0, 1400.0)}) {
+                                    Eigen::Vector2d(811.661, 756.215), Eigen::Vector2d(900.0, 1400.0)}) {
     const Eigen::Vector2d xy = affine.inverse() * (uv - Eigen::Vector2d(params[0], params[1]));
     const double rho = xy.norm();
     const double poly = params[5] + params[7] * rho * rho + params[8] * std::pow(rho, 3) + params[9] * std::pow(rho, 4);

@@ -1,18 +1,18 @@
 // Tests of the Camera struct (camera.h): model names, FOV limit, projection with Jacobian against
 // numeric differentiation, unprojection validity, the valid-pixel mask and Check().
 #include "datasets/camera.h"
-#include "datasets/camera_models.h"
-#include "datasets/ocam.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
-
 #include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "datasets/camera_models.h"
+#include "datasets/ocam.h"
 
 namespace rovo {
 namespace {

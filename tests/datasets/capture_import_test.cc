@@ -1,13 +1,13 @@
 // Importing a real capture in the OmniMVS layout (shared/data/itbt_real: three synchronous shots of a
 // four-camera 220 deg rig, no ground-truth poses) as a dataset.
-#include "datasets/dataset.h"
-#include "datasets/io.h"
-#include "datasets/omnimvs.h"
-
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <string>
+
+#include "datasets/dataset.h"
+#include "datasets/io.h"
+#include "datasets/omnimvs.h"
 
 namespace rovo {
 namespace {
@@ -78,7 +78,8 @@ TEST(CaptureImport, StaticMasksAreCopiedAndValidated) {
   fs::create_directories(masks);
   // The capture's own images serve as masks of the right size (any 1-channel PNG is a mask).
   for (int c = 0; c < 4; ++c) {
-    fs::copy_file(kCapture + "/cam" + std::to_string(c + 1) + "/00001.png", masks + "/cam" + std::to_string(c) + ".png");
+    fs::copy_file(kCapture + "/cam" + std::to_string(c + 1) + "/00001.png",
+                  masks + "/cam" + std::to_string(c) + ".png");
   }
   ImportOmniMvsCapture(kCapture + "/config.yaml", kCapture, masks, out);
   EXPECT_TRUE(ReadDatasetInfo(out).has_static_masks);

@@ -1,16 +1,15 @@
 #include "datasets/dataset.h"
-#include "datasets/io.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-
-#include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <nlohmann/json.hpp>
 
-#include <unistd.h>
+#include "datasets/io.h"
 
 namespace rovo {
 namespace {
@@ -127,8 +126,11 @@ TEST(DatasetInfo, ReadErrorsNameFileAndField) {
   ExpectFieldError([](J& j) { j["rig"]["cameras"][3]["name"] = "cam0"; }, "/rig/cameras/3/name");
   ExpectFieldError([](J& j) { j["rig"]["cameras"][0]["cam_from_rig"]["rotation_xyzw"][3] = 2.0; },
                    "/rig/cameras/0/cam_from_rig/rotation_xyzw");
-  ExpectFieldError([](J& j) { j["rig"]["cameras"][0]["cam_from_rig"]["translation"] = J::array({1, 2}); },
-                   "/rig/cameras/0/cam_from_rig/translation");
+  ExpectFieldError(
+      [](J& j) {
+        j["rig"]["cameras"][0]["cam_from_rig"]["translation"] = J::array({1, 2});
+      },
+      "/rig/cameras/0/cam_from_rig/translation");
   ExpectFieldError([](J& j) { j["perturbed"][1]["cam_from_rig"].erase(0); }, "/perturbed/1/cam_from_rig");
   ExpectFieldError([](J& j) { j["perturbed"][0]["sigma_rotation_deg"] = -5; }, "/perturbed/0/sigma_rotation_deg");
 }

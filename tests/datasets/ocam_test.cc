@@ -3,13 +3,10 @@
 // cam2world (its row/column axes and backward z).
 #include "datasets/ocam.h"
 
-#include "datasets/camera_models.h"
-
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
-
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -17,13 +14,17 @@
 #include <string>
 #include <vector>
 
+#include "datasets/camera_models.h"
+
 namespace rovo {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
 // The real-rig-like lens of the issue: identity affine, centre (811.7, 756.2), 1600x1532, 220 deg.
-std::vector<double> RealRigForward() { return {811.7, 756.2, 1.0, 0.0, 0.0, -392.2, 0.0, 0.00127, -1.746e-6, 2.258e-9}; }
+std::vector<double> RealRigForward() {
+  return {811.7, 756.2, 1.0, 0.0, 0.0, -392.2, 0.0, 0.00127, -1.746e-6, 2.258e-9};
+}
 
 double AngleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), a.dot(b));
@@ -54,17 +55,21 @@ Eigen::Vector3d OcamCalibCam2World(double row, double col, const std::vector<dou
 }
 
 // The same direction in rovo's camera frame (x right = columns, y down = rows, z forward).
-Eigen::Vector3d RovoFromOcamCalib(const Eigen::Vector3d& ocam) { return Eigen::Vector3d(ocam.y(), ocam.x(), -ocam.z()); }
+Eigen::Vector3d RovoFromOcamCalib(const Eigen::Vector3d& ocam) {
+  return Eigen::Vector3d(ocam.y(), ocam.x(), -ocam.z());
+}
 
 // Local dtheta/drho of the forward model, to turn an elevation error into pixels independently of
 // the library's own error measure.
-double Elevation(const std::vector<double>& p, double rho) { return std::atan2(OcamModel::ForwardPoly(p.data(), rho), rho); }
+double Elevation(const std::vector<double>& p, double rho) {
+  return std::atan2(OcamModel::ForwardPoly(p.data(), rho), rho);
+}
 
 TEST(OcamFit, RealRigPolynomialReachesTheTolerance) {
   const std::vector<double> params = RealRigForward();
   const OcamInverseFit fit = FitOcamInversePolynomial(params, 220.0);
-  std::printf("real-rig fit: %zu coefficients, max %.5f px, rms %.5f px\n", fit.inverse_poly.size(),
-              fit.max_error_px, fit.rms_error_px);
+  std::printf("real-rig fit: %zu coefficients, max %.5f px, rms %.5f px\n", fit.inverse_poly.size(), fit.max_error_px,
+              fit.rms_error_px);
   EXPECT_LT(fit.max_error_px, 0.01);
   EXPECT_LE(fit.rms_error_px, fit.max_error_px);
   EXPECT_LE(fit.inverse_poly.size(), 21u);
@@ -95,9 +100,9 @@ TEST(OcamFit, DegreeCapReturnsTheBestFit) {
   EXPECT_EQ(fit.inverse_poly.size(), 5u);
   EXPECT_GT(fit.max_error_px, 0.01);
   EXPECT_LT(fit.max_error_px, 20.0);
-  EXPECT_THROW(MakeOcamCamera(1600, 1532, 811.7, 756.2, 1, 0, 0, {-392.2, 0.0, 0.00127, -1.746e-6, 2.258e-9}, 220.0,
-                              1e-9),
-               std::invalid_argument);
+  EXPECT_THROW(
+      MakeOcamCamera(1600, 1532, 811.7, 756.2, 1, 0, 0, {-392.2, 0.0, 0.00127, -1.746e-6, 2.258e-9}, 220.0, 1e-9),
+      std::invalid_argument);
 }
 
 // The inverse polynomials published with the real rig (OmniMVS config.yaml, numbers copied here)
@@ -107,12 +112,52 @@ TEST(OcamFit, PublishedInverseOfTheRealRigIsOffAndRefitRepairsIt) {
     std::vector<double> params;  // cx(col), cy(row), c, d, e, a0..a4, then the published b
   };
   const std::vector<PublishedCamera> cameras = {
-      {{811.661, 756.215, 0.999876, -2.91382E-4, -1.66556E-4, -392.21983020642324, 0.0, 0.0012707685299884767,
-        -1.7456026867522776E-6, 2.257655719602505E-9, 611.433, 386.965, -15.0504, -65.1466, -119.568, 27.7131,
-        355.781, 206.82, -667.654, -1290.67, -985.814, -361.63, -52.6566}},
-      {{817.845, 793.1, 1.00028, -0.032979, 0.0327437, -393.2636335626606, 0.0, 0.0013030161088532755,
-        -1.8689651365463267E-6, 2.3792432009042225E-9, 611.562, 383.54, -22.3448, -47.6112, -41.6246, 10.0601,
-        -37.4865, -278.722, -487.074, -433.682, -222.271, -63.4335, -7.90549}},
+      {{811.661,
+        756.215,
+        0.999876,
+        -2.91382E-4,
+        -1.66556E-4,
+        -392.21983020642324,
+        0.0,
+        0.0012707685299884767,
+        -1.7456026867522776E-6,
+        2.257655719602505E-9,
+        611.433,
+        386.965,
+        -15.0504,
+        -65.1466,
+        -119.568,
+        27.7131,
+        355.781,
+        206.82,
+        -667.654,
+        -1290.67,
+        -985.814,
+        -361.63,
+        -52.6566}},
+      {{817.845,
+        793.1,
+        1.00028,
+        -0.032979,
+        0.0327437,
+        -393.2636335626606,
+        0.0,
+        0.0013030161088532755,
+        -1.8689651365463267E-6,
+        2.3792432009042225E-9,
+        611.562,
+        383.54,
+        -22.3448,
+        -47.6112,
+        -41.6246,
+        10.0601,
+        -37.4865,
+        -278.722,
+        -487.074,
+        -433.682,
+        -222.271,
+        -63.4335,
+        -7.90549}},
   };
   for (const PublishedCamera& camera : cameras) {
     const double published_error = OcamInverseMaxErrorPx(camera.params, 220.0);
@@ -151,7 +196,8 @@ TEST(OcamFit, RejectsInvalidForwardModels) {
 }
 
 TEST(OcamCamera, MakeOcamCameraBuildsACheckedCamera) {
-  const Camera camera = MakeOcamCamera(1600, 1532, 811.7, 756.2, 1.0, 0.0, 0.0, {-392.2, 0.0, 0.00127, -1.746e-6, 2.258e-9});
+  const Camera camera =
+      MakeOcamCamera(1600, 1532, 811.7, 756.2, 1.0, 0.0, 0.0, {-392.2, 0.0, 0.00127, -1.746e-6, 2.258e-9});
   EXPECT_EQ(camera.model, CameraModelId::kOcam);
   EXPECT_EQ(camera.width, 1600);
   EXPECT_EQ(camera.height, 1532);
@@ -301,8 +347,8 @@ TEST(OcamCalibReader, AccurateInverseInTheFileIsKept) {
   const std::vector<double> params = RealRigForward();
   const OcamInverseFit fit = FitOcamInversePolynomial(params, 220.0, 0.001);
   ASSERT_LT(fit.max_error_px, 0.001);
-  std::string text = "# cam2world\n5 -392.2 0 0.00127 -1.746e-6 2.258e-9\n# world2cam\n" +
-                     std::to_string(fit.inverse_poly.size());
+  std::string text =
+      "# cam2world\n5 -392.2 0 0.00127 -1.746e-6 2.258e-9\n# world2cam\n" + std::to_string(fit.inverse_poly.size());
   char number[64];
   for (double b : fit.inverse_poly) {
     std::snprintf(number, sizeof(number), " %.17g", b);

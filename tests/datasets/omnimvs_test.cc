@@ -1,16 +1,16 @@
-#include "datasets/io.h"
-#include "datasets/ocam.h"
 #include "datasets/omnimvs.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <sstream>
 
-#include <unistd.h>
+#include "datasets/io.h"
+#include "datasets/ocam.h"
 
 namespace rovo {
 namespace {
@@ -72,8 +72,8 @@ TEST(OmniMvs, PixelBearingsMatchTheFileConvention) {
   // Camera 2 of the file (cam1 here) has the largest skew (d = -0.033, e = 0.033).
   const double center[2] = {793.1, 817.845};
   const double affine[3] = {1.00028, -0.032979, 0.0327437};
-  const double poly[5] = {-393.2636335626606, 0.0, 0.0013030161088532755,
-                          -1.8689651365463267E-6, 2.3792432009042225E-9};
+  const double poly[5] = {-393.2636335626606, 0.0, 0.0013030161088532755, -1.8689651365463267E-6,
+                          2.3792432009042225E-9};
   const Camera& camera = rig.cameras[1].camera;
   for (double col : {100.0, 500.0, 817.845, 1000.0, 1500.0}) {
     for (double row : {80.0, 400.0, 793.1, 1100.0, 1450.0}) {
@@ -111,13 +111,14 @@ TEST(OmniMvs, FrameChangeMapsFileAxesToRep103) {
   EXPECT_NEAR(m.determinant(), 1.0, 1e-15);
   EXPECT_TRUE((m * Eigen::Vector3d(0, 1, 0)).isApprox(Eigen::Vector3d(0, 0, -1)));  // file y (down) -> -z
   // File camera 1: cam2rig rotation vector and translation from the yaml.
-  const Rigid3 file_rig_from_cam = Rigid3::FromAxisAngle(
-      Eigen::Vector3d(0.05287133304667693, 0.7411561834637101, 0.02981358273057615),
-      Eigen::Vector3d(0.1485451015397448, -6.40692965168468E-5, 0.14722476953097846));
+  const Rigid3 file_rig_from_cam =
+      Rigid3::FromAxisAngle(Eigen::Vector3d(0.05287133304667693, 0.7411561834637101, 0.02981358273057615),
+                            Eigen::Vector3d(0.1485451015397448, -6.40692965168468E-5, 0.14722476953097846));
   const Rig rig = ReadOmniMvsConfig(kConfig, nullptr);
   const Rigid3& cam_from_rig = rig.cameras[0].cam_from_rig;
   EXPECT_TRUE(CameraPositionInRig(cam_from_rig).isApprox(m * file_rig_from_cam.translation, 1e-12));
-  EXPECT_TRUE(CameraAxisInRig(cam_from_rig).isApprox(m * (file_rig_from_cam.rotation * Eigen::Vector3d::UnitZ()), 1e-12));
+  EXPECT_TRUE(
+      CameraAxisInRig(cam_from_rig).isApprox(m * (file_rig_from_cam.rotation * Eigen::Vector3d::UnitZ()), 1e-12));
   // A point seen by the camera maps consistently through both frames.
   const Eigen::Vector3d point_in_file_rig(3.0, -0.5, 2.0);
   const Eigen::Vector3d in_cam_direct = file_rig_from_cam.Inverse() * point_in_file_rig;

@@ -1,4 +1,3 @@
-#include "datasets/ocam.h"
 #include "datasets/rig.h"
 
 #include <gmock/gmock.h>
@@ -6,6 +5,8 @@
 
 #include <cmath>
 #include <cstring>
+
+#include "datasets/ocam.h"
 
 namespace rovo {
 namespace {
@@ -225,7 +226,8 @@ TEST(PerturbExtrinsics, DeterministicAndRecorded) {
               0);
     EXPECT_GT(RotationDistanceDeg(a.cam_from_rig[i].rotation, c.cam_from_rig[i].rotation), 1e-6);
     // Rotation-only noise keeps the camera centre.
-    EXPECT_TRUE(CameraPositionInRig(a.cam_from_rig[i]).isApprox(CameraPositionInRig(rig.cameras[i].cam_from_rig), 1e-12));
+    EXPECT_TRUE(
+        CameraPositionInRig(a.cam_from_rig[i]).isApprox(CameraPositionInRig(rig.cameras[i].cam_from_rig), 1e-12));
     EXPECT_GT(RotationDistanceDeg(a.cam_from_rig[i].rotation, rig.cameras[i].cam_from_rig.rotation), 1e-3);
   }
   // Fixed by the algorithm (mt19937_64 + Box-Muller, draw order of FORMAT.md), not by the standard

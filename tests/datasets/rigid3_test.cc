@@ -42,8 +42,7 @@ TEST(Rigid3, AxisAngleRoundTrip) {
   EXPECT_TRUE(b_from_a.AxisAngle().isApprox(rotation_vector, 1e-12));
   EXPECT_NEAR(RotationAngleDeg(b_from_a.rotation), rotation_vector.norm() * 180.0 / M_PI, 1e-10);
   // Zero vector gives the identity.
-  EXPECT_LT(RotationAngleDeg(Rigid3::FromAxisAngle(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()).rotation),
-            1e-12);
+  EXPECT_LT(RotationAngleDeg(Rigid3::FromAxisAngle(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()).rotation), 1e-12);
   // 90 degrees about z maps x to y.
   const Rigid3 rz = Rigid3::FromAxisAngle(Eigen::Vector3d(0, 0, M_PI / 2), Eigen::Vector3d::Zero());
   EXPECT_TRUE((rz * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitY(), 1e-12));

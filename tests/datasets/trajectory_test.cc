@@ -1,15 +1,15 @@
-#include "datasets/io.h"
 #include "datasets/trajectory.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstring>
 #include <filesystem>
 #include <random>
 #include <sstream>
 
-#include <unistd.h>
+#include "datasets/io.h"
 
 namespace rovo {
 namespace {
@@ -50,7 +50,8 @@ TEST(Tum, RoundTripIsBitExact) {
       EXPECT_TRUE(BitEqual(read[i].world_from_rig.translation[k], written[i].world_from_rig.translation[k]));
     }
     for (int k = 0; k < 4; ++k) {
-      EXPECT_TRUE(BitEqual(read[i].world_from_rig.rotation.coeffs()[k], written[i].world_from_rig.rotation.coeffs()[k]));
+      EXPECT_TRUE(
+          BitEqual(read[i].world_from_rig.rotation.coeffs()[k], written[i].world_from_rig.rotation.coeffs()[k]));
     }
   }
   // Writing again gives the same bytes (deterministic output).

@@ -1,11 +1,6 @@
 // The suite's plan of tasks, perturbation draws, and `rovo batch` (folder, status, resume plan)
 // without Slurm; tests/eval/integration/slurm_batch_test.sh runs it on a real Slurm.
 #include "eval/batch.h"
-#include "eval/suite.h"
-#include "scenes/city.h"
-
-#include "datasets/io.h"
-#include "datasets/run.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -13,6 +8,11 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+
+#include "datasets/io.h"
+#include "datasets/run.h"
+#include "eval/suite.h"
+#include "scenes/city.h"
 
 namespace rovo {
 namespace {

@@ -1,6 +1,6 @@
-#include "eval/plots.h"
-
 #include <gtest/gtest.h>
+
+#include "eval/plots.h"
 
 namespace rovo {
 namespace {

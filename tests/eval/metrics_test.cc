@@ -242,10 +242,9 @@ TEST(Extrinsics, ErrorRelativeToCameraZeroIgnoresCommonRigMotion) {
   ASSERT_EQ(errors.size(), 9u);
   // cam2_from_cam0 estimated = offset * gt: the translation moves by R_offset t_gt + 0.05 z - t_gt.
   const Rigid3 gt_cam2_from_cam0 = gt[2] * gt[0].Inverse();
-  const double expected_translation =
-      (QuaternionFromRollPitchYawDeg(1, 0, 0) * gt_cam2_from_cam0.translation + Eigen::Vector3d(0, 0, 0.05) -
-       gt_cam2_from_cam0.translation)
-          .norm();
+  const double expected_translation = (QuaternionFromRollPitchYawDeg(1, 0, 0) * gt_cam2_from_cam0.translation +
+                                       Eigen::Vector3d(0, 0, 0.05) - gt_cam2_from_cam0.translation)
+                                          .norm();
   EXPECT_GT(expected_translation, 0.04);
   for (const ExtrinsicError& e : errors) {
     const bool off = e.camera == 2 && e.frame < 2;
@@ -279,11 +278,12 @@ TEST(EvaluateRun, SummarisesFramesAndExtrinsics) {
     f.time_ms = 10.0;
     run.frames.push_back(f);
   }
-  const std::vector<Rigid3> gt_ext = {Rigid3(), Rigid3(QuaternionFromRollPitchYawDeg(0, 0, 90), Eigen::Vector3d(1, 0, 0))};
+  const std::vector<Rigid3> gt_ext = {Rigid3(),
+                                      Rigid3(QuaternionFromRollPitchYawDeg(0, 0, 90), Eigen::Vector3d(1, 0, 0))};
   for (int i = 0; i < 20; ++i) {
     run.extrinsics.push_back({i, i * 0.1, 0, gt_ext[0]});
-    run.extrinsics.push_back({i, i * 0.1, 1,
-                              Rigid3(QuaternionFromRollPitchYawDeg(0, 0, 90.0 + (19 - i) * 0.1), Eigen::Vector3d(1, 0, 0))});
+    run.extrinsics.push_back(
+        {i, i * 0.1, 1, Rigid3(QuaternionFromRollPitchYawDeg(0, 0, 90.0 + (19 - i) * 0.1), Eigen::Vector3d(1, 0, 0))});
   }
   const RunEvaluation e = EvaluateRun(gt, gt_ext, run, "r");
   const RunMetrics& m = e.metrics;

@@ -1,13 +1,14 @@
 // EvaluateAndReport over a synthetic dataset (dataset.json + groundtruth.tum, no images) and runs.
-#include "datasets/dataset.h"
-#include "datasets/io.h"
-#include "datasets/run.h"
 #include "eval/report.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
+
+#include "datasets/dataset.h"
+#include "datasets/io.h"
+#include "datasets/run.h"
 
 namespace rovo {
 namespace {

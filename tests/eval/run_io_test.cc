@@ -1,12 +1,12 @@
-#include "datasets/io.h"
-#include "datasets/run.h"
-
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include "datasets/io.h"
+#include "datasets/run.h"
 
 namespace rovo {
 namespace {
@@ -15,8 +15,9 @@ namespace fs = std::filesystem;
 class RunIoTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = (fs::temp_directory_path() / ("rovo_run_io_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-                                         "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name()))
+    dir_ = (fs::temp_directory_path() /
+            ("rovo_run_io_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+             ::testing::UnitTest::GetInstance()->current_test_info()->name()))
                .string();
     fs::remove_all(dir_);
   }
@@ -40,8 +41,8 @@ class RunIoTest : public ::testing::Test {
       f.time_ms = 12.5;
       run.frames.push_back(f);
       for (int c = 0; c < 2; ++c) {
-        run.extrinsics.push_back({i, 0.1 * i, c,
-                                  Rigid3::FromAxisAngle(Eigen::Vector3d(0.3 * c, -0.1, 0.7), Eigen::Vector3d(c, 0.1, 1e-7))});
+        run.extrinsics.push_back(
+            {i, 0.1 * i, c, Rigid3::FromAxisAngle(Eigen::Vector3d(0.3 * c, -0.1, 0.7), Eigen::Vector3d(c, 0.1, 1e-7))});
       }
     }
     return run;
@@ -96,9 +97,10 @@ TEST_F(RunIoTest, RoundTripIsExact) {
   const std::string ext = ReadFile(RunExtrinsicsPath(dir_));
   EXPECT_EQ(ext.substr(0, ext.find('\n')), "frame,timestamp,camera,qx,qy,qz,qw,tx,ty,tz");
   const std::string frames = ReadFile(RunFramesPath(dir_));
-  EXPECT_EQ(frames.substr(0, frames.find('\n')),
-            "frame,timestamp,num_correspondences,num_inliers,inlier_ratio,mean_reproj_error_deg,keyframe,status,time_ms,"
-            "missing_cameras");
+  EXPECT_EQ(
+      frames.substr(0, frames.find('\n')),
+      "frame,timestamp,num_correspondences,num_inliers,inlier_ratio,mean_reproj_error_deg,keyframe,status,time_ms,"
+      "missing_cameras");
   // No temporary files left behind.
   for (const auto& entry : fs::directory_iterator(dir_)) {
     EXPECT_EQ(entry.path().string().find(".tmp."), std::string::npos) << entry.path();

@@ -1,14 +1,13 @@
-#include "eval/gate.h"
-#include "eval/suite.h"
-
-#include "datasets/io.h"
-#include "datasets/run.h"
-
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
+
+#include "datasets/io.h"
+#include "datasets/run.h"
+#include "eval/gate.h"
+#include "eval/suite.h"
 
 namespace rovo {
 namespace {
@@ -43,8 +42,8 @@ std::string WriteRunFolder(const nlohmann::json& info) {
   const fs::path dir = fs::temp_directory_path() / ("rovo_suite_resume_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
-  for (const std::string& file : {RunTrajectoryPath(dir.string()), RunFramesPath(dir.string()),
-                                  RunExtrinsicsPath(dir.string())}) {
+  for (const std::string& file :
+       {RunTrajectoryPath(dir.string()), RunFramesPath(dir.string()), RunExtrinsicsPath(dir.string())}) {
     std::ofstream(file) << "\n";
   }
   std::ofstream(RunInfoPath(dir.string())) << info.dump();
@@ -52,7 +51,7 @@ std::string WriteRunFolder(const nlohmann::json& info) {
 }
 
 TEST(Suite, ReusesOnlyRunsMadeWithTheSameSettings) {
-  nlohmann::json info = {{"mode", "online"}, {"dataset", "/data/x"}, {"frames", {0, 60}}, {"noise_set", 1},
+  nlohmann::json info = {{"mode", "online"}, {"dataset", "/data/x"},   {"frames", {0, 60}}, {"noise_set", 1},
                          {"seed", 0},        {"max_new_features", 150}};
   RunSettings want;
   want.mode = ExtrinsicsMode::kOnline;
@@ -120,10 +119,10 @@ TEST(Suite, SummariseModesAggregatesOverNoiseSets) {
 TEST(Suite, TableShowsOursAndThePapersRelativeError) {
   const std::string md = SuiteTableMarkdown(SamplePresets(), true);
   EXPECT_NE(md.find("Cloudy Urban (`cloudy_urban`) quick"), std::string::npos) << md;
-  EXPECT_NE(md.find("4.000 ± 1.414"), std::string::npos) << md;            // NoisyExt RMSE mean ± std
-  EXPECT_NE(md.find("12.08 / 0.409 / 0.120"), std::string::npos) << md;    // paper: 42.28, 1.43, 0.42 of 350 m
-  EXPECT_NE(md.find("4.00 / 0.300 / 0.100"), std::string::npos) << md;     // ours, relative
-  EXPECT_NE(md.find("61.0 / 70.0"), std::string::npos) << md;              // inliers Online / GT
+  EXPECT_NE(md.find("4.000 ± 1.414"), std::string::npos) << md;          // NoisyExt RMSE mean ± std
+  EXPECT_NE(md.find("12.08 / 0.409 / 0.120"), std::string::npos) << md;  // paper: 42.28, 1.43, 0.42 of 350 m
+  EXPECT_NE(md.find("4.00 / 0.300 / 0.100"), std::string::npos) << md;   // ours, relative
+  EXPECT_NE(md.find("61.0 / 70.0"), std::string::npos) << md;            // inliers Online / GT
   EXPECT_NE(md.find("Umeyama"), std::string::npos) << md;
   ASSERT_TRUE(PaperRowForPreset("canyon_multifov").has_value());
   EXPECT_EQ(PaperRowForPreset("canyon_multifov")->length_m, 440.0);
@@ -142,9 +141,9 @@ TEST(Suite, TableSaysWhenARunHasNoValue) {
   p.modes = SummariseModes({Metrics("gt", -1, 0.1, 0.7), Metrics("noisy", 0, 3.0, 0.4), Metrics("noisy", 1, 5.0, 0.5),
                             lost, Metrics("online", 0, 0.2, 0.6)});
   const std::string md = SuiteTableMarkdown({p}, true);
-  EXPECT_NE(md.find("4.000 ± 1.414 (2 of 3 runs)"), std::string::npos) << md;  // NoisyExt RMSE
+  EXPECT_NE(md.find("4.000 ± 1.414 (2 of 3 runs)"), std::string::npos) << md;         // NoisyExt RMSE
   EXPECT_NE(md.find("4.00 (2 of 3 runs) / 0.200 / 0.100"), std::string::npos) << md;  // relative
-  EXPECT_EQ(md.find("of 1 runs"), std::string::npos) << md;  // complete modes carry no count
+  EXPECT_EQ(md.find("of 1 runs"), std::string::npos) << md;                           // complete modes carry no count
 }
 
 nlohmann::json SampleSuiteJson() {
@@ -154,10 +153,11 @@ nlohmann::json SampleSuiteJson() {
 }
 
 TEST(Gate, PassesAndFailsOnThresholds) {
-  nlohmann::json gates = {{"gates",
-                           {{{"preset", "cloudy_urban"}, {"mode", "gt"}, {"metric", "relative_rmse_pct"}, {"max", 0.2}},
-                            {{"preset", "cloudy_urban"}, {"mode", "online"}, {"metric", "mean_inlier_ratio"}, {"min", 0.5}},
-                            {{"preset", "cloudy_urban"}, {"mode", "noisy"}, {"metric", "relative_rmse_pct"}, {"min", 1.0}}}}};
+  nlohmann::json gates = {
+      {"gates",
+       {{{"preset", "cloudy_urban"}, {"mode", "gt"}, {"metric", "relative_rmse_pct"}, {"max", 0.2}},
+        {{"preset", "cloudy_urban"}, {"mode", "online"}, {"metric", "mean_inlier_ratio"}, {"min", 0.5}},
+        {{"preset", "cloudy_urban"}, {"mode", "noisy"}, {"metric", "relative_rmse_pct"}, {"min", 1.0}}}}};
   const nlohmann::json suite = SampleSuiteJson();
   std::vector<GateCheck> checks = CheckGates(gates, "gates.json", suite);
   ASSERT_EQ(checks.size(), 3u);
@@ -191,8 +191,7 @@ TEST(Gate, MalformedGateNamesTheEntry) {
     return std::string();
   };
   EXPECT_NE(error({{"nogates", 1}}).find("ci/gates.json: missing array field \"gates\""), std::string::npos);
-  const nlohmann::json bad_metric = {
-      {"gates", {{{"preset", "p"}, {"mode", "gt"}, {"metric", "speed"}, {"max", 1}}}}};
+  const nlohmann::json bad_metric = {{"gates", {{{"preset", "p"}, {"mode", "gt"}, {"metric", "speed"}, {"max", 1}}}}};
   EXPECT_NE(error(bad_metric).find("gates[0]: field \"metric\""), std::string::npos) << error(bad_metric);
   const nlohmann::json both = {
       {"gates", {{{"preset", "p"}, {"mode", "gt"}, {"metric", "rmse_se3_m"}, {"max", 1}, {"min", 0}}}}};

@@ -6,14 +6,13 @@
 // in masks): 1 floor z=0, 2 ceiling z=3, 3 wall x=-4, 4 wall x=+4, 5 wall y=-3, 6 wall y=+3.
 // Mover (id 7): axis-aligned cube of half-size 0.3 m centred at MoverCentre(frame).
 
-#include "datasets/rig.h"
-#include "scenes/scene.h"
-
 #include <Eigen/Core>
-
 #include <cmath>
 #include <limits>
 #include <string>
+
+#include "datasets/rig.h"
+#include "scenes/scene.h"
 
 namespace rovo::testing {
 
@@ -113,7 +112,8 @@ inline Scene MakeBoxScene(int frames, bool with_mover) {
     obj.name = "mover";
     obj.mesh = 6;
     obj.id = 7;
-    for (int i = 0; i < frames; ++i) obj.world_from_object_per_frame.push_back(Rigid3(Eigen::Quaterniond::Identity(), MoverCentre(i)));
+    for (int i = 0; i < frames; ++i)
+      obj.world_from_object_per_frame.push_back(Rigid3(Eigen::Quaterniond::Identity(), MoverCentre(i)));
     scene.objects.push_back(obj);
   }
   scene.lighting.direction_to_sun = Eigen::Vector3d(0.3, 0.2, 0.9);
@@ -121,7 +121,8 @@ inline Scene MakeBoxScene(int frames, bool with_mover) {
   for (int i = 0; i < frames; ++i) {
     StampedPose pose;
     pose.timestamp = i / scene.frame_rate;
-    pose.world_from_rig = Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(0.05 * i, Eigen::Vector3d::UnitZ())), RigPosition(i));
+    pose.world_from_rig =
+        Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(0.05 * i, Eigen::Vector3d::UnitZ())), RigPosition(i));
     scene.rig_trajectory.push_back(pose);
   }
   return scene;

@@ -3,9 +3,9 @@
 // low in front of the rig (+x, 20 degrees up). The omnimvs4 rig (cam0 looks along +x, cam2 along
 // -x) stands at 1.5 m and moves 0.5 m per frame along +y: cam0 sees the sun, cam2 does not.
 
-#include "tests/render/box_scene.h"
-
 #include <cmath>
+
+#include "tests/render/box_scene.h"
 
 namespace rovo::testing {
 

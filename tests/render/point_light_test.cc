@@ -1,15 +1,14 @@
 // Point and spot lights, emission and the Blinn-Phong highlight against the formula of
 // render/tracer.h, on a plane seen from above with no sun, sky or ambient light.
-#include "render/texture.h"
-#include "render/tracer.h"
-
-#include "datasets/rig.h"
-#include "tests/render/box_scene.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+
+#include "datasets/rig.h"
+#include "render/texture.h"
+#include "render/tracer.h"
+#include "tests/render/box_scene.h"
 
 namespace rovo {
 namespace {

@@ -1,14 +1,13 @@
 // RenderDataset on a small saved box scene: outputs, resume, shards, threads, bad input.
-#include "render/render.h"
-
-#include "datasets/dataset.h"
-#include "datasets/io.h"
-#include "tests/render/box_scene.h"
-
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <map>
+
+#include "datasets/dataset.h"
+#include "datasets/io.h"
+#include "render/render.h"
+#include "tests/render/box_scene.h"
 
 namespace rovo {
 namespace {
@@ -17,9 +16,8 @@ namespace fs = std::filesystem;
 class RenderDatasetTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    root_ = fs::temp_directory_path() /
-            ("rovo_render_test_" + std::to_string(::getpid()) + "_" +
-             ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    root_ = fs::temp_directory_path() / ("rovo_render_test_" + std::to_string(::getpid()) + "_" +
+                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(root_);
     fs::create_directories(root_);
     scene_dir_ = (root_ / "scene").string();
@@ -76,7 +74,8 @@ TEST_F(RenderDatasetTest, WritesACompleteReadableDataset) {
   EXPECT_FALSE(info.scene_hash.empty());
   EXPECT_EQ(ReadTum(GroundTruthPath(options.out_dir)).size(), static_cast<size_t>(kFrames));
   const std::vector<ValidationIssue> issues = ValidateDataset(options.out_dir);
-  for (const ValidationIssue& issue : issues) ADD_FAILURE() << issue.file << " " << issue.field << ": " << issue.message;
+  for (const ValidationIssue& issue : issues)
+    ADD_FAILURE() << issue.file << " " << issue.field << ": " << issue.message;
   for (int f = 0; f < kFrames; ++f) EXPECT_TRUE(FrameComplete(options.out_dir, info.rig, f, true, true));
   // No temporary files left behind.
   for (const auto& [path, content] : Files(options.out_dir)) EXPECT_EQ(path.find(".tmp."), std::string::npos) << path;

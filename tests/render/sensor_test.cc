@@ -3,6 +3,17 @@
 // the dataset record and exposure.csv; `rovo render --sensor` end to end on small scenes.
 #include "render/sensor.h"
 
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+
 #include "datasets/dataset.h"
 #include "datasets/io.h"
 #include "render/render.h"
@@ -10,18 +21,6 @@
 #include "render/tracer.h"
 #include "tests/render/box_scene.h"
 #include "tests/render/open_scene.h"
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-#include <OpenImageIO/imageio.h>
-#include <tbb/task_arena.h>
-
-#include <cmath>
-#include <cstdlib>
-#include <filesystem>
-#include <map>
-
-#include <unistd.h>
 
 namespace rovo {
 namespace {
@@ -635,7 +634,8 @@ TEST_F(SensorDatasetTest, RealisticProfileSetsSensorAndTimingUnlessOverridden) {
   const std::string out = (root_ / "realistic").string();
   const std::string command = std::string(ROVO_BINARY) + " render --scene " + scene_dir_ + " --out " + out +
                               " --rig omnimvs4 --scale 0.1 --spp 1 --frames 0:2 --quiet --realistic "
-                              "--rolling-shutter-ms 5 > " + (root_ / "log.txt").string() + " 2>&1";
+                              "--rolling-shutter-ms 5 > " +
+                              (root_ / "log.txt").string() + " 2>&1";
   ASSERT_EQ(std::system(command.c_str()), 0) << ReadFile((root_ / "log.txt").string());
   const DatasetInfo info = ReadDatasetInfo(out);
   ASSERT_TRUE(info.sensor.has_value());

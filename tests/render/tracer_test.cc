@@ -1,12 +1,12 @@
 #include "render/tracer.h"
 
-#include "datasets/rig.h"
-#include "tests/render/box_scene.h"
-
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
 #include <cmath>
+
+#include "datasets/rig.h"
+#include "tests/render/box_scene.h"
 
 namespace rovo {
 namespace {
@@ -169,17 +169,17 @@ TEST(TracerTest, DynamicObjectFollowsItsPerFrameTransform) {
     int mover_pixels = 0;
     for (size_t i = 0; i < image.mask.size(); ++i) {
       if (!rays.valid[i]) continue;
-      const Eigen::Vector3d dir = world_from_cam.rotation * rays.camera.Unproject(
-                                                                 Eigen::Vector2d(i % camera.width, i / camera.width))
-                                                                 .value();
+      const Eigen::Vector3d dir =
+          world_from_cam.rotation * rays.camera.Unproject(Eigen::Vector2d(i % camera.width, i / camera.width)).value();
       double t_room = 0, t_cube = 0;
       int face = 0;
       ASSERT_TRUE(IntersectRoom(world_from_cam.translation, dir, &t_room, &face));
-      const bool cube = IntersectCube(world_from_cam.translation, dir, testing::MoverCentre(frame),
-                                      testing::kMoverHalf, &t_cube) &&
-                        t_cube < t_room;
+      const bool cube =
+          IntersectCube(world_from_cam.translation, dir, testing::MoverCentre(frame), testing::kMoverHalf, &t_cube) &&
+          t_cube < t_room;
       const double t = cube ? t_cube : t_room;
-      EXPECT_NEAR(image.depth[i], t, 1e-3) << "frame " << frame << " pixel " << i % camera.width << "," << i / camera.width << " cube " << cube;
+      EXPECT_NEAR(image.depth[i], t, 1e-3)
+          << "frame " << frame << " pixel " << i % camera.width << "," << i / camera.width << " cube " << cube;
       if (cube && std::abs(image.depth[i] - t) < 1e-3) {
         EXPECT_EQ(image.mask[i], 7);
         ++mover_pixels;

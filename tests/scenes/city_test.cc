@@ -1,12 +1,7 @@
-#include "datasets/io.h"
 #include "scenes/city.h"
-#include "scenes/city_layout.h"
-#include "scenes/rng.h"
-#include "scenes/texture_gen.h"
-
-#include "tests/scenes/scratch_dir.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -16,7 +11,11 @@
 #include <set>
 #include <string>
 
-#include <unistd.h>
+#include "datasets/io.h"
+#include "scenes/city_layout.h"
+#include "scenes/rng.h"
+#include "scenes/texture_gen.h"
+#include "tests/scenes/scratch_dir.h"
 
 namespace rovo {
 namespace {
@@ -49,7 +48,8 @@ TEST(GenerateScene, SameSeedSameHashAndBytes) {
   const std::string da = FreshDir("det_a"), db = FreshDir("det_b");
   SaveScene(a, da);
   SaveScene(b, db);
-  for (const char* f : {"scene.json", "geometry.bin", "motion.bin", "trajectory.tum", "textures/000.png", "textures/012.png"}) {
+  for (const char* f :
+       {"scene.json", "geometry.bin", "motion.bin", "trajectory.tum", "textures/000.png", "textures/012.png"}) {
     EXPECT_EQ(ReadFile(da + "/" + f), ReadFile(db + "/" + f)) << f;
   }
   // The saved scene loads back to the same content.
@@ -69,7 +69,8 @@ TEST(GenerateScene, DifferentSeedsDiffer) {
   const CityLayout la = MakeCityLayout(FindScenePreset("static_urban"), 1, false);
   const CityLayout lb = MakeCityLayout(FindScenePreset("static_urban"), 2, false);
   EXPECT_NE(la.grid.xs, lb.grid.xs);
-  EXPECT_GT((la.trajectory.back().world_from_rig.translation - lb.trajectory.back().world_from_rig.translation).norm(), 1.0);
+  EXPECT_GT((la.trajectory.back().world_from_rig.translation - lb.trajectory.back().world_from_rig.translation).norm(),
+            1.0);
 }
 
 TEST(GenerateScene, CloudyAndSunsetShareStreets) {
@@ -78,7 +79,8 @@ TEST(GenerateScene, CloudyAndSunsetShareStreets) {
   ASSERT_EQ(cloudy.meshes.size(), sunset.meshes.size());
   for (size_t i = 0; i < cloudy.meshes.size(); ++i) EXPECT_EQ(cloudy.meshes[i].positions, sunset.meshes[i].positions);
   ASSERT_EQ(cloudy.rig_trajectory.size(), sunset.rig_trajectory.size());
-  EXPECT_EQ(cloudy.rig_trajectory.back().world_from_rig.translation, sunset.rig_trajectory.back().world_from_rig.translation);
+  EXPECT_EQ(cloudy.rig_trajectory.back().world_from_rig.translation,
+            sunset.rig_trajectory.back().world_from_rig.translation);
   EXPECT_NE(SceneHash(cloudy), SceneHash(sunset));
   // Overcast: weak sun, bright sky; sunset: low sun.
   EXPECT_LT(cloudy.lighting.sun_radiance.maxCoeff(), 0.2f * sunset.lighting.sun_radiance.maxCoeff());
@@ -127,17 +129,20 @@ TEST(RigDrive, SmoothOnTheRoadAndOutsideBuildings) {
         if (k >= 1 && k + 1 < tr.size()) {
           const Eigen::Vector3d v = tr[k + 1].world_from_rig.translation - tr[k - 1].world_from_rig.translation;
           const Eigen::Vector3d forward = tr[k].world_from_rig.rotation * Eigen::Vector3d::UnitX();
-          if (v.head<2>().norm() > 1e-3) min_heading_dot = std::min(min_heading_dot, forward.head<2>().normalized().dot(v.head<2>().normalized()));
+          if (v.head<2>().norm() > 1e-3)
+            min_heading_dot = std::min(min_heading_dot, forward.head<2>().normalized().dot(v.head<2>().normalized()));
           const Eigen::Vector3d up = tr[k].world_from_rig.rotation * Eigen::Vector3d::UnitZ();
           EXPECT_GT(up.z(), std::cos(3.0 * M_PI / 180));  // only small roll/pitch
         }
         if (k >= 1 && k + 1 < tr.size()) {
-          const Eigen::Vector3d a = (tr[k + 1].world_from_rig.translation - 2 * x + tr[k - 1].world_from_rig.translation) / (dt * dt);
+          const Eigen::Vector3d a =
+              (tr[k + 1].world_from_rig.translation - 2 * x + tr[k - 1].world_from_rig.translation) / (dt * dt);
           max_accel = std::max(max_accel, a.norm());
         }
         if (k >= 2 && k + 1 < tr.size()) {
-          const Eigen::Vector3d j = (tr[k + 1].world_from_rig.translation - 3 * x + 3 * tr[k - 1].world_from_rig.translation -
-                                     tr[k - 2].world_from_rig.translation) / (dt * dt * dt);
+          const Eigen::Vector3d j = (tr[k + 1].world_from_rig.translation - 3 * x +
+                                     3 * tr[k - 1].world_from_rig.translation - tr[k - 2].world_from_rig.translation) /
+                                    (dt * dt * dt);
           max_jerk = std::max(max_jerk, j.norm());
         }
       }
@@ -216,12 +221,15 @@ TEST(GenerateScene, TrafficIdsMotionAndClearance) {
     ASSERT_EQ(o.world_from_object_per_frame.size(), frames);
     double nearest = 1e9;
     for (size_t f = 0; f < frames; ++f) {
-      const Eigen::Vector3d d = o.world_from_object_per_frame[f].translation - s.rig_trajectory[f].world_from_rig.translation;
+      const Eigen::Vector3d d =
+          o.world_from_object_per_frame[f].translation - s.rig_trajectory[f].world_from_rig.translation;
       if (o.world_from_object_per_frame[f].translation.z() < -50) continue;  // off its path, hidden
       nearest = std::min(nearest, d.head<2>().norm());
       // Moves smoothly: < 2 m per frame (20 m/s).
       if (f > 0 && o.world_from_object_per_frame[f - 1].translation.z() > -50) {
-        EXPECT_LT((o.world_from_object_per_frame[f].translation - o.world_from_object_per_frame[f - 1].translation).norm(), 2.0);
+        EXPECT_LT(
+            (o.world_from_object_per_frame[f].translation - o.world_from_object_per_frame[f - 1].translation).norm(),
+            2.0);
       }
     }
     closest = std::min(closest, nearest);
@@ -230,8 +238,8 @@ TEST(GenerateScene, TrafficIdsMotionAndClearance) {
   EXPECT_GE(ids.size(), 5u);
   EXPECT_EQ(*ids.begin(), 1);
   EXPECT_EQ(*ids.rbegin(), static_cast<int>(ids.size()));  // ids 1..N
-  EXPECT_GT(closest, 2.5);        // never inside the rig's car
-  EXPECT_GE(close_vehicles, 2);   // some pass close (lead vehicle, oncoming)
+  EXPECT_GT(closest, 2.5);                                 // never inside the rig's car
+  EXPECT_GE(close_vehicles, 2);                            // some pass close (lead vehicle, oncoming)
 }
 
 // Texel density where VO tracks features: 1-3 cm per texel on facades, about 1 cm on roads.
@@ -248,10 +256,13 @@ TEST(GenerateScene, TexelDensity) {
         if (tex < 0) continue;
         // Facade and shop textures (details such as roofs and awnings have their own scales).
         const std::string& tex_name = s.textures[tex].name;
-        if (mesh_name == "buildings" && tex_name.rfind("facade", 0) != 0 && tex_name.rfind("storefront", 0) != 0) continue;
+        if (mesh_name == "buildings" && tex_name.rfind("facade", 0) != 0 && tex_name.rfind("storefront", 0) != 0)
+          continue;
         const auto& tri = m.triangles[t];
-        const double area = 0.5 * (m.positions[tri[1]] - m.positions[tri[0]]).cross(m.positions[tri[2]] - m.positions[tri[0]]).norm();
-        Eigen::Vector2d e1 = (m.uvs[tri[1]] - m.uvs[tri[0]]).cast<double>(), e2 = (m.uvs[tri[2]] - m.uvs[tri[0]]).cast<double>();
+        const double area =
+            0.5 * (m.positions[tri[1]] - m.positions[tri[0]]).cross(m.positions[tri[2]] - m.positions[tri[0]]).norm();
+        Eigen::Vector2d e1 = (m.uvs[tri[1]] - m.uvs[tri[0]]).cast<double>(),
+                        e2 = (m.uvs[tri[2]] - m.uvs[tri[0]]).cast<double>();
         e1.x() *= s.textures[tex].width, e2.x() *= s.textures[tex].width;
         e1.y() *= s.textures[tex].height, e2.y() *= s.textures[tex].height;
         const double texel_area = 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
@@ -296,7 +307,8 @@ TEST(GenerateScene, FacadeReliefLinesUpWithPaintedWindows) {
       if (suffix == std::string::npos) continue;
       const BuildingPlan& plan = layout.buildings[std::stoul(name.substr(9, suffix - 9))];
       const Eigen::Vector3i& tri = buildings->triangles[t];
-      const Eigen::Vector3f a = buildings->positions[tri[0]], b = buildings->positions[tri[1]], c = buildings->positions[tri[2]];
+      const Eigen::Vector3f a = buildings->positions[tri[0]], b = buildings->positions[tri[1]],
+                            c = buildings->positions[tri[2]];
       const Eigen::Vector3f normal = (b - a).cross(c - a).normalized();
       if (std::abs(normal.z()) > 1e-3) continue;  // top/bottom of a relief block
       // A front face: its plane is parallel to the street side and at least 5 cm in front of the wall.
@@ -310,8 +322,9 @@ TEST(GenerateScene, FacadeReliefLinesUpWithPaintedWindows) {
       const int bay_px = 1024 / fl.bays, win_w_px = static_cast<int>(bay_px * fl.window_width_fraction);
       const int win_h_px = static_cast<int>(256 * fl.window_height_fraction), win_top_px = (256 - win_h_px) / 2 - 8;
       const Eigen::Vector2f ua = buildings->uvs[tri[0]], ub = buildings->uvs[tri[1]], uc = buildings->uvs[tri[2]];
-      for (const Eigen::Vector3f& w : {Eigen::Vector3f(1.0f / 3, 1.0f / 3, 1.0f / 3), Eigen::Vector3f(0.9f, 0.05f, 0.05f),
-                                       Eigen::Vector3f(0.05f, 0.9f, 0.05f), Eigen::Vector3f(0.05f, 0.05f, 0.9f)}) {
+      for (const Eigen::Vector3f& w :
+           {Eigen::Vector3f(1.0f / 3, 1.0f / 3, 1.0f / 3), Eigen::Vector3f(0.9f, 0.05f, 0.05f),
+            Eigen::Vector3f(0.05f, 0.9f, 0.05f), Eigen::Vector3f(0.05f, 0.05f, 0.9f)}) {
         const Eigen::Vector2f uv = w[0] * ua + w[1] * ub + w[2] * uc;
         const double x = (uv.x() - std::floor(uv.x())) * 1024, y = (uv.y() - std::floor(uv.y())) * 1024;
         const double x_in = std::fmod(x, bay_px) - (bay_px - win_w_px) / 2, y_in = std::fmod(y, 256.0) - win_top_px;
@@ -384,10 +397,11 @@ TEST(CityLayout, CanyonIsNarrowAndTall) {
   EXPECT_GE(canyon.median_height / canyon.median_width, 2.5);
   EXPECT_GE(wide.median_width, 15.0);
   EXPECT_LT(wide.median_height / wide.median_width, 1.5);
-  std::printf("canyon: facade-to-facade %.1f m, building height %.1f m (H/W %.1f), both sides within 25 m %.0f%%\n"
-              "static_urban: %.1f m, %.1f m (H/W %.1f)\n",
-              canyon.median_width, canyon.median_height, canyon.median_height / canyon.median_width,
-              100 * canyon.both_sides_fraction, wide.median_width, wide.median_height, wide.median_height / wide.median_width);
+  std::printf(
+      "canyon: facade-to-facade %.1f m, building height %.1f m (H/W %.1f), both sides within 25 m %.0f%%\n"
+      "static_urban: %.1f m, %.1f m (H/W %.1f)\n",
+      canyon.median_width, canyon.median_height, canyon.median_height / canyon.median_width,
+      100 * canyon.both_sides_fraction, wide.median_width, wide.median_height, wide.median_height / wide.median_width);
 }
 
 TEST(Textures, TileSeamlesslyAndHaveDetail) {
@@ -427,8 +441,8 @@ TEST(Textures, TileSeamlesslyAndHaveDetail) {
 
 TEST(SceneCli, GenerateAndList) {
   const std::string out = FreshDir("cli");
-  const std::string cmd = std::string(ROVO_BINARY) + " scene generate --preset cloudy_urban --quick --seed 5 --out " + out + "/s > " +
-                          out + "/log.txt 2>&1";
+  const std::string cmd = std::string(ROVO_BINARY) + " scene generate --preset cloudy_urban --quick --seed 5 --out " +
+                          out + "/s > " + out + "/log.txt 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << ReadFile(out + "/log.txt");
   const std::string log = ReadFile(out + "/log.txt");
   EXPECT_NE(log.find("triangles"), std::string::npos) << log;
@@ -445,7 +459,8 @@ TEST(SceneCli, GenerateAndList) {
   const std::string list = std::string(ROVO_BINARY) + " scene list > " + out + "/list.txt 2>&1";
   ASSERT_EQ(std::system(list.c_str()), 0);
   EXPECT_NE(ReadFile(out + "/list.txt").find("canyon_multifov"), std::string::npos);
-  const std::string bad = std::string(ROVO_BINARY) + " scene generate --preset nope --out " + out + "/x > " + out + "/bad.txt 2>&1";
+  const std::string bad =
+      std::string(ROVO_BINARY) + " scene generate --preset nope --out " + out + "/x > " + out + "/bad.txt 2>&1";
   EXPECT_NE(std::system(bad.c_str()), 0);
   EXPECT_NE(ReadFile(out + "/bad.txt").find("static_urban"), std::string::npos);
 }

@@ -1,14 +1,5 @@
 // The harder worlds (indoor_hall, suburban_road, night_street): they generate, load back, are
 // deterministic, and have the properties the presets claim, each measured on the scene.
-#include "datasets/io.h"
-#include "datasets/rig.h"
-#include "scenes/city.h"
-#include "scenes/city_layout.h"
-#include "scenes/indoor.h"
-#include "scenes/texture_gen.h"
-
-#include "tests/scenes/scratch_dir.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,6 +8,14 @@
 #include <limits>
 #include <string>
 #include <vector>
+
+#include "datasets/io.h"
+#include "datasets/rig.h"
+#include "scenes/city.h"
+#include "scenes/city_layout.h"
+#include "scenes/indoor.h"
+#include "scenes/texture_gen.h"
+#include "tests/scenes/scratch_dir.h"
 
 namespace rovo {
 namespace {

@@ -1,18 +1,16 @@
-#include "datasets/io.h"
-#include "scenes/scene.h"
-
-#include "tests/scenes/scratch_dir.h"
-
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include <filesystem>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include <unistd.h>
+#include "datasets/io.h"
+#include "scenes/scene.h"
+#include "tests/scenes/scratch_dir.h"
 
 namespace rovo {
 namespace {
@@ -98,7 +96,8 @@ void ExpectScenesEqual(const Scene& a, const Scene& b) {
   for (size_t i = 0; i < a.rig_trajectory.size(); ++i) {
     EXPECT_EQ(a.rig_trajectory[i].timestamp, b.rig_trajectory[i].timestamp);
     EXPECT_EQ(a.rig_trajectory[i].world_from_rig.translation, b.rig_trajectory[i].world_from_rig.translation);
-    EXPECT_EQ(a.rig_trajectory[i].world_from_rig.rotation.coeffs(), b.rig_trajectory[i].world_from_rig.rotation.coeffs());
+    EXPECT_EQ(a.rig_trajectory[i].world_from_rig.rotation.coeffs(),
+              b.rig_trajectory[i].world_from_rig.rotation.coeffs());
   }
   ASSERT_EQ(a.objects.size(), b.objects.size());
   for (size_t i = 0; i < a.objects.size(); ++i) {
@@ -120,7 +119,8 @@ TEST(SceneIo, RoundTripIsExact) {
   // Saving the loaded scene again gives the same bytes.
   const std::string dir2 = FreshDir("roundtrip2");
   SaveScene(loaded, dir2);
-  for (const char* f : {"scene.json", "geometry.bin", "motion.bin", "trajectory.tum", "textures/000.png", "textures/001.png"}) {
+  for (const char* f :
+       {"scene.json", "geometry.bin", "motion.bin", "trajectory.tum", "textures/000.png", "textures/001.png"}) {
     EXPECT_EQ(ReadFile(dir + "/" + f), ReadFile(dir2 + "/" + f)) << f;
   }
   // No temporary files are left behind.
@@ -308,15 +308,23 @@ TEST(SceneIo, LightsAndMaterialExtensionsRoundTrip) {
 TEST(SceneIo, LightErrorsNameFileAndField) {
   const Scene scene = WithLights(MakeTestScene());
   const std::vector<std::pair<std::function<void(nlohmann::json&)>, std::string>> cases = {
-      {[](nlohmann::json& j) { j["lights"][0]["intensity"] = {0.1, -0.2, 0.3}; },
+      {[](nlohmann::json& j) {
+         j["lights"][0]["intensity"] = {0.1, -0.2, 0.3};
+       },
        "lights[0].intensity: must not be negative"},
       {[](nlohmann::json& j) { j["lights"][1]["object"] = 2; }, "lights[1].object: value 2 outside [-1, 1]"},
       {[](nlohmann::json& j) { j["lights"][0]["range"] = -1.0; }, "lights[0].range"},
       {[](nlohmann::json& j) { j["lights"][1]["spot"]["angle_deg"] = 190.0; }, "lights[1].spot.angle_deg"},
-      {[](nlohmann::json& j) { j["lights"][1]["spot"]["direction"] = {0, 0, 0}; }, "lights[1].spot.direction"},
+      {[](nlohmann::json& j) {
+         j["lights"][1]["spot"]["direction"] = {0, 0, 0};
+       },
+       "lights[1].spot.direction"},
       {[](nlohmann::json& j) { j["lights"][1]["spot"]["blend"] = 1.5; }, "lights[1].spot.blend"},
       {[](nlohmann::json& j) { j["lights"][0].erase("position"); }, "lights[0].position: missing"},
-      {[](nlohmann::json& j) { j["materials"][1]["emission"] = {1.0, -1.0, 0.0}; }, "materials[1].emission"},
+      {[](nlohmann::json& j) {
+         j["materials"][1]["emission"] = {1.0, -1.0, 0.0};
+       },
+       "materials[1].emission"},
       {[](nlohmann::json& j) { j["materials"][2].erase("shininess"); }, "materials[2].shininess: missing"},
       {[](nlohmann::json& j) { j["materials"][2]["specular"] = 2.0; }, "materials[2].specular"},
   };

@@ -2,12 +2,11 @@
 // Scratch folders for the scenes tests: one root per test process, removed after the last test.
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <string>
 #include <system_error>
-
-#include <unistd.h>
 
 namespace rovo::test {
 

@@ -127,12 +127,14 @@ TEST(LocalBa, OnlineCalibrationRecoversPerturbedExtrinsics) {
   const std::vector<double> baselines = RingBaselineLengths(s.cam_from_rig);
   std::normal_distribution<double> noise(0.0, 1.0);
   for (int j = 1; j < 4; ++j) {
-    p.cam_from_rig[j] = Rigid3(test::RandomRotation(rng, 5.0) * p.cam_from_rig[j].rotation, p.cam_from_rig[j].translation);
+    p.cam_from_rig[j] =
+        Rigid3(test::RandomRotation(rng, 5.0) * p.cam_from_rig[j].rotation, p.cam_from_rig[j].translation);
     EXPECT_GT(RotationDistanceDeg(p.cam_from_rig[j].rotation, s.cam_from_rig[j].rotation), 4.9);
   }
   for (size_t i = 1; i < p.rig_from_world.size(); ++i) {
-    p.rig_from_world[i] = Rigid3(test::RandomRotation(rng, 0.3) * p.rig_from_world[i].rotation,
-                                 p.rig_from_world[i].translation + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)) * 0.05);
+    p.rig_from_world[i] =
+        Rigid3(test::RandomRotation(rng, 0.3) * p.rig_from_world[i].rotation,
+               p.rig_from_world[i].translation + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)) * 0.05);
   }
   for (auto& x : p.points_in_world) x += Eigen::Vector3d(noise(rng), noise(rng), noise(rng)) * 0.1;
   p.baseline_lengths = baselines;
@@ -201,7 +203,8 @@ TEST(LocalBa, DeterministicForSameInput) {
   Scenario s = MakeScenario(rng, 5, 200);
   LocalBaProblem a = s.problem;
   for (auto& x : a.points_in_world) x += Eigen::Vector3d(0.05, 0.0, -0.05);
-  a.cam_from_rig[2] = Rigid3(test::RandomRotation(rng, 2.0) * a.cam_from_rig[2].rotation, a.cam_from_rig[2].translation);
+  a.cam_from_rig[2] =
+      Rigid3(test::RandomRotation(rng, 2.0) * a.cam_from_rig[2].rotation, a.cam_from_rig[2].translation);
   LocalBaProblem b = a;
   LocalBaOptions options;
   options.optimize_extrinsics = true;

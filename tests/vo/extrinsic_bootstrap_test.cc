@@ -1,11 +1,11 @@
 #include "vo/extrinsic_bootstrap.h"
 
-#include "synthetic_rig.h"
-#include "vo/local_ba.h"
-
 #include <gtest/gtest.h>
 
 #include <random>
+
+#include "synthetic_rig.h"
+#include "vo/local_ba.h"
 
 namespace rovo {
 namespace {

@@ -2,10 +2,10 @@
 // Test helpers for tests that link vo only (eval's ExtrinsicErrorDeg, ExtrinsicTranslationErrorM):
 // the largest, over cameras i >= 1, of the rotation angle between est(cam_i_from_cam0) and
 // truth(cam_i_from_cam0) in degrees, and of the distance between their translations in metres.
-#include "datasets/rigid3.h"
-
 #include <algorithm>
 #include <vector>
+
+#include "datasets/rigid3.h"
 
 namespace rovo {
 

@@ -2,17 +2,17 @@
 // matching and id unification checked against the exact geometry.
 #include "vo/frontend.h"
 
-#include "datasets/rig.h"
-
 #include <gtest/gtest.h>
-#include <opencv2/core/utility.hpp>
 #include <tbb/global_control.h>
 
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <opencv2/core/utility.hpp>
 #include <set>
 #include <thread>
+
+#include "datasets/rig.h"
 
 namespace rovo {
 namespace {
@@ -39,8 +39,8 @@ struct BoxWorld {
     return (a * (1 - sx) + b * sx) * (1 - sy) + (c * (1 - sx) + d * sx) * sy;
   }
   static double Texture(double x, double y, int face) {
-    const double tiles = Hash(static_cast<int64_t>(std::floor(x / 0.35)), static_cast<int64_t>(std::floor(y / 0.35)),
-                              face + 17);
+    const double tiles =
+        Hash(static_cast<int64_t>(std::floor(x / 0.35)), static_cast<int64_t>(std::floor(y / 0.35)), face + 17);
     return 30.0 + 140.0 * tiles + 80.0 * Noise(x, y, face, 0.09);
   }
 
@@ -344,7 +344,8 @@ TEST_F(FrontendBox, ExtrinsicUpdatesRebuildOnlyPastTheThreshold) {
 // feature of camera 1 is detected, tracked or matched there, over frames; the other views are unchanged.
 TEST_F(FrontendBox, StaticMasksKeepFeaturesOut) {
   std::vector<cv::Mat> masks;
-  for (const RigCamera& rc : rig_->cameras) masks.push_back(cv::Mat(rc.camera.height, rc.camera.width, CV_8UC1, cv::Scalar(255)));
+  for (const RigCamera& rc : rig_->cameras)
+    masks.push_back(cv::Mat(rc.camera.height, rc.camera.width, CV_8UC1, cv::Scalar(255)));
   masks[1].rowRange(masks[1].rows / 2, masks[1].rows).setTo(0);
   Frontend masked(*rig_, FrontendOptions{});
   masked.SetStaticMasks(masks);

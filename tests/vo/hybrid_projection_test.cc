@@ -1,13 +1,13 @@
 #include "vo/hybrid_projection.h"
 
-#include "datasets/rig.h"
-
 #include <gtest/gtest.h>
-#include <opencv2/imgproc.hpp>
 
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 #include <random>
 #include <string>
+
+#include "datasets/rig.h"
 
 namespace rovo {
 namespace {
@@ -107,8 +107,8 @@ TEST(HybridProjection, MapsMatchExactFunctions) {
       for (int v = 0; v < p.height(); ++v) {
         for (int u = 0; u < p.width(); ++u) {
           const auto uv = p.FisheyeFromWarped(Eigen::Vector2d(u, v));
-          const bool inside = uv && uv->x() >= 0 && uv->y() >= 0 && uv->x() <= p.camera().width - 1 &&
-                              uv->y() <= p.camera().height - 1;
+          const bool inside =
+              uv && uv->x() >= 0 && uv->y() >= 0 && uv->x() <= p.camera().width - 1 && uv->y() <= p.camera().height - 1;
           ASSERT_EQ(p.valid_mask().at<uint8_t>(v, u) != 0, inside) << rig_name << " " << u << "," << v;
           if (!inside) continue;
           ++valid;
@@ -180,8 +180,8 @@ TEST(HybridProjection, OverlapIsRectified) {
       for (int k = 0; k < 2000 && checked < 100; ++k) {
         // Points in front of the shared plane, 3-30 m away.
         const Eigen::Vector3d tangent = m.cross(Eigen::Vector3d::UnitZ());
-        const Eigen::Vector3d point_in_rig =
-            (5.0 + 25.0 * std::abs(uniform(rng))) * m + 10.0 * uniform(rng) * tangent + 3.0 * uniform(rng) * Eigen::Vector3d::UnitZ();
+        const Eigen::Vector3d point_in_rig = (5.0 + 25.0 * std::abs(uniform(rng))) * m + 10.0 * uniform(rng) * tangent +
+                                             3.0 * uniform(rng) * Eigen::Vector3d::UnitZ();
         const auto pa = projections[a].WarpedFromBearing(rig.cameras[a].cam_from_rig * point_in_rig);
         const auto pb = projections[b].WarpedFromBearing(rig.cameras[b].cam_from_rig * point_in_rig);
         if (!pa || !pb || !projections[a].InWarpedImage(*pa) || !projections[b].InWarpedImage(*pb)) continue;
@@ -256,8 +256,9 @@ TEST(HybridProjection, LayoutChangeMeasuresCameraRotation) {
   // Rotate camera 2 by 3 degrees about its own y axis (yaw): its layout axes move by ~3 deg in
   // its own frame.
   std::vector<Rigid3> extrinsics = rig.Extrinsics();
-  extrinsics[2] = Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(3.0 * kDeg, Eigen::Vector3d::UnitY())), Eigen::Vector3d::Zero()) *
-                  extrinsics[2];
+  extrinsics[2] =
+      Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(3.0 * kDeg, Eigen::Vector3d::UnitY())), Eigen::Vector3d::Zero()) *
+      extrinsics[2];
   const Rig moved = rig.WithExtrinsics(extrinsics);
   const auto moved_layouts = ComputeHybridLayouts(moved);
   const double change = HybridLayoutChangeDeg(layouts[2], rig.cameras[2].cam_from_rig, moved_layouts[2], extrinsics[2]);

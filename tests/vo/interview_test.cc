@@ -1,14 +1,13 @@
-#include "vo/interview_matching.h"
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <optional>
+#include <random>
 
 #include "datasets/rig.h"
 #include "vo/hybrid_projection.h"
-
-#include <gtest/gtest.h>
-#include <opencv2/imgproc.hpp>
-
-#include <cmath>
-#include <optional>
-#include <random>
+#include "vo/interview_matching.h"
 
 namespace rovo {
 namespace {
@@ -275,7 +274,8 @@ class SyntheticPair : public ::testing::Test {
       AddFeature(&points_b_, &bearings_b_, b_, in_b, Flip(descriptor, 8, cv_rng), angle + 5.0f);
       truth_.push_back({static_cast<int>(points_a_.size()) - 1, static_cast<int>(points_b_.size()) - 1});
       // Distractor in b: same descriptor and orientation, a different direction.
-      const Eigen::Vector3d wrong = rig_.cameras[b_].cam_from_rig * (point + 2.0 * tangent + 1.5 * Eigen::Vector3d::UnitZ());
+      const Eigen::Vector3d wrong =
+          rig_.cameras[b_].cam_from_rig * (point + 2.0 * tangent + 1.5 * Eigen::Vector3d::UnitZ());
       if (rig_.cameras[b_].camera.InFov(wrong)) {
         AddFeature(&points_b_, &bearings_b_, b_, wrong, Flip(descriptor, 4, cv_rng), angle);
       }
@@ -313,7 +313,8 @@ class SyntheticPair : public ::testing::Test {
     for (auto* bearings : {&va.bearings_in_rig, &vb.bearings_in_rig}) {
       for (Eigen::Vector3d& d : *bearings) {
         d = (Eigen::AngleAxisd(normal(rng), Eigen::Vector3d::UnitZ()) *
-             Eigen::AngleAxisd(normal(rng), d.unitOrthogonal()) * d).normalized();
+             Eigen::AngleAxisd(normal(rng), d.unitOrthogonal()) * d)
+                .normalized();
       }
     }
     va.centre_in_rig = rig_.cameras[a_].cam_from_rig.Inverse().translation;

@@ -3,9 +3,9 @@
 #include "vo/orb_matching.h"
 
 #include <gtest/gtest.h>
-#include <opencv2/features2d.hpp>
 
 #include <algorithm>
+#include <opencv2/features2d.hpp>
 
 namespace rovo {
 namespace {
@@ -64,7 +64,8 @@ TEST(OrbMatching, DistanceBoundAndDegenerateInputs) {
   cv::Mat a(200, 32, CV_8U);
   rng.fill(a, cv::RNG::UNIFORM, 0, 256);
   const cv::Mat b = NearCopies(a, 200, 200, 30, rng);
-  for (const auto& [i, j] : MutualRatioOrbMatches(a, b, 1.0, 10)) EXPECT_LE(cv::norm(a.row(i), b.row(j), cv::NORM_HAMMING), 10);
+  for (const auto& [i, j] : MutualRatioOrbMatches(a, b, 1.0, 10))
+    EXPECT_LE(cv::norm(a.row(i), b.row(j), cv::NORM_HAMMING), 10);
   EXPECT_EQ(MutualRatioOrbMatches(a, b, 1.0, 10), Reference(a, b, 1.0, 10));
   EXPECT_TRUE(MutualRatioOrbMatches(a.rowRange(0, 1), b, 0.8, 80).empty());
   EXPECT_TRUE(MutualRatioOrbMatches(cv::Mat(), b, 0.8, 80).empty());

@@ -1,10 +1,10 @@
 #include "vo/p3p.h"
 
-#include "synthetic_rig.h"
-
 #include <gtest/gtest.h>
 
 #include <random>
+
+#include "synthetic_rig.h"
 
 namespace rovo {
 namespace {
@@ -44,7 +44,7 @@ TEST(P3P, RecoversTruePoseAndOnlyValidSolutions) {
     }
     EXPECT_LT(best, 1e-9) << "trial " << trial;
   }
-  EXPECT_GT(beyond_90, trials / 2);               // the test really covers rays behind the image plane
+  EXPECT_GT(beyond_90, trials / 2);                  // the test really covers rays behind the image plane
   EXPECT_GT(total_solutions, trials + trials / 10);  // multiple solutions occur and are all valid
 }
 

@@ -2,11 +2,11 @@
 // point field seen by a four-camera 220 deg rig, track ids = point ids. No rendering.
 #include "vo/pipeline.h"
 
-#include "synthetic_rig.h"
-
 #include <gtest/gtest.h>
 
 #include <random>
+
+#include "synthetic_rig.h"
 
 namespace rovo {
 namespace {
@@ -93,16 +93,17 @@ TEST(VoBackend, OnlineCalibrationReducesExtrinsicError) {
   const test::World w = test::MakeWorld(frames, 7);
   std::mt19937_64 rng(8);
   std::vector<Rigid3> noisy = w.cam_from_rig;
-  for (int j = 1; j < 4; ++j) noisy[j] = Rigid3(test::RandomRotation(rng, 3.0) * noisy[j].rotation, noisy[j].translation);
+  for (int j = 1; j < 4; ++j)
+    noisy[j] = Rigid3(test::RandomRotation(rng, 3.0) * noisy[j].rotation, noisy[j].translation);
   BackendOptions options;
   options.ba.optimize_extrinsics = true;
   VoBackend backend(noisy, w.world_from_rig[0], options);
   for (int f = 0; f < frames; ++f) {
     const auto r = backend.ProcessFrame(f, test::Observe(w, f, rng, 0.0002, 0.0));
     if (getenv("ROVO_DEBUG")) {
-      printf("%d %s corr %d inl %d ratio %.2f kf %d lm %d err %.3f\n", f, r.record.status.c_str(), r.record.num_correspondences,
-             r.record.num_inliers, r.record.inlier_ratio, r.record.keyframe, r.num_landmarks,
-             PositionError(r.world_from_rig, w.world_from_rig[f]));
+      printf("%d %s corr %d inl %d ratio %.2f kf %d lm %d err %.3f\n", f, r.record.status.c_str(),
+             r.record.num_correspondences, r.record.num_inliers, r.record.inlier_ratio, r.record.keyframe,
+             r.num_landmarks, PositionError(r.world_from_rig, w.world_from_rig[f]));
     }
   }
   for (int j = 1; j < 4; ++j) {

@@ -1,11 +1,11 @@
 #include "vo/ransac.h"
 
-#include "synthetic_rig.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
+
+#include "synthetic_rig.h"
 
 namespace rovo {
 namespace {

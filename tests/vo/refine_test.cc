@@ -1,10 +1,9 @@
-#include "vo/pose_refinement.h"
-
-#include "synthetic_rig.h"
-
 #include <gtest/gtest.h>
 
 #include <random>
+
+#include "synthetic_rig.h"
+#include "vo/pose_refinement.h"
 
 namespace rovo {
 namespace {

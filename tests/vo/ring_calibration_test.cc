@@ -1,10 +1,10 @@
 #include "vo/ring_calibration.h"
 
-#include "datasets/rig.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
+
+#include "datasets/rig.h"
 
 namespace rovo {
 namespace {

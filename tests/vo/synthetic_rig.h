@@ -2,15 +2,14 @@
 // Synthetic rig, world points, correspondences and front-end output for the back-end tests (no
 // rendering).
 
-#include "datasets/rigid3.h"
-#include "vo/frontend.h"
-#include "vo/ransac.h"
-
 #include <Eigen/Core>
-
 #include <cmath>
 #include <random>
 #include <vector>
+
+#include "datasets/rigid3.h"
+#include "vo/frontend.h"
+#include "vo/ransac.h"
 
 namespace rovo::test {
 

@@ -1,11 +1,11 @@
 #include "vo/tracking.h"
 
 #include <gtest/gtest.h>
-#include <opencv2/features2d.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include <cmath>
 #include <map>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
 #include <random>
 #include <set>
 

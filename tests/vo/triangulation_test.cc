@@ -1,10 +1,10 @@
 #include "vo/triangulation.h"
 
-#include "synthetic_rig.h"
-
 #include <gtest/gtest.h>
 
 #include <random>
+
+#include "synthetic_rig.h"
 
 namespace rovo {
 namespace {

@@ -2,19 +2,18 @@
 // by a content hash of the code and settings that make it, runs GTExt / NoisyExt / OnlineExt with
 // the real `rovo` binary, and checks ci/gates.json. A second test shows the gate fails (exit
 // status 1) when a threshold is tightened below the measured value.
-#include "datasets/io.h"
-
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 
-#include <sys/wait.h>
-#include <unistd.h>
+#include "datasets/io.h"
 
 namespace rovo {
 namespace {
@@ -49,7 +48,8 @@ std::string DatasetCacheKey(const nlohmann::json& suite_settings) {
   }
   std::sort(files.begin(), files.end());
   std::string content = suite_settings.dump();
-  for (const fs::path& f : files) content += f.lexically_relative(ROVO_SOURCE_DIR).string() + "\n" + ReadFile(f.string());
+  for (const fs::path& f : files)
+    content += f.lexically_relative(ROVO_SOURCE_DIR).string() + "\n" + ReadFile(f.string());
   return HashHex(content.data(), content.size());
 }
 
@@ -64,7 +64,7 @@ class GateTest : public ::testing::Test {
     fs::remove_all(suite_dir_);
     std::fprintf(stderr, "gate test: dataset cache %s, suite %s\n", data_dir_.c_str(), suite_dir_.c_str());
     first_ = RunShell(std::string(ROVO_BINARY) + " gate --run --gates " + gates_path_ + " --suite " + suite_dir_ +
-                 " --data " + data_dir_);
+                      " --data " + data_dir_);
   }
   static void TearDownTestSuite() { fs::remove_all(suite_dir_); }
 
@@ -126,9 +126,9 @@ TEST_F(GateTest, CalibrationConvergesOnFreshDraws) {
   const std::string dataset = GateDataset(data_dir_);
   ASSERT_FALSE(dataset.empty()) << data_dir_;
   const std::string shot_dir = suite_dir_ + "/calibration_shot";
-  const CommandResult shot = RunShell(std::string(ROVO_BINARY) + " study calibration " + dataset +
-                                      " --shot-only --draws 10 --seed 5000 --threads 2 --quiet --fit-frames 0 --out " +
-                                      shot_dir);
+  const CommandResult shot =
+      RunShell(std::string(ROVO_BINARY) + " study calibration " + dataset +
+               " --shot-only --draws 10 --seed 5000 --threads 2 --quiet --fit-frames 0 --out " + shot_dir);
   ASSERT_EQ(shot.status, 0) << shot.output;
   const nlohmann::json s = ReadJsonFile(shot_dir + "/calibration.json");
   EXPECT_GE(s.at("converged").get<int>(), 9) << shot.output;
@@ -146,7 +146,8 @@ TEST_F(GateTest, CalibrationConvergesOnFreshDraws) {
   EXPECT_NEAR(fit.at("angle_scale").get<double>(), 1.0, 0.005);
   const nlohmann::json& total = fit.at("rows").back();
   ASSERT_EQ(total.at("camera_a").get<int>(), -1) << fit.dump();
-  EXPECT_GE(total.at("results").at("inliers").get<int>(), 0.98 * total.at("given").at("inliers").get<int>()) << fit.dump();
+  EXPECT_GE(total.at("results").at("inliers").get<int>(), 0.98 * total.at("given").at("inliers").get<int>())
+      << fit.dump();
   EXPECT_LT(total.at("results").at("median_deg").get<double>(), total.at("given").at("median_deg").get<double>() + 0.02)
       << fit.dump();
   const std::string run_dir = suite_dir_ + "/calibration_run";

@@ -1,20 +1,19 @@
 // `rovo eval` on a synthetic dataset and runs, then report.html rendered by headless Chromium: the
 // screenshot must exist and show content (not a blank page).
-#include "datasets/dataset.h"
-#include "datasets/io.h"
-#include "datasets/run.h"
-
 #include <gtest/gtest.h>
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
-#include <sys/wait.h>
-#include <unistd.h>
+#include "datasets/dataset.h"
+#include "datasets/io.h"
+#include "datasets/run.h"
 
 namespace rovo {
 namespace {
@@ -57,8 +56,8 @@ TEST(ReportScreenshot, HeadlessChromiumRendersTheReport) {
       StampedPose p = gt[static_cast<size_t>(i)];
       p.world_from_rig.translation += noise * Eigen::Vector3d(std::sin(i * 0.3), std::cos(i * 0.2), 0.1 * (i % 3));
       run.trajectory.push_back(p);
-      run.frames.push_back({i, i * 0.1, 300, 180 - i % 20, (180.0 - i % 20) / 300.0, 0.1 + 0.01 * (i % 5), i % 5 == 0,
-                            "ok", 30.0, ""});
+      run.frames.push_back(
+          {i, i * 0.1, 300, 180 - i % 20, (180.0 - i % 20) / 300.0, 0.1 + 0.01 * (i % 5), i % 5 == 0, "ok", 30.0, ""});
       // Online: extrinsics converge from the perturbed set to the ground truth over the sequence.
       for (int c = 0; c < 4; ++c) {
         const Rigid3& truth = info.rig.cameras[static_cast<size_t>(c)].cam_from_rig;
@@ -85,8 +84,9 @@ TEST(ReportScreenshot, HeadlessChromiumRendersTheReport) {
   output.clear();
   const int status = RunCommand(
       "chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run --disable-background-networking "
-      "--disable-component-update --disable-sync --user-data-dir=" + profile + " --screenshot=" + png +
-          " --window-size=1280,2000 file://" + fs::absolute(report + "/report.html").string(),
+      "--disable-component-update --disable-sync --user-data-dir=" +
+          profile + " --screenshot=" + png + " --window-size=1280,2000 file://" +
+          fs::absolute(report + "/report.html").string(),
       &output);
   ASSERT_EQ(status, 0) << output;
   ASSERT_TRUE(fs::is_regular_file(png)) << output;

@@ -1,12 +1,10 @@
 // `rovo render` as a process: SIGKILL mid-run then rerun equals an uninterrupted run; CLI errors;
 // the quick preset end to end; `rovo scene preview`; the scene folder's rig.json as the default rig.
-#include "datasets/dataset.h"
-#include "datasets/io.h"
-#include "render/render.h"
-#include "tests/render/box_scene.h"
-
-#include <gtest/gtest.h>
 #include <OpenImageIO/imageio.h>
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <csignal>
@@ -14,9 +12,10 @@
 #include <map>
 #include <thread>
 
-#include <fcntl.h>
-#include <sys/wait.h>
-#include <unistd.h>
+#include "datasets/dataset.h"
+#include "datasets/io.h"
+#include "render/render.h"
+#include "tests/render/box_scene.h"
 
 namespace rovo {
 namespace {
@@ -71,8 +70,9 @@ TEST_F(RenderCliTest, KilledRunResumesToTheSameBytes) {
   constexpr int kFrames = 16;
   SaveScene(testing::MakeBoxScene(kFrames, true), Path("scene"));
   auto args = [&](const std::string& out) {
-    return std::vector<std::string>{"render", "--scene", Path("scene"), "--rig", "omnimvs4", "--scale", "0.3",
-                                    "--spp", "4", "--depth", "--masks", "--threads", "1", "--out", out};
+    return std::vector<std::string>{"render",  "--scene",   Path("scene"), "--rig", "omnimvs4",
+                                    "--scale", "0.3",       "--spp",       "4",     "--depth",
+                                    "--masks", "--threads", "1",           "--out", out};
   };
   ASSERT_EQ(RunRovo(args(Path("reference")), Path("reference.log")), 0) << ReadFile(Path("reference.log"));
 
@@ -112,8 +112,8 @@ TEST_F(RenderCliTest, BadInputExitsNonZeroNamingTheProblem) {
 
 TEST_F(RenderCliTest, QuickPresetRendersAValidDataset) {
   ASSERT_EQ(RunRovo({"render", "--preset", "static_urban", "--quick", "--frames", "0:2", "--scale", "0.2", "--masks",
-                 "--out", Path("quick")},
-                Path("quick.log")),
+                     "--out", Path("quick")},
+                    Path("quick.log")),
             0)
       << ReadFile(Path("quick.log"));
   const DatasetInfo info = ReadDatasetInfo(Path("quick"));
@@ -136,9 +136,9 @@ TEST_F(RenderCliTest, QuickPresetRendersAValidDataset) {
 
 TEST_F(RenderCliTest, ScenePreviewWritesAContactSheet) {
   SaveScene(testing::MakeBoxScene(4, true), Path("scene"));
-  ASSERT_EQ(RunRovo({"scene", "preview", Path("scene"), "--frames", "0,3", "--rig", "omnimvs4", "--scale", "0.1", "--out",
-                 Path("sheet.png")},
-                Path("p.log")),
+  ASSERT_EQ(RunRovo({"scene", "preview", Path("scene"), "--frames", "0,3", "--rig", "omnimvs4", "--scale", "0.1",
+                     "--out", Path("sheet.png")},
+                    Path("p.log")),
             0)
       << ReadFile(Path("p.log"));
   auto in = OIIO::ImageInput::open(Path("sheet.png"));

@@ -12,16 +12,8 @@
 //
 // Needs `blender` (Debian package) on PATH.
 
-#include "tests/scenes/integration/shell_log.h"
-#include "datasets/io.h"
-#include "datasets/rig.h"
-#include "scenes/city.h"
-#include "scenes/scene.h"
-
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -32,10 +24,17 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "datasets/io.h"
+#include "datasets/rig.h"
+#include "scenes/city.h"
+#include "scenes/scene.h"
+#include "tests/scenes/integration/shell_log.h"
 
 namespace rovo {
 namespace {

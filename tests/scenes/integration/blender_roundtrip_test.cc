@@ -7,13 +7,8 @@
 //
 // Needs `blender` (Debian package) and `oiiotool` (openimageio-tools) on PATH.
 
-#include "tests/scenes/integration/shell_log.h"
-#include "datasets/rig.h"
-#include "scenes/scene.h"
-
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
-
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -26,6 +21,10 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "datasets/rig.h"
+#include "scenes/scene.h"
+#include "tests/scenes/integration/shell_log.h"
 
 namespace rovo {
 namespace {
@@ -197,9 +196,10 @@ void CheckDepthAgainstCycles(const RoundTrip& rt) {
   }
   const double fraction = static_cast<double>(agree) / std::max(common, 1L);
   const double mismatch = static_cast<double>(hit_mismatch) / std::max(cycles_hits, 1L);
-  std::printf("rovo render vs Cycles depth: %.4f of %ld commonly valid pixels agree within 1%% relative "
-              "(mean relative difference %.2e); hit/no-hit disagree at %.4f of Cycles' hits\n",
-              fraction, common, sum_rel / std::max(common, 1L), mismatch);
+  std::printf(
+      "rovo render vs Cycles depth: %.4f of %ld commonly valid pixels agree within 1%% relative "
+      "(mean relative difference %.2e); hit/no-hit disagree at %.4f of Cycles' hits\n",
+      fraction, common, sum_rel / std::max(common, 1L), mismatch);
   // Not vacuous: most of the image circle sees geometry (the room is open only at the top).
   EXPECT_GT(common, static_cast<long>(0.4 * kFrames * kCameras * kImageSize * kImageSize));
   EXPECT_GE(fraction, 0.98);

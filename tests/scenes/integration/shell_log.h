@@ -2,11 +2,12 @@
 // Shell helpers of the Blender integration tests: commands run with their output appended to a log
 // file, whose tail goes into a failure message.
 
+#include <sys/wait.h>
+
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 
 namespace rovo::testing {
 

@@ -2,14 +2,13 @@
 // noise and outliers, over a 100 m drive with near and far points, the estimated trajectory has the
 // true length to 0.1 %. (A systematic slide of KLT tracks along the image motion does shorten it:
 // see max_forward_backward_px in vo/frontend.h.) Integration label: ~15 s CPU, too slow under ASan.
-#include "vo/pipeline.h"
-
-#include "../synthetic_rig.h"
-
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <random>
+
+#include "../synthetic_rig.h"
+#include "vo/pipeline.h"
 
 namespace rovo {
 namespace {

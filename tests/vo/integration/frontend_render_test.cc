@@ -1,16 +1,16 @@
 // Front-end on a small rendered dataset (cloudy_urban, quick form, with depth): accepted inter-view
 // matches are checked against the depth ground truth, and the projection study runs end to end.
-#include "datasets/dataset.h"
-#include "vo/frontend.h"
-#include "vo/projection_study.h"
-
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
-#include <unistd.h>
+
+#include "datasets/dataset.h"
+#include "vo/frontend.h"
+#include "vo/projection_study.h"
 
 namespace rovo {
 namespace {
@@ -20,11 +20,12 @@ constexpr int kFrames = 4;
 class RenderedQuick : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new std::string((std::filesystem::temp_directory_path() /
-                            ("rovo_frontend_it_" + std::to_string(::getpid())))
-                               .string());
-    const std::string command = std::string(ROVO_BINARY) + " render --preset cloudy_urban --quick --depth --quiet --frames 0:" +
-                                std::to_string(kFrames) + " --out " + *dir_;
+    dir_ = new std::string(
+        (std::filesystem::temp_directory_path() / ("rovo_frontend_it_" + std::to_string(::getpid()))).string());
+    const std::string command =
+        std::string(ROVO_BINARY) +
+        " render --preset cloudy_urban --quick --depth --quiet --frames 0:" + std::to_string(kFrames) + " --out " +
+        *dir_;
     ASSERT_EQ(std::system(command.c_str()), 0) << command;
   }
   static void TearDownTestSuite() {
@@ -101,7 +102,8 @@ TEST_F(RenderedQuick, ProjectionStudyWritesItsTable) {
   EXPECT_GE(result.ChainInlierRatioHybrid(), 0.85);
   EXPECT_GE(result.ChainInlierRatioFisheye(), 0.85);
   EXPECT_GT(result.chain_inliers_hybrid, result.chain_inliers_fisheye);
-  for (const char* name : {"table.md", "study.json", "matches_hybrid.png", "matches_fisheye.png", "matches_frontend.png"}) {
+  for (const char* name :
+       {"table.md", "study.json", "matches_hybrid.png", "matches_fisheye.png", "matches_frontend.png"}) {
     EXPECT_TRUE(std::filesystem::exists(options.out_dir + "/" + name)) << name;
   }
 }

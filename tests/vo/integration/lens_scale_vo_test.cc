@@ -6,17 +6,17 @@
 // overlaps' geometry is wrong by degrees around the ring and the trajectory goes astray (draws
 // 8000-8004, 80 frames: relative RMSE 0.5-2.6 % applied, 7.5-9.8 % reported, 0.2-0.9 % with the
 // true lenses; draw 8000: 0.91 % against 9.77 %, any thread count).
-#include "datasets/io.h"
-
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <system_error>
-#include <unistd.h>
+
+#include "datasets/io.h"
 
 namespace rovo {
 namespace {
@@ -29,7 +29,8 @@ int RunCommand(const std::string& command) { return std::system(command.c_str())
 void WriteMisdeclaredCopy(const fs::path& src, const fs::path& dst, double factor) {
   fs::create_directories(dst);
   for (const auto& entry : fs::directory_iterator(src)) {
-    if (entry.path().filename() != "dataset.json") fs::create_symlink(fs::absolute(entry.path()), dst / entry.path().filename());
+    if (entry.path().filename() != "dataset.json")
+      fs::create_symlink(fs::absolute(entry.path()), dst / entry.path().filename());
   }
   nlohmann::json dataset = nlohmann::json::parse(ReadFile((src / "dataset.json").string()));
   for (auto& camera : dataset["rig"]["cameras"]) {
@@ -43,7 +44,8 @@ void WriteMisdeclaredCopy(const fs::path& src, const fs::path& dst, double facto
 // Relative translation RMSE (%) of run `run` against `dataset`'s ground truth, by `rovo eval`.
 double RelativeRmsePct(const std::string& dataset, const std::string& run) {
   const std::string out = run + "_eval";
-  EXPECT_EQ(RunCommand(std::string(ROVO_BINARY) + " eval " + dataset + " " + run + " --out " + out + " > /dev/null"), 0);
+  EXPECT_EQ(RunCommand(std::string(ROVO_BINARY) + " eval " + dataset + " " + run + " --out " + out + " > /dev/null"),
+            0);
   return nlohmann::json::parse(ReadFile(out + "/metrics.json"))["runs"][0]["relative_rmse_pct"].get<double>();
 }
 
@@ -64,7 +66,8 @@ TEST(LensScaleVo, TheStartUpsLensScaleKeepsTheTrajectory) {
   const ScratchDir scratch("rovo_lens_scale_vo");
   const fs::path& root = scratch.path;
   const std::string truth = (root / "truth").string(), declared = (root / "declared").string();
-  ASSERT_EQ(RunCommand(std::string(ROVO_BINARY) + " render --preset canyon_multifov --quick --quiet --out " + truth), 0);
+  ASSERT_EQ(RunCommand(std::string(ROVO_BINARY) + " render --preset canyon_multifov --quick --quiet --out " + truth),
+            0);
   WriteMisdeclaredCopy(truth, declared, 1.015);
 
   double rmse[2] = {0.0, 0.0};

@@ -1,18 +1,18 @@
 // End to end: render a short cloudy_urban sequence, black out three frames of every camera, run
 // `rovo vo` and check that the run reports the gap as lost, re-initialises, tracks again, and stays
 // close to the ground truth.
-#include "datasets/dataset.h"
-#include "datasets/run.h"
-#include "datasets/trajectory.h"
-
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
+
+#include "datasets/dataset.h"
+#include "datasets/run.h"
+#include "datasets/trajectory.h"
 
 namespace rovo {
 namespace {
@@ -26,7 +26,8 @@ TEST(PipelineIntegration, RecoversFromGapOfBlackFrames) {
   fs::remove_all(root);
   const std::string dataset = (root / "dataset").string();
   const std::string run_dir = (root / "run").string();
-  ASSERT_EQ(RunCommand(std::string(ROVO_BINARY) + " render --preset cloudy_urban --quick --frames 0:30 --quiet --out " + dataset),
+  ASSERT_EQ(RunCommand(std::string(ROVO_BINARY) + " render --preset cloudy_urban --quick --frames 0:30 --quiet --out " +
+                       dataset),
             0);
   const DatasetInfo info = ReadDatasetInfo(dataset);
   ASSERT_GE(info.frame_count, 30);
@@ -40,7 +41,8 @@ TEST(PipelineIntegration, RecoversFromGapOfBlackFrames) {
       ASSERT_TRUE(cv::imwrite(path, image)) << path;
     }
   }
-  ASSERT_EQ(RunCommand(std::string(ROVO_BINARY) + " vo " + dataset + " --extrinsics gt --frames 0:30 --quiet --out " + run_dir),
+  ASSERT_EQ(RunCommand(std::string(ROVO_BINARY) + " vo " + dataset + " --extrinsics gt --frames 0:30 --quiet --out " +
+                       run_dir),
             0);
   const RunData run = ReadRun(run_dir);
   ASSERT_EQ(run.frames.size(), 30u);
@@ -53,7 +55,8 @@ TEST(PipelineIntegration, RecoversFromGapOfBlackFrames) {
   const Trajectory gt = ReadTum(GroundTruthPath(dataset));
   const double length = PathLength(Trajectory(gt.begin(), gt.begin() + 30));
   for (int frame = 0; frame < 30; ++frame) {
-    const double error = (run.trajectory[frame].world_from_rig.translation - gt[frame].world_from_rig.translation).norm();
+    const double error =
+        (run.trajectory[frame].world_from_rig.translation - gt[frame].world_from_rig.translation).norm();
     EXPECT_LT(error, 0.05 * length + 0.5) << "frame " << frame;
   }
   EXPECT_EQ(run.info["mode"], "gt");
@@ -64,8 +67,8 @@ TEST(PipelineIntegration, RecoversFromGapOfBlackFrames) {
   { std::ofstream(broken, std::ios::trunc) << "not a png"; }
   fs::remove(ImagePath(dataset, info.rig.cameras[1].name, 6));
   const std::string run2 = (root / "run_missing").string();
-  ASSERT_EQ(RunCommand(std::string(ROVO_BINARY) + " vo " + dataset + " --extrinsics gt --frames 0:8 --quiet --out " + run2 +
-                       " > " + (root / "stdout.txt").string()),
+  ASSERT_EQ(RunCommand(std::string(ROVO_BINARY) + " vo " + dataset + " --extrinsics gt --frames 0:8 --quiet --out " +
+                       run2 + " > " + (root / "stdout.txt").string()),
             0);
   const RunData missing = ReadRun(run2);
   EXPECT_EQ(missing.frames[5].missing_cameras, "2");

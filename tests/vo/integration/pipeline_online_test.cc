@@ -3,16 +3,16 @@
 // byte for byte (determinism for a fixed seed and thread count) and (b) the start-up calibration and
 // the online BA bring every camera's rotation relative to camera 0 from degrees off to within a
 // fraction of a degree of the ground truth.
-#include "datasets/dataset.h"
-#include "datasets/io.h"
-#include "datasets/run.h"
-
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <utility>
+
+#include "datasets/dataset.h"
+#include "datasets/io.h"
+#include "datasets/run.h"
 
 namespace rovo {
 namespace {
@@ -94,8 +94,8 @@ TEST(PipelineIntegration, AsyncBaMatchesSynchronousBa) {
             0);
   const std::string async_run = (root / "async").string(), sync_run = (root / "sync").string();
   ASSERT_EQ(RunCommand(std::string(ROVO_BINARY) + " vo " + dataset + " --threads 2 --quiet --out " + async_run), 0);
-  ASSERT_EQ(RunCommand(std::string(ROVO_BINARY) + " vo " + dataset + " --threads 2 --sync-ba --quiet --out " + sync_run),
-            0);
+  ASSERT_EQ(
+      RunCommand(std::string(ROVO_BINARY) + " vo " + dataset + " --threads 2 --sync-ba --quiet --out " + sync_run), 0);
   EXPECT_EQ(ReadFile(async_run + "/trajectory.tum"), ReadFile(sync_run + "/trajectory.tum"));
   const RunData a = ReadRun(async_run), b = ReadRun(sync_run);
   ASSERT_EQ(a.frames.size(), 12u);

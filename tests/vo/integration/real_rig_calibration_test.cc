@@ -1,16 +1,16 @@
 // The start-up calibration on real frames of a real 4 x 220 deg rig (shared/data/itbt_real, its own
 // calibration as the reference), from seeded sigma = 5 deg draws not used for tuning.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+
 #include "datasets/dataset.h"
 #include "datasets/omnimvs.h"
 #include "tests/vo/extrinsic_error.h"
 #include "vo/image_loader.h"
 #include "vo/ring_calibration.h"
 #include "vo/startup_calibration.h"
-
-#include <gtest/gtest.h>
-
-#include <algorithm>
-#include <filesystem>
 
 namespace rovo {
 namespace {
@@ -26,11 +26,11 @@ class RealRigCalibration : public ::testing::Test {
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
   struct Outcome {
-    int converged = 0;                 // by the start-up calibration's own verdict
-    int close = 0;                     // of those, within the bound of the file's calibration
-    double agreement_deg = 0.0;        // largest difference between two converged results
+    int converged = 0;                                     // by the start-up calibration's own verdict
+    int close = 0;                                         // of those, within the bound of the file's calibration
+    double agreement_deg = 0.0;                            // largest difference between two converged results
     double min_angle_scale = 10.0, max_angle_scale = 0.0;  // the lenses' angle scale of the converged results
-    int min_placements = 1000;         // view placements averaged, fewest over the converged draws
+    int min_placements = 1000;                             // view placements averaged, fewest over the converged draws
     double max_placement_spread_deg = 0.0;
   };
   // Start-up calibration from draws first_seed..first_seed+n-1 on `shots` shots from `frame` on
@@ -56,7 +56,8 @@ class RealRigCalibration : public ::testing::Test {
       out.max_angle_scale = std::max(out.max_angle_scale, r.ring.angle_scale);
       out.min_placements = std::min(out.min_placements, r.placements_averaged);
       out.max_placement_spread_deg = std::max(out.max_placement_spread_deg, r.placement_spread_deg);
-      for (const auto& other : results) out.agreement_deg = std::max(out.agreement_deg, RelativeExtrinsicErrorDeg(r.cam_from_rig, other));
+      for (const auto& other : results)
+        out.agreement_deg = std::max(out.agreement_deg, RelativeExtrinsicErrorDeg(r.cam_from_rig, other));
       results.push_back(r.cam_from_rig);
       std::fprintf(stderr,
                    "frame %d shots %d draw %d: %.3f deg from the file's calibration, lens angle scale %.4f, %d view "

@@ -3,19 +3,19 @@
 // with the exact lenses it stays at 1, and with lenses declared with every off-axis angle 1.5 % too
 // large (the equidistant focal lengths divided by 1.015) it finds the scale that undoes that and
 // still calibrates the extrinsics from a sigma = 5 deg draw.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+
 #include "datasets/dataset.h"
 #include "tests/vo/extrinsic_error.h"
 #include "vo/image_loader.h"
 #include "vo/ring_calibration.h"
-
-#include <gtest/gtest.h>
-
-#include <cstdlib>
-#include <functional>
-#include <memory>
-#include <filesystem>
-#include <string>
-#include <unistd.h>
 
 namespace rovo {
 namespace {
@@ -24,8 +24,9 @@ class RingAngleScale : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = (std::filesystem::temp_directory_path() / ("rovo_ring_scale_" + std::to_string(::getpid()))).string();
-    const std::string command =
-        std::string(ROVO_BINARY) + " render --preset cloudy_urban --rig omnimvs4 --quick --quiet --frames 0:1 --out " + dir_;
+    const std::string command = std::string(ROVO_BINARY) +
+                                " render --preset cloudy_urban --rig omnimvs4 --quick --quiet --frames 0:1 --out " +
+                                dir_;
     ASSERT_EQ(std::system(command.c_str()), 0) << command;
   }
   static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
@@ -77,7 +78,8 @@ TEST_F(RingAngleScale, ExactLensesKeepScaleOne) {
 // in the baselines moves them by about a tenth of their length).
 TEST_F(RingAngleScale, TheBaselinesFollowTheCameras) {
   const RingCalibrationReport turned = Calibrate(1.0, 0.03, 8101);
-  const RingCalibrationReport kept = Calibrate(1.0, 0.03, 8101, [](RingCalibrationOptions* o) { o->turn_centres = false; });
+  const RingCalibrationReport kept =
+      Calibrate(1.0, 0.03, 8101, [](RingCalibrationOptions* o) { o->turn_centres = false; });
   // A turn the matches know less well than the bound is still given to the centres, but they do not
   // count as known (the VO's BA then does not hold them).
   const RingCalibrationReport unsure =
