@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "datasets/ocam.h"
-#include "datasets/omnimvs.h"
+#include "datasets/omnimvs_rig.h"
 
 namespace rovo {
 namespace {

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "eval/suite.h"
+#include "eval/suite_summary.h"
 
 namespace rovo {
 
@@ -77,48 +77,6 @@ std::vector<GateCheck> CheckGates(const nlohmann::json& gates, const std::string
     checks.push_back(c);
   }
   return checks;
-}
-
-SuiteOptions GateSuiteOptions(const nlohmann::json& gates, const std::string& gates_what) {
-  if (!gates.is_object() || !gates.contains("suite") || !gates["suite"].is_object()) {
-    throw std::runtime_error(gates_what + ": missing object field \"suite\" (needed by --run)");
-  }
-  const nlohmann::json& s = gates["suite"];
-  auto fail = [&](const std::string& key, const std::string& what) {
-    throw std::runtime_error(gates_what + ": suite." + key + ": " + what);
-  };
-  // An integer field in [lo, hi], or `fallback` when absent.
-  auto integer = [&](const char* key, int64_t fallback, int64_t lo, int64_t hi) {
-    if (!s.contains(key)) return fallback;
-    const nlohmann::json& v = s[key];
-    if (!v.is_number_integer() || (v.is_number_unsigned() && v.get<uint64_t>() > static_cast<uint64_t>(hi)) ||
-        v.get<int64_t>() < lo || v.get<int64_t>() > hi) {
-      fail(key, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-    }
-    return v.get<int64_t>();
-  };
-  auto seed = [&](const char* key) {
-    if (!s.contains(key)) return uint64_t{0};
-    if (!s[key].is_number_unsigned()) fail(key, "expected a non-negative integer");
-    return s[key].get<uint64_t>();
-  };
-  SuiteOptions options;
-  if (!s.contains("presets") || !s["presets"].is_array()) fail("presets", "expected an array of preset names");
-  for (const nlohmann::json& name : s["presets"]) {
-    if (!name.is_string()) fail("presets", "expected an array of preset names");
-    options.presets.push_back(name.get<std::string>());
-  }
-  options.quick = true;
-  if (s.contains("quick")) {
-    if (!s["quick"].is_boolean()) fail("quick", "expected true or false");
-    options.quick = s["quick"].get<bool>();
-  }
-  options.noise_sets = static_cast<int>(integer("noise_sets", 1, 1, 1000));
-  options.scene_seed = seed("scene_seed");
-  options.vo_seed = seed("vo_seed");
-  options.vo_threads = static_cast<int>(integer("vo_threads", 0, 0, 1024));
-  options.max_new_features = static_cast<int>(integer("max_new_features", -1, -1, 1000000));
-  return options;
 }
 
 bool AllGatesPass(const std::vector<GateCheck>& checks) {

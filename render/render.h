@@ -108,20 +108,4 @@ struct PreviewOptions {
 };
 void RenderScenePreview(const PreviewOptions& options);
 
-// `rovo bench render`: prints a table of render speed, raw ray-cast speed and memory.
-struct RenderBenchOptions {
-  std::string preset = "static_urban";
-  std::string scene_dir;  // instead of the preset
-  uint64_t seed = 0;
-  int frames = 3;
-  double scale = 1.0;
-  int threads = 0;
-  int spp = 0;                // default-quality spp (0 = kDefaultSpp)
-  std::string write_dir;      // if set, also time full dataset writing into this folder
-  bool quality = false;       // also measure aliasing: error vs. a 32-spp reference and shimmer
-  bool breakdown = false;     // also time 1 spp without trilinear filtering and without textures
-  std::string cycles_timing;  // timing.json of scenes/blender/time_cycles_vs_rovo.py: print the Cycles ratio
-};
-void RunRenderBenchmark(const RenderBenchOptions& options);
-
 }  // namespace rovo

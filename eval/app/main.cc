@@ -1,11 +1,10 @@
-// The `rovo` command: parses the command line and hands off to the parts' commands.
+// The `rovo` command: builds the command tree (one Add<Group>Commands per file of eval/app/) and runs it.
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
 
-#include "datasets/cli_groups.h"
-#include "eval/calibration_study.h"
+#include "eval/app/commands.h"
 #include "rovo/version.h"
 
 int main(int argc, char** argv) {
@@ -15,23 +14,29 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "rovo " ROVO_VERSION);
   app.require_subcommand(1);
 
-  rovo::CliGroups groups;
-  groups.root = &app;
-  groups.dataset = app.add_subcommand("dataset", "Inspect and validate datasets");
-  groups.dataset->require_subcommand(1);
-  groups.scene = app.add_subcommand("scene", "Generate, convert and preview scenes");
-  groups.scene->require_subcommand(1);
-  groups.bench = app.add_subcommand("bench", "Speed benchmarks that print a table");
-  groups.bench->require_subcommand(1);
-  groups.study = app.add_subcommand("study", "Studies that reproduce the paper's analyses");
-  groups.study->require_subcommand(1);
+  rovo::CommandTree tree;
+  tree.root = &app;
+  tree.dataset = app.add_subcommand("dataset", "Inspect and validate datasets");
+  tree.dataset->require_subcommand(1);
+  tree.scene = app.add_subcommand("scene", "Generate, convert and preview scenes");
+  tree.scene->require_subcommand(1);
+  tree.bench = app.add_subcommand("bench", "Speed benchmarks that print a table");
+  tree.bench->require_subcommand(1);
+  tree.study = app.add_subcommand("study", "Studies that reproduce the paper's analyses");
+  tree.study->require_subcommand(1);
 
-  rovo::AddDatasetCommands(groups);
-  rovo::AddSceneCommands(groups);
-  rovo::AddRenderCommands(groups);
-  rovo::AddVoCommands(groups);
-  rovo::AddEvalCommands(groups);
-  rovo::AddCalibrationStudyCommand(groups.study);
+  rovo::AddDatasetCommands(tree);
+  rovo::AddExchangeCommands(tree);
+  rovo::AddSceneCommands(tree);
+  rovo::AddRenderCommands(tree);
+  rovo::AddBenchCommands(tree);
+  rovo::AddVoCommands(tree);
+  rovo::AddStudyCommands(tree);
+  rovo::AddEvalCommands(tree);
+  rovo::AddSuiteCommands(tree);
+  rovo::AddBatchCommands(tree);
+  rovo::AddDemoCommands(tree);
+  rovo::AddGateCommands(tree);
 
   try {
     app.parse(argc, argv);

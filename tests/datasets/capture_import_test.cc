@@ -6,8 +6,8 @@
 #include <string>
 
 #include "datasets/dataset.h"
+#include "datasets/exchange/omnimvs.h"
 #include "datasets/io.h"
-#include "datasets/omnimvs.h"
 
 namespace rovo {
 namespace {

@@ -1,6 +1,6 @@
 // Exchange formats: lens fits, Kalibr / Basalt / EuRoC files written and read back, other systems'
 // trajectory formats.
-#include "datasets/exchange.h"
+#include "datasets/exchange/exchange.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <sstream>
 
+#include "datasets/exchange/lens_fit.h"
 #include "datasets/io.h"
-#include "datasets/lens_fit.h"
 #include "datasets/trajectory.h"
 
 namespace rovo {

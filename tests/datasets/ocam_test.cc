@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "datasets/camera_models.h"
+#include "datasets/exchange/ocamcalib.h"
 
 namespace rovo {
 namespace {

@@ -1,4 +1,4 @@
-#include "datasets/omnimvs.h"
+#include "datasets/exchange/omnimvs.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

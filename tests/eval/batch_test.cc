@@ -1,6 +1,6 @@
 // The suite's plan of tasks, perturbation draws, and `rovo batch` (folder, status, resume plan)
 // without Slurm; tests/eval/integration/slurm_batch_test.sh runs it on a real Slurm.
-#include "eval/batch.h"
+#include "eval/orchestration/batch.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -11,7 +11,7 @@
 
 #include "datasets/io.h"
 #include "datasets/run.h"
-#include "eval/suite.h"
+#include "eval/orchestration/suite.h"
 #include "scenes/city.h"
 
 namespace rovo {

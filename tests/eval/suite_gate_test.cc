@@ -7,7 +7,7 @@
 #include "datasets/io.h"
 #include "datasets/run.h"
 #include "eval/gate.h"
-#include "eval/suite.h"
+#include "eval/orchestration/suite.h"
 
 namespace rovo {
 namespace {

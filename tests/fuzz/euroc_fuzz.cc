@@ -1,6 +1,6 @@
 // Fuzz target: EuRoC/ASL camera files (ReadEurocSensorYaml on sensor.yaml, ReadEurocImageList on
 // data.csv). The input holds sensor.yaml and data.csv separated by a marker line (fuzz_util.h).
-#include "datasets/exchange.h"
+#include "datasets/exchange/exchange.h"
 #include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -5,7 +5,7 @@
 // mav0/cam0/sensor.yaml. Empty parts other than data.csv are absent files. mav0/cam0/data/ holds
 // 0.png, 100000000.png and 200000000.png (not real images: the import copies them, the validator
 // reports them).
-#include "datasets/exchange.h"
+#include "datasets/exchange/exchange.h"
 #include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -3,7 +3,7 @@
 // input holds gates.json and suite.json separated by a marker line (fuzz_util.h PartMarker).
 #include "datasets/io.h"
 #include "eval/gate.h"
-#include "eval/suite.h"
+#include "eval/orchestration/suite.h"
 #include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -1,5 +1,5 @@
 // Fuzz target: Kalibr camchain.yaml (ReadKalibrCamchain).
-#include "datasets/exchange.h"
+#include "datasets/exchange/exchange.h"
 #include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -1,5 +1,5 @@
 // Fuzz target: OCamCalib calib_results.txt (ReadOcamCalibTxt).
-#include "datasets/ocam.h"
+#include "datasets/exchange/ocamcalib.h"
 #include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

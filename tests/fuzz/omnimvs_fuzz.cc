@@ -1,6 +1,6 @@
 // Fuzz target: OmniMVS config.yaml (ReadOmniMvsConfig, ReadOmniMvsCapture and the image names the
 // capture's img_fmt gives).
-#include "datasets/omnimvs.h"
+#include "datasets/exchange/omnimvs.h"
 #include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -9,8 +9,8 @@
 #include <string>
 
 #include "datasets/dataset.h"
+#include "eval/studies/projection_study.h"
 #include "vo/frontend.h"
-#include "vo/projection_study.h"
 
 namespace rovo {
 namespace {

@@ -6,7 +6,7 @@
 #include <filesystem>
 
 #include "datasets/dataset.h"
-#include "datasets/omnimvs.h"
+#include "datasets/exchange/omnimvs.h"
 #include "tests/vo/extrinsic_error.h"
 #include "vo/image_loader.h"
 #include "vo/ring_calibration.h"

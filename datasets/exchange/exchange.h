@@ -1,0 +1,114 @@
+#pragma once
+// Datasets for other systems and from them: EuRoC/ASL folders with Kalibr camchains or Basalt
+// calibration files (docs/exchange.md has the layout, the frame conventions and the lens fits).
+//
+//   <out>/mav0/camK/data/<timestamp_ns>.png, data.csv, sensor.yaml   (EuRoC/ASL layout)
+//   <out>/mav0/state_groundtruth_estimate0/data.csv                  (EuRoC ground-truth columns)
+//   <out>/camchain.yaml, camchain-perturbed-N.yaml                   (--format kalibr)
+//   <out>/calibration.json, calibration-perturbed-N.json             (--format basalt)
+//   <out>/README.md, rovo_export.json                                (conventions, lens fit errors)
+// The EuRoC body frame is the rovo rig frame (REP-103): T_BS = rig_from_cam, Kalibr's T_cam_imu =
+// cam_from_rig, Basalt's T_imu_cam = rig_from_cam; T_cn_cnm1 = camN_from_cam(N-1).
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "datasets/dataset.h"
+#include "datasets/exchange/lens_fit.h"
+
+namespace rovo {
+
+enum class ExchangeFormat { kEuroc, kKalibr, kBasalt };
+ExchangeFormat ExchangeFormatFromName(const std::string& name);  // euroc | kalibr | basalt
+std::string ExchangeFormatName(ExchangeFormat format);
+// The lens models a format can carry (Kalibr's pinhole-equidistant cannot pass 180 degrees and
+// Basalt has no omni), in order of preference on ties.
+std::vector<ExchangeLensModel> ExchangeFormatModels(ExchangeFormat format);
+
+// One camera as the exchange files describe it.
+struct ExchangeCamera {
+  std::string name;  // cam0, cam1, ...
+  ExchangeLensModel model = ExchangeLensModel::kDoubleSphere;
+  std::vector<double> params;  // lens_fit.h layout
+  int width = 0;
+  int height = 0;
+  double max_fov_deg = 0.0;  // 0 when the file does not say
+  Rigid3 cam_from_rig;
+};
+
+// Kalibr's field values of a lens: camera_model, intrinsics, distortion_model, distortion_coeffs.
+struct KalibrLensFields {
+  std::string camera_model;
+  std::vector<double> intrinsics;
+  std::string distortion_model;
+  std::vector<double> distortion_coeffs;
+};
+KalibrLensFields ToKalibrFields(ExchangeLensModel model, const std::vector<double>& params);
+// Inverse of ToKalibrFields; throws std::runtime_error "<what>: <field>: ..." for lenses rovo cannot use.
+void FromKalibrFields(const KalibrLensFields& fields, const std::string& what, ExchangeLensModel* model,
+                      std::vector<double>* params);
+
+// EuRoC (exchange_euroc.cc).
+std::string EurocSensorYaml(const ExchangeCamera& camera, double rate_hz, const std::string& comment);
+ExchangeCamera ReadEurocSensorYaml(const std::string& path, const std::string& name);
+// state_groundtruth_estimate0/data.csv text: timestamp [ns], position, quaternion (w first),
+// velocity in the world frame (central differences), zero gyro and accelerometer biases.
+std::string EurocGroundTruthCsv(const Trajectory& world_from_rig);
+int64_t SecondsToNs(double seconds);
+// Image list of mav0/camK/data.csv: (timestamp ns, file name). Throws naming the file and line.
+std::vector<std::pair<int64_t, std::string>> ReadEurocImageList(const std::string& path);
+
+// Kalibr (exchange_kalibr.cc). `header` is written as # comment lines first.
+std::string KalibrCamchainYaml(const std::vector<ExchangeCamera>& cameras, const std::string& header);
+std::vector<ExchangeCamera> ReadKalibrCamchain(const std::string& path);
+
+// Basalt (exchange_basalt.cc): the whole cereal object under "value0".
+nlohmann::json BasaltCalibrationJson(const std::vector<ExchangeCamera>& cameras);
+std::vector<ExchangeCamera> ReadBasaltCalibration(const std::string& path);
+
+struct ExportOptions {
+  ExchangeFormat format = ExchangeFormat::kEuroc;
+  std::string out_dir;
+  std::optional<ExchangeLensModel> model;  // default: the format's model with the smallest max error
+  double max_fit_error_px = 5.0;           // refuse when a camera's fit is worse
+};
+
+struct ExportReport {
+  ExchangeLensModel model = ExchangeLensModel::kDoubleSphere;
+  std::vector<LensFit> fits;  // per camera, the exported model
+  std::string fit_table;      // Markdown, every candidate model of the format per camera
+  int frames = 0;
+  bool ground_truth = false;
+};
+
+// Throws std::runtime_error naming the dataset, the camera and the bound when a fit is too poor.
+ExportReport ExportDataset(const std::string& dataset_dir, const ExportOptions& options);
+
+struct ImportOptions {
+  ExchangeFormat format = ExchangeFormat::kKalibr;
+  std::string calibration;  // default: <in>/camchain.yaml (kalibr), <in>/calibration.json (basalt)
+  std::string out_dir;
+};
+
+struct ImportReport {
+  int frames = 0;
+  int cameras = 0;
+  int perturbed_sets = 0;
+  bool ground_truth = false;
+  std::vector<ValidationIssue> issues;  // ValidateDataset of the result
+};
+
+// A EuRoC-style folder (<in>/mav0/camK/...) plus its calibration becomes a rovo dataset: frames
+// where every camera has an image, ground truth interpolated at the image times when
+// state_groundtruth_estimate0/data.csv exists, perturbed sets from camchain-perturbed-N.yaml /
+// calibration-perturbed-N.json beside the calibration.
+ImportReport ImportDataset(const std::string& in_dir, const ImportOptions& options);
+
+// Numbers for the YAML files of the exchange formats: full precision (%.17g), lists as [a, b, c].
+std::string YamlNumber(double value);
+std::string YamlList(const std::vector<double>& values);
+
+}  // namespace rovo

@@ -1,0 +1,62 @@
+// `rovo bench render | vo`: speed tables (eval/bench/).
+#include <CLI/CLI.hpp>
+#include <memory>
+
+#include "eval/app/commands.h"
+#include "eval/app/vo_args.h"
+#include "eval/bench/render_bench.h"
+#include "eval/bench/vo_bench.h"
+
+namespace rovo {
+namespace {
+
+// `rovo bench render`.
+void AddRenderBenchCommand(CLI::App* bench) {
+  auto options = std::make_shared<RenderBenchOptions>();
+  CLI::App* cmd = bench->add_subcommand(
+      "render",
+      "Render speed: s/frame and Mrays/s at 1 spp and default quality, raw Embree cast of the same rays "
+      "(ratio full/raw), BVH build time, peak memory, load average, optionally the Cycles ratio");
+  cmd->add_option("--preset", options->preset, "Scene preset")->capture_default_str();
+  cmd->add_option("--scene", options->scene_dir, "Scene folder instead of the preset");
+  cmd->add_option("--seed", options->seed, "Scene seed")->capture_default_str();
+  cmd->add_option("--frames", options->frames, "Frames to time")->capture_default_str();
+  cmd->add_option("--scale", options->scale, "Image scale")->capture_default_str();
+  cmd->add_option("--threads", options->threads, "Threads (default: all cores)");
+  cmd->add_option("--spp", options->spp, "Default-quality spp (0 = the default)");
+  cmd->add_flag("--quality", options->quality,
+                "Also measure anti-aliasing per spp, sample pattern and texture filter: mean error vs. a 32-spp "
+                "reference and shimmer (frame-to-frame change not in the reference) over quarter-pixel pan steps");
+  cmd->add_flag("--breakdown", options->breakdown,
+                "Also time the 1-spp render with bilinear (single mip level) texturing and without textures");
+  cmd->add_option("--cycles-timing", options->cycles_timing,
+                  "timing.json written by scenes/blender/time_cycles_vs_rovo.py: print the Cycles/rovo ratio "
+                  "(Cycles takes minutes per frame, so it is timed by that script, not here)");
+  cmd->add_option("--write", options->write_dir, "Also time a full `rovo render` of the frames into this folder");
+  cmd->callback([options] { RunRenderBenchmark(*options); });
+}
+
+}  // namespace
+
+void AddBenchCommands(CommandTree& tree) {
+  AddRenderBenchCommand(tree.bench);
+
+  // `rovo bench vo`.
+  auto bench_args = std::make_shared<VoArgs>();
+  CLI::App* bench = tree.bench->add_subcommand(
+      "vo",
+      "Time the whole pipeline on a dataset (full image size) and print a table of mean ms per frame by stage, "
+      "with a machine reference taken before and after the run (full-size hybrid warps, one per core at once); "
+      "compare speeds only between runs whose references agree");
+  AddVoRunOptions(bench, bench_args.get());
+  bench->add_option("--out", bench_args->options.out_dir, "Run folder to write (default: DATASET/../bench_vo_run)");
+  bench->add_flag("--preload", bench_args->options.preload_images,
+                  "Decode every frame's images before timing (a live rig delivers decoded images; PNG decoding costs "
+                  "about 30 CPU-ms per full-size view). Keeps all frames in memory: use --frames");
+  bench->callback([bench_args] {
+    FinaliseVoArgs(bench_args.get());
+    RunVoBenchmark(bench_args->options);
+  });
+}
+
+}  // namespace rovo

@@ -1,0 +1,320 @@
+// `rovo bench render`: speed table (full render vs. raw Embree cast of the same rays, BVH build,
+// peak memory, optional Cycles ratio) and the --quality anti-aliasing study.
+#include "eval/bench/render_bench.h"
+
+#include <sys/resource.h>
+#include <tbb/task_arena.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "render/render.h"
+#include "render/tracer.h"
+
+namespace rovo {
+namespace {
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+// Process CPU seconds (user + system): stable on a shared machine where wall time is not.
+double CpuSeconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_utime.tv_sec + usage.ru_stime.tv_sec + 1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
+
+double PeakMemoryMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+double LoadAverage() {
+  double load[1] = {0.0};
+  return getloadavg(load, 1) == 1 ? load[0] : -1.0;
+}
+
+double MeanAbsDiff(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b, const std::vector<uint8_t>& valid) {
+  double sum = 0.0;
+  size_t n = 0;
+  for (size_t i = 0; i < valid.size(); ++i) {
+    if (!valid[i]) continue;
+    for (int c = 0; c < 3; ++c) sum += std::abs(static_cast<int>(a[3 * i + c]) - static_cast<int>(b[3 * i + c]));
+    n += 3;
+  }
+  return n ? sum / n : 0.0;
+}
+
+// Renders camera 0 of frame 0 turned by quarter-pixel yaw steps (a slow pan) with each sampling
+// setting and prints the mean absolute difference to a 32-spp reference and the shimmer: mean
+// |(I_k - I_k-1) - (R_k - R_k-1)|, the frame-to-frame change not explained by the reference's.
+void RunQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tbb::task_arena& arena) {
+  constexpr int kSteps = 5;
+  constexpr int kReferenceSpp = 32;
+  CameraRays rays;
+  arena.execute([&] { rays = CameraRays::Make(rig.cameras[0].camera); });
+  const Rigid3 world_from_cam = scene.rig_trajectory[0].world_from_rig * rig.cameras[0].cam_from_rig.Inverse();
+  const size_t centre = static_cast<size_t>(rays.height / 2) * rays.width + rays.width / 2;
+  const double step_rad = 0.25 * rays.pixel_angle[centre];
+  auto render_steps = [&](const ShadeSettings& settings) {
+    std::vector<std::vector<uint8_t>> images;
+    for (int k = 0; k < kSteps; ++k) {
+      // Yaw about the camera's y axis (image columns shift by about k/4 px at the centre).
+      const Rigid3 nudge = Rigid3::FromAxisAngle(Eigen::Vector3d(0, k * step_rad, 0), Eigen::Vector3d::Zero());
+      CameraImage image;
+      arena.execute([&] {
+        tracer.SetFrame(0);
+        tracer.Render(rays, world_from_cam * nudge, settings, &image);
+      });
+      images.push_back(std::move(image.rgb));
+    }
+    return images;
+  };
+  auto shimmer = [&](const std::vector<std::vector<uint8_t>>& images, const std::vector<std::vector<uint8_t>>& ref) {
+    double sum = 0.0;
+    size_t n = 0;
+    for (int k = 1; k < kSteps; ++k) {
+      for (size_t i = 0; i < rays.valid.size(); ++i) {
+        if (!rays.valid[i]) continue;
+        for (int c = 0; c < 3; ++c) {
+          const int d_img = images[k][3 * i + c] - images[k - 1][3 * i + c];
+          const int d_ref = ref[k][3 * i + c] - ref[k - 1][3 * i + c];
+          sum += std::abs(d_img - d_ref);
+          ++n;
+        }
+      }
+    }
+    return n ? sum / n : 0.0;
+  };
+  ShadeSettings reference_settings;
+  reference_settings.spp = kReferenceSpp;
+  reference_settings.lod_bias = 0.0f;
+  const auto reference = render_steps(reference_settings);
+
+  struct Variant {
+    int spp;
+    bool trilinear;
+    float lod_bias;
+    bool rotate;
+  };
+  const std::vector<Variant> variants = {
+      {1, true, 0.0f, false},   {1, true, -0.5f, false},  {1, false, 0.0f, false}, {1, false, -0.5f, false},
+      {2, true, -0.5f, false},  {2, false, -0.5f, false}, {2, true, -0.5f, true},  {4, true, -0.5f, false},
+      {4, false, -0.5f, false}, {4, true, -0.5f, true},
+  };
+  std::printf(
+      "\nanti-aliasing: camera 0 of frame 0, %dx%d, %d quarter-pixel yaw steps, reference %d spp "
+      "(fixed pattern, trilinear, LOD bias 0); 8-bit units, mean over valid pixels and channels\n",
+      rays.width, rays.height, kSteps, kReferenceSpp);
+  std::printf("| spp | pattern | texture filter | LOD bias | mean abs error | shimmer | CPU s/view |\n");
+  std::printf("|---:|---|---|---:|---:|---:|---:|\n");
+  for (const Variant& v : variants) {
+    ShadeSettings settings;
+    settings.spp = v.spp;
+    settings.trilinear = v.trilinear;
+    settings.lod_bias = v.lod_bias;
+    settings.rotate_pattern = v.rotate;
+    const double cpu0 = CpuSeconds();
+    const auto images = render_steps(settings);
+    const double cpu = (CpuSeconds() - cpu0) / kSteps;
+    double error = 0.0;
+    for (int k = 0; k < kSteps; ++k) error += MeanAbsDiff(images[k], reference[k], rays.valid);
+    std::printf("| %d | %s | %s | %+.1f | %.3f | %.3f | %.3f |\n", v.spp,
+                v.spp == 1 ? "centre" : (v.rotate ? "per-pixel rotated" : "fixed"),
+                v.trilinear ? "trilinear" : "bilinear, nearest level", v.lod_bias, error / kSteps,
+                shimmer(images, reference), cpu);
+  }
+  std::printf("(CPU s/view computes sub-pixel bearings on the fly; rovo render precomputes them per camera)\n");
+}
+
+// Prints the Cycles comparison from WORK/timing.json of scenes/blender/time_cycles_vs_rovo.py.
+void PrintCyclesRatio(const std::string& path, double bench_default_cpu, int spp_default) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open (run scenes/blender/time_cycles_vs_rovo.py first)");
+  nlohmann::json timing;
+  try {
+    in >> timing;
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": not valid JSON: " + e.what());
+  }
+  if (!timing.contains("rows") || !timing["rows"].is_array() || timing["rows"].size() < 3)
+    throw std::runtime_error(path + ": field 'rows': expected the Cycles row and two rovo rows");
+  auto cpu = [&](size_t i) {
+    const nlohmann::json& row = timing["rows"][i];
+    if (!row.contains("cpu_seconds_per_frame") || !row["cpu_seconds_per_frame"].is_number())
+      throw std::runtime_error(path + ": field 'rows/" + std::to_string(i) + "/cpu_seconds_per_frame' missing");
+    return row["cpu_seconds_per_frame"].get<double>();
+  };
+  const double cycles = cpu(0), rovo_same_spp = cpu(1), rovo_default = cpu(2);
+  std::printf(
+      "\nCycles (%s, %s): %.1f CPU s/frame; rovo render --scene on the same exported frames "
+      "(whole command incl. load, BVH, PNG): %.2f CPU s/frame at the same spp (%.1fx), %.2f at the "
+      "default spp (%.1fx, target >= 30x)\n",
+      path.c_str(), timing.value("rows", nlohmann::json::array())[0].value("renderer", "?").c_str(), cycles,
+      rovo_same_spp, cycles / rovo_same_spp, rovo_default, cycles / rovo_default);
+  std::printf("Cycles CPU s/frame over this bench's default-quality (%d spp) render: %.1fx (different scenes)\n",
+              spp_default, cycles / bench_default_cpu);
+}
+
+// One row of the speed table.
+struct BenchRow {
+  std::string name;
+  int spp;
+  bool raw;
+  bool textures = true;
+  bool trilinear = true;
+  double seconds_per_frame = 0;
+  double cpu_seconds_per_frame = 0;
+};
+
+std::vector<BenchRow> BenchRows(int spp_default, bool breakdown) {
+  std::vector<BenchRow> rows = {{"raw cast (same camera + shadow rays)", 1, true}, {"full render", 1, false}};
+  if (spp_default != 1) {
+    rows.push_back({"raw cast (same camera + shadow rays)", spp_default, true});
+    rows.push_back({"full render", spp_default, false});
+  }
+  if (breakdown) {
+    rows.push_back({"full render, bilinear on the nearest mip level", 1, false, true, false});
+    rows.push_back({"full render, no textures", 1, false, false, true});
+  }
+  return rows;
+}
+
+// Times every row over `frames` frames. Rows interleaved frame by frame (one untimed warm-up frame
+// per row first), so that every row sees the same load on a shared machine and the ratios between
+// rows are robust to it.
+void TimeRows(const Scene& scene, const Rig& rig, const std::vector<CameraRays>& rays, Tracer& tracer,
+              tbb::task_arena& arena, int frames, std::vector<BenchRow>* rows) {
+  std::vector<CameraImage> images(rig.NumCameras());
+  auto settings_for = [](const BenchRow& row) {
+    ShadeSettings settings;
+    settings.spp = row.spp;
+    settings.raw_cast_only = row.raw;
+    settings.textures = row.textures;
+    settings.trilinear = row.trilinear;
+    return settings;
+  };
+  auto render_frame = [&](const ShadeSettings& settings, int f) {
+    arena.execute([&] {
+      tracer.SetFrame(f);
+      const Rigid3& world_from_rig = scene.rig_trajectory[f].world_from_rig;
+      for (int c = 0; c < rig.NumCameras(); ++c)
+        tracer.Render(rays[c], world_from_rig * rig.cameras[c].cam_from_rig.Inverse(), settings, &images[c]);
+    });
+  };
+  for (const BenchRow& row : *rows) render_frame(settings_for(row), 0);
+  for (int f = 0; f < frames; ++f) {
+    for (BenchRow& row : *rows) {
+      const auto t = std::chrono::steady_clock::now();
+      const double cpu0 = CpuSeconds();
+      render_frame(settings_for(row), f);
+      row.seconds_per_frame += Seconds(t) / frames;
+      row.cpu_seconds_per_frame += (CpuSeconds() - cpu0) / frames;
+    }
+  }
+}
+
+// Seconds per frame of a full `rovo render` of the frames into options.write_dir.
+double TimeDatasetWriting(const RenderBenchOptions& options, int frames, int spp) {
+  RenderOptions ro;
+  ro.preset = options.scene_dir.empty() ? options.preset : "";
+  ro.scene_dir = options.scene_dir;
+  ro.seed = options.seed;
+  ro.out_dir = options.write_dir;
+  ro.frame_end = frames;
+  ro.scale = options.scale;
+  ro.threads = options.threads;
+  ro.spp = spp;
+  ro.quiet = true;
+  const RenderSummary s = RenderDataset(ro);
+  return s.frames_rendered > 0 ? s.seconds / s.frames_rendered : -1.0;
+}
+
+// The speed table and the ratios against the targets.
+void PrintRowTable(const std::vector<BenchRow>& rows, int64_t valid_pixels, int spp_default) {
+  std::printf(
+      "\n| mode | spp | wall s/frame | CPU s/frame | camera Mrays/s (wall) | camera Mrays/CPU-s |\n"
+      "|---|---:|---:|---:|---:|---:|\n");
+  for (const BenchRow& row : rows) {
+    const double rays_per_frame = valid_pixels * static_cast<double>(row.spp);
+    std::printf("| %s | %d | %.3f | %.3f | %.1f | %.1f |\n", row.name.c_str(), row.spp, row.seconds_per_frame,
+                row.cpu_seconds_per_frame, rays_per_frame / row.seconds_per_frame / 1e6,
+                rays_per_frame / row.cpu_seconds_per_frame / 1e6);
+  }
+  std::printf("\nfull/raw at 1 spp: wall %.2f, CPU %.2f (target <= 1.5)\n",
+              rows[1].seconds_per_frame / rows[0].seconds_per_frame,
+              rows[1].cpu_seconds_per_frame / rows[0].cpu_seconds_per_frame);
+  const BenchRow& full_default = spp_default != 1 ? rows[3] : rows[1];
+  if (spp_default != 1)
+    std::printf("full/raw at %d spp: wall %.2f, CPU %.2f\n", spp_default,
+                rows[3].seconds_per_frame / rows[2].seconds_per_frame,
+                rows[3].cpu_seconds_per_frame / rows[2].cpu_seconds_per_frame);
+  std::printf("default quality (%d spp): %.3f s/frame wall, %.3f CPU s/frame (target <= 1 s wall on 2 idle cores)\n",
+              spp_default, full_default.seconds_per_frame, full_default.cpu_seconds_per_frame);
+}
+
+}  // namespace
+
+void RunRenderBenchmark(const RenderBenchOptions& options) {
+  if (options.frames < 1) throw std::invalid_argument("--frames: must be >= 1");
+  const double load_before = LoadAverage();
+  const auto t_scene = std::chrono::steady_clock::now();
+  const Scene scene =
+      SceneForOptions(options.scene_dir.empty() ? options.preset : "", false, options.seed, options.scene_dir);
+  const double scene_seconds = Seconds(t_scene);
+  const Rig rig = RigForOptions("", scene, options.scale, options.scene_dir);
+  const int frames = std::min<int>(options.frames, static_cast<int>(scene.rig_trajectory.size()));
+  const int spp_default = options.spp > 0 ? options.spp : kDefaultSpp;
+
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+  std::unique_ptr<Tracer> tracer;
+  std::vector<CameraRays> rays;
+  double rays_seconds = 0.0;
+  arena.execute([&] {
+    tracer = std::make_unique<Tracer>(scene);
+    const auto t = std::chrono::steady_clock::now();
+    std::vector<Camera> cameras;
+    for (const RigCamera& cam : rig.cameras) cameras.push_back(cam.camera);
+    rays = MakeCameraRays(cameras, 0, spp_default);
+    rays_seconds = Seconds(t);
+  });
+  int64_t valid_pixels = 0;
+  for (const CameraRays& r : rays) valid_pixels += r.num_valid;
+
+  std::vector<BenchRow> rows = BenchRows(spp_default, options.breakdown);
+  TimeRows(scene, rig, rays, *tracer, arena, frames, &rows);
+  const double write_seconds_per_frame =
+      options.write_dir.empty() ? -1.0 : TimeDatasetWriting(options, frames, spp_default);
+
+  const Camera& cam0 = rig.cameras[0].camera;
+  std::printf("rovo bench render: %s, %d frames, rig %d x %dx%d, threads %d, load average %.1f before / %.1f after\n",
+              options.scene_dir.empty() ? ("preset " + options.preset).c_str() : options.scene_dir.c_str(), frames,
+              rig.NumCameras(), cam0.width, cam0.height,
+              options.threads > 0 ? options.threads : tbb::this_task_arena::max_concurrency(), load_before,
+              LoadAverage());
+  std::printf(
+      "scene: %zu static triangles, %zu objects; generate/load %.2f s; static BVH build %.3f s; "
+      "pixel and sample bearings (%d spp) %.2f s\n",
+      tracer->num_static_triangles(), scene.objects.size(), scene_seconds, tracer->static_build_seconds(), spp_default,
+      rays_seconds);
+  PrintRowTable(rows, valid_pixels, spp_default);
+  const BenchRow& full_default = spp_default != 1 ? rows[3] : rows[1];
+  if (write_seconds_per_frame >= 0.0)
+    std::printf("rovo render incl. PNG writing (%d spp): %.3f s/frame (includes scene generation and set-up)\n",
+                spp_default, write_seconds_per_frame);
+  std::printf("peak memory (getrusage): %.0f MB\n", PeakMemoryMb());
+  if (!options.cycles_timing.empty())
+    PrintCyclesRatio(options.cycles_timing, full_default.cpu_seconds_per_frame, spp_default);
+  if (options.quality) RunQualityStudy(scene, rig, *tracer, arena);
+}
+
+}  // namespace rovo

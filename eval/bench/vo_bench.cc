@@ -1,0 +1,105 @@
+// `rovo bench vo`: time per frame by stage, and the machine reference that makes two runs comparable.
+#include "eval/bench/vo_bench.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <opencv2/core.hpp>
+#include <thread>
+#include <vector>
+
+#include "datasets/rig.h"
+#include "vo/hybrid_projection.h"
+
+namespace rovo {
+
+// Machine reference printed with the bench table: full-size hybrid warps (rovo4, camera 0, a fixed
+// random image), one per core on `cores` cores at once (shared caches and memory bandwidth included),
+// median wall time of 31 rounds after 9 warm-up rounds (single rounds vary by 2x on this machine, the
+// median by about 10 % between seconds). Measured before and after the run: the machine's speed
+// drifts by a third or more between hours (the one-core warp took 6.8 ms one evening, 10.5 ms
+// another), so runs are comparable only when their references agree.
+double MachineReferenceWarpMs(int cores) {
+  const Rig rig = MakeRigPreset("rovo4");
+  const std::vector<HybridLayout> layouts = ComputeHybridLayouts(rig);
+  const HybridProjection projection(rig.cameras[0].camera, rig.cameras[0].cam_from_rig, layouts[0]);
+  cv::Mat image(rig.cameras[0].camera.height, rig.cameras[0].camera.width, CV_8UC1);
+  cv::RNG(7).fill(image, cv::RNG::UNIFORM, 0, 255);
+  const int threads = cv::getNumThreads();
+  cv::setNumThreads(1);
+  std::vector<cv::Mat> warped(cores);
+  std::vector<double> ms;
+  for (int k = 0; k < 40; ++k) {
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<std::thread> workers;
+    for (int c = 0; c < cores; ++c) workers.emplace_back([&, c] { projection.Warp(image, &warped[c]); });
+    for (std::thread& w : workers) w.join();
+    const double round_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    if (k >= 9) ms.push_back(round_ms);  // the first rounds of a process run slow (warm-up)
+  }
+  cv::setNumThreads(threads);
+  std::nth_element(ms.begin(), ms.begin() + ms.size() / 2, ms.end());
+  return ms[ms.size() / 2];
+}
+
+void RunVoBenchmark(VoOptions options) {
+  if (options.out_dir.empty()) options.out_dir = options.dataset_dir + "_bench_vo_run";
+  const int cores =
+      options.threads > 0 ? options.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const double reference_before_ms = MachineReferenceWarpMs(cores);
+  const VoSummary s = RunVo(options);
+  const double reference_after_ms = MachineReferenceWarpMs(cores);
+  const VoStageTimes& t = s.stage_ms;
+  std::printf("rovo bench vo: %s, mode %s, %d frames, threads %d\n", options.dataset_dir.c_str(),
+              ExtrinsicsModeName(options.mode).c_str(), s.frames, options.threads);
+  // CPU = process CPU time of all threads (FrontendFrame::cpu_ms_*); measured for the front-end only. It
+  // includes the image decoder and an async BA running meanwhile: use --preload --sync-ba for the
+  // front-end's own CPU time.
+  std::printf(
+      "| stage                     | ms/frame | CPU ms/frame |\n"
+      "|---------------------------|---------:|-------------:|\n");
+  const double frontend_wall = t.warp + t.detect + t.track + t.match;
+  const double frontend_cpu = t.cpu_warp + t.cpu_detect + t.cpu_track + t.cpu_match;
+  const struct {
+    const char* name;
+    double wall, cpu;  // cpu < 0: not measured
+  } rows[] = {{"load images (wait)", t.load, -1},
+              {"front-end: warp", t.warp, t.cpu_warp},
+              {"front-end: detect", t.detect, t.cpu_detect},
+              {"front-end: track", t.track, t.cpu_track},
+              {"front-end: match", t.match, t.cpu_match},
+              {"front-end: total", frontend_wall, frontend_cpu},
+              {"back-end: RANSAC", t.ransac, -1},
+              {"back-end: refine", t.refine, -1},
+              {"back-end: triangulate", t.triangulate, -1},
+              {"back-end: local BA solve", t.ba, -1},
+              {"back-end: wait for BA", t.ba_wait, -1},
+              {"back-end: in-line total", t.backend_total, -1},
+              {"whole frame", t.total, -1}};
+  for (const auto& row : rows) {
+    if (row.cpu >= 0) {
+      std::printf("| %-25s | %8.2f | %12.2f |\n", row.name, row.wall, row.cpu);
+    } else {
+      std::printf("| %-25s | %8.2f |            - |\n", row.name, row.wall);
+    }
+  }
+  std::printf("RANSAC: %.2f us per hypothesis\n", t.ransac_us_per_hypothesis);
+  std::printf("local BA: %s\n", options.async_ba ? "solved on its own thread beside the next frame's front-end "
+                                                   "(in-line total = wait for it + the rest)"
+                                                 : "solved in line (--sync-ba)");
+  std::printf("whole pipeline: %.2f frames/s (target 10 Hz)%s\n", t.total > 0 ? 1000.0 / t.total : 0.0,
+              options.preload_images ? ", images decoded beforehand" : ", images decoded on a second thread");
+  std::printf(
+      "machine reference: one full-size hybrid warp per core on %d core%s at once: %.2f ms before the run, "
+      "%.2f ms after\n",
+      cores, cores == 1 ? "" : "s", reference_before_ms, reference_after_ms);
+  const double reference_low_ms = std::min(reference_before_ms, reference_after_ms);
+  if (std::abs(reference_after_ms - reference_before_ms) > 0.2 * reference_low_ms) {
+    std::printf(
+        "warning: the machine's speed changed by more than 20 %% during the run; repeat it before "
+        "comparing\n");
+  }
+}
+
+}  // namespace rovo

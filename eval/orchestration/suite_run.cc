@@ -1,0 +1,253 @@
+// Running a suite's tasks: datasets, VO runs (reused when their settings match), the whole suite.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+#include <type_traits>
+
+#include "datasets/dataset.h"
+#include "datasets/io.h"
+#include "datasets/progress.h"
+#include "datasets/run.h"
+#include "eval/format.h"
+#include "eval/orchestration/suite.h"
+#include "eval/plots.h"
+#include "eval/report.h"
+#include "render/render.h"
+#include "render/timing.h"
+#include "rovo/version.h"
+#include "scenes/city.h"
+#include "scenes/rng.h"
+#include "vo/pipeline.h"
+
+namespace rovo {
+namespace fs = std::filesystem;
+
+bool RunReusable(const std::string& run_dir, const RunSettings& want, std::string* mismatch) {
+  mismatch->clear();
+  std::error_code ec;
+  if (!fs::is_regular_file(RunInfoPath(run_dir), ec)) return false;
+  nlohmann::json info;
+  try {
+    info = ReadJsonFile(RunInfoPath(run_dir));
+  } catch (const std::exception&) {
+    return false;
+  }
+  if (!info.is_object() || !info.contains("dataset") || !info.contains("frames") ||
+      info["frames"] != nlohmann::json::array({0, want.frame_end}) ||
+      !fs::is_regular_file(RunTrajectoryPath(run_dir), ec) || !fs::is_regular_file(RunFramesPath(run_dir), ec) ||
+      !fs::is_regular_file(RunExtrinsicsPath(run_dir), ec)) {
+    return false;  // incomplete (a run writes run.json last)
+  }
+  // Runs from before max_new_features was recorded had no limit.
+  const nlohmann::json recorded_limit = info.value("max_new_features", nlohmann::json(0));
+  const std::pair<const char*, std::pair<nlohmann::json, nlohmann::json>> checks[] = {
+      {"mode", {info.value("mode", nlohmann::json()), ExtrinsicsModeName(want.mode)}},
+      {"noise_set", {info.value("noise_set", nlohmann::json()), want.noise_set}},
+      // Runs from before draws were recorded started from a stored set.
+      {"draw_seed", {info.value("draw_seed", nlohmann::json(-1)), want.draw_seed}},
+      {"seed", {info.value("seed", nlohmann::json()), want.seed}},
+      {"max_new_features", {recorded_limit, want.max_new_features}},
+  };
+  for (const auto& [field, values] : checks) {
+    if (values.first != values.second) {
+      *mismatch = std::string(field) + ": " + values.first.dump() + " vs " + values.second.dump();
+      return false;
+    }
+  }
+  if (want.draw_seed >= 0 && info.value("draw_sigma_deg", nlohmann::json()) != nlohmann::json(want.draw_sigma_deg)) {
+    *mismatch = "draw_sigma_deg: " + info.value("draw_sigma_deg", nlohmann::json()).dump() + " vs " +
+                nlohmann::json(want.draw_sigma_deg).dump();
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+// Whether the dataset's sensor and timing records are the ones `render` would write (a variant's
+// dataset rendered with other effects is not reused).
+bool EffectsMatch(const DatasetInfo& info, const RenderOptions& render) {
+  const int n = info.rig.NumCameras();
+  if (render.sensor.enabled != info.sensor.has_value() || render.timing.Enabled() != info.timing.has_value())
+    return false;
+  if (info.sensor &&
+      *info.sensor != MakeSensorRecord(render.sensor, CameraSensitivities(render.sensor, n, render.seed)))
+    return false;
+  return !info.timing ||
+         *info.timing == MakeTimingRecord(render.timing, TriggerOffsetsMs(render.timing, n, render.seed));
+}
+
+// Complete: the first `max_frames` frames (all when <= 0) have every camera's image, and the effects
+// match `render`'s.
+bool DatasetComplete(const std::string& dataset_dir, int max_frames, const RenderOptions& render) {
+  std::error_code ec;
+  if (!fs::is_regular_file(DatasetJsonPath(dataset_dir), ec) ||
+      !fs::is_regular_file(GroundTruthPath(dataset_dir), ec)) {
+    return false;
+  }
+  try {
+    const DatasetInfo info = ReadDatasetInfo(dataset_dir);
+    if (!EffectsMatch(info, render)) return false;
+    const int frames = max_frames > 0 ? std::min(max_frames, info.frame_count) : info.frame_count;
+    for (int f = 0; f < frames; ++f) {
+      for (const RigCamera& cam : info.rig.cameras) {
+        if (!fs::is_regular_file(ImagePath(dataset_dir, cam.name, f), ec)) return false;
+      }
+    }
+    return info.frame_count > 0 && info.frame_count >= max_frames;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+// The render settings of a variant (ParseSuiteEntry), on top of the preset's.
+void ApplySuiteVariant(const std::string& variant, RenderOptions* render) {
+  if (variant.empty()) return;
+  const bool sensor = variant == "sensor" || variant == "gray" || variant == "realistic";
+  if (variant == "ideal") render->sensor = MakeSensorSettings("ideal", {});
+  if (sensor) {
+    SensorOverrides overrides;
+    if (variant == "gray") overrides.grayscale = true;
+    render->sensor = MakeSensorSettings("realistic", overrides);
+  }
+  if (variant == "realistic") render->timing = RealisticTiming();
+  if (variant == "blur") render->timing.shutter_ms = 10.0;
+  if (variant == "rolling") render->timing.rolling_shutter_ms = 30.0;
+  if (variant == "trigger") render->timing.trigger_offset_std_ms = 1.0;
+}
+
+// The dataset must cover the runs' frames and hold the noise sets they use.
+void CheckSuiteDataset(const SuitePlan& plan, size_t preset_index) {
+  const std::string& dir = plan.dataset_dirs[preset_index];
+  const DatasetInfo info = ReadDatasetInfo(dir);
+  if (info.frame_count < plan.frame_ends[preset_index]) {
+    throw std::runtime_error(DatasetJsonPath(dir) + ": field \"frame_count\" is " + std::to_string(info.frame_count) +
+                             ", the suite runs frames [0, " + std::to_string(plan.frame_ends[preset_index]) + ")");
+  }
+  if (static_cast<int>(info.perturbed.size()) < plan.options.noise_sets) {
+    throw std::runtime_error(DatasetJsonPath(dir) + ": field \"perturbed\" holds " +
+                             std::to_string(info.perturbed.size()) + " noise sets, --seeds asks for " +
+                             std::to_string(plan.options.noise_sets));
+  }
+}
+
+// Runs `todo` with `parallel` runs at a time; rethrows the first error after the running ones end.
+void RunSuiteRunsInParallel(const SuitePlan& plan, const std::vector<const SuiteRun*>& todo, int parallel,
+                            int threads_per_run) {
+  Progress progress("suite VO runs", static_cast<int64_t>(todo.size()), "runs", plan.options.quiet);
+  std::atomic<size_t> next{0};
+  std::mutex error_mutex;
+  std::exception_ptr first_error;
+  auto worker = [&] {
+    while (true) {
+      const size_t index = next.fetch_add(1);
+      if (index >= todo.size()) return;
+      {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (first_error) return;
+      }
+      try {
+        RunSuiteRun(plan, *todo[index], threads_per_run, plan.options.quiet || parallel > 1);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!first_error) first_error = std::current_exception();
+      }
+      progress.Add(1);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int i = 1; i < parallel; ++i) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  progress.Finish();
+  if (first_error) std::rethrow_exception(first_error);
+}
+
+}  // namespace
+
+void RenderSuiteDataset(const SuitePlan& plan, size_t preset_index, int shard, int shards, int threads) {
+  const SuiteOptions& options = plan.options;
+  const std::string& dir = plan.dataset_dirs.at(preset_index);
+  const std::string& preset = options.presets[preset_index];
+  RenderOptions render;
+  const SuiteEntry entry = ParseSuiteEntry(preset);
+  render.preset = entry.preset;
+  ApplySuiteVariant(entry.variant, &render);
+  render.seed = options.scene_seed;
+  if (DatasetComplete(dir, plan.frame_ends[preset_index], render)) {
+    if (!options.quiet) std::fprintf(stderr, "rovo suite: dataset %s is complete, not rendering\n", dir.c_str());
+    return;
+  }
+  if (!options.quiet) {
+    std::fprintf(stderr, "rovo suite: rendering %s%s -> %s%s\n", preset.c_str(), options.quick ? " (quick)" : "",
+                 dir.c_str(),
+                 shards > 1 ? (" (shard " + std::to_string(shard) + "/" + std::to_string(shards) + ")").c_str() : "");
+  }
+  EnsureWritableDir(plan.data_dir);
+  render.quick = options.quick;
+  render.out_dir = dir;
+  if (options.frames > 0) render.frame_end = plan.frame_ends[preset_index];
+  render.shard_index = shard;
+  render.shard_count = shards;
+  render.threads = threads;
+  render.depth = false;
+  render.quiet = options.quiet;
+  RenderDataset(render);
+}
+
+bool RunSuiteRun(const SuitePlan& plan, const SuiteRun& run, int threads, bool quiet) {
+  std::string mismatch;
+  if (RunReusable(run.run_dir, run.settings, &mismatch)) {
+    if (!plan.options.quiet) std::fprintf(stderr, "rovo suite: run %s is complete, skipping\n", run.run_dir.c_str());
+    return false;
+  }
+  if (!mismatch.empty()) {
+    std::fprintf(stderr, "rovo suite: run %s was made with other settings (%s), running it again\n",
+                 run.run_dir.c_str(), mismatch.c_str());
+  }
+  CheckSuiteDataset(plan, run.preset_index);
+  VoOptions vo;
+  vo.dataset_dir = plan.dataset_dirs[run.preset_index];
+  vo.out_dir = run.run_dir;
+  vo.mode = run.settings.mode;
+  vo.noise_set = run.settings.noise_set;
+  vo.draw_seed = run.settings.draw_seed;
+  vo.draw_sigma_deg = run.settings.draw_sigma_deg;
+  vo.max_new_features = run.settings.max_new_features;
+  vo.seed = run.settings.seed;
+  vo.threads = threads;
+  vo.quiet = quiet;
+  vo.frame_end = run.settings.frame_end;
+  RunVo(vo);
+  return true;
+}
+
+std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
+  const SuitePlan plan = PlanSuite(options);
+  EnsureWritableDir(options.out_dir);
+  EnsureWritableDir(plan.data_dir);
+  const int cores = options.threads > 0 ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  // Datasets: rendering uses all cores, one dataset at a time.
+  for (size_t i = 0; i < plan.dataset_dirs.size(); ++i) {
+    RenderSuiteDataset(plan, i, 0, 1, cores);
+    CheckSuiteDataset(plan, i);
+  }
+  // VO runs, --jobs at a time.
+  std::vector<const SuiteRun*> todo;
+  for (const SuiteRun& run : plan.runs) {
+    std::string mismatch;
+    if (!RunReusable(run.run_dir, run.settings, &mismatch)) todo.push_back(&run);
+  }
+  const int parallel = std::min<int>(options.jobs, std::max<int>(1, static_cast<int>(todo.size())));
+  const int threads_per_run = options.vo_threads > 0 ? options.vo_threads : std::max(1, cores / parallel);
+  RunSuiteRunsInParallel(plan, todo, parallel, threads_per_run);
+  return MergeSuite(plan);
+}
+
+}  // namespace rovo
