@@ -18,6 +18,7 @@
 // the same on every platform for a given seed.
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <string>
@@ -38,11 +39,11 @@ ViewSampling ViewSamplingFromName(const std::string& name);  // "pps" | "uniform
 RansacViews RansacViewsFromName(const std::string& name);    // "multiview" | "single-view"
 
 struct MultiViewRansacOptions {
-  double tau_rad = 0.01;      // inlier threshold and truncation of the cost (0.57 deg)
-  int min_iterations = 20;    // at least this many hypotheses draws
-  int max_iterations = 1000;  // hard bound on draws
-  double confidence = 0.999;  // for the adaptive iteration bound
-  int min_inliers = 10;       // fewer: no consensus
+  double tau_rad = 0.2 * M_PI / 180.0;  // inlier threshold and truncation of the cost (0.2 deg)
+  int min_iterations = 20;              // at least this many hypotheses draws
+  int max_iterations = 1000;            // hard bound on draws
+  double confidence = 0.999;            // for the adaptive iteration bound
+  int min_inliers = 10;                 // fewer: no consensus
   ViewSampling sampling = ViewSampling::kPps;
   RansacViews views = RansacViews::kMultiView;
   uint64_t seed = 0;
