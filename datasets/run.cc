@@ -137,15 +137,6 @@ class CsvReader {
   std::vector<int> lines_;
 };
 
-const char* const kStatuses[] = {"ok", "init", "lost"};
-
-bool IsKnownStatus(const std::string& status) {
-  for (const char* s : kStatuses) {
-    if (status == s) return true;
-  }
-  return false;
-}
-
 std::vector<FrameRecord> ReadFramesCsv(const std::string& path) {
   const std::string text = ReadFile(path);
   const bool old_layout = text.rfind(Join(kFramesColumnsWithoutMissing) + "\n", 0) == 0 ||
@@ -168,8 +159,12 @@ std::vector<FrameRecord> ReadFramesCsv(const std::string& path) {
     f.mean_reproj_error_deg = csv.Double(r, 5);
     if (f.mean_reproj_error_deg < 0.0) csv.Fail(r, 5, "negative error");
     f.keyframe = csv.Bool(r, 6);
-    f.status = csv.Text(r, 7);
-    if (!IsKnownStatus(f.status)) csv.Fail(r, 7, "unknown status \"" + f.status + "\" (ok|init|lost)");
+    const std::string status = csv.Text(r, 7);
+    try {
+      f.status = FrameStatusFromName(status);
+    } catch (const std::invalid_argument&) {
+      csv.Fail(r, 7, "unknown status \"" + status + "\" (ok|init|lost)");
+    }
     f.time_ms = csv.Double(r, 8);
     if (f.time_ms < 0.0) csv.Fail(r, 8, "negative time");
     if (!old_layout) {
@@ -225,18 +220,33 @@ void CheckRunInfo(const nlohmann::json& info, const std::string& path) {
 std::string RunTrajectoryPath(const std::string& run_dir) { return (fs::path(run_dir) / "trajectory.tum").string(); }
 std::string RunFramesPath(const std::string& run_dir) { return (fs::path(run_dir) / "frames.csv").string(); }
 std::string RunExtrinsicsPath(const std::string& run_dir) { return (fs::path(run_dir) / "extrinsics.csv").string(); }
+const char* FrameStatusName(FrameStatus status) {
+  switch (status) {
+    case FrameStatus::kOk:
+      return "ok";
+    case FrameStatus::kInit:
+      return "init";
+    case FrameStatus::kLost:
+      return "lost";
+  }
+  return "ok";
+}
+
+FrameStatus FrameStatusFromName(const std::string& name) {
+  if (name == "ok") return FrameStatus::kOk;
+  if (name == "init") return FrameStatus::kInit;
+  if (name == "lost") return FrameStatus::kLost;
+  throw std::invalid_argument("frame status: expected ok, init or lost, got \"" + name + "\"");
+}
+
 std::string RunInfoPath(const std::string& run_dir) { return (fs::path(run_dir) / "run.json").string(); }
 
 void WriteFramesCsv(const std::string& path, const std::vector<FrameRecord>& frames) {
   std::string text = Join(kFramesColumns) + "\n";
   for (const FrameRecord& f : frames) {
-    if (f.status.find(',') != std::string::npos || f.status.find('\n') != std::string::npos) {
-      throw std::invalid_argument(path + ": frame " + std::to_string(f.frame) +
-                                  ": status must not contain ',' or newline");
-    }
     text += Join({std::to_string(f.frame), FormatDouble(f.timestamp), std::to_string(f.num_correspondences),
                   std::to_string(f.num_inliers), FormatDouble(f.inlier_ratio), FormatDouble(f.mean_reproj_error_deg),
-                  f.keyframe ? "1" : "0", f.status, FormatDouble(f.time_ms), f.missing_cameras});
+                  f.keyframe ? "1" : "0", FrameStatusName(f.status), FormatDouble(f.time_ms), f.missing_cameras});
     text += '\n';
   }
   WriteFileAtomic(path, text);

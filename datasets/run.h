@@ -14,9 +14,16 @@
 
 namespace rovo {
 
-// Frame status values written to frames.csv.
-//   ok: pose from RANSAC + refinement; init: (re)initialised from inter-view triangulation;
-//   lost: no pose (too few correspondences, no consensus, unreadable/black image).
+// A frame's outcome, "ok" | "init" | "lost" in frames.csv.
+enum class FrameStatus {
+  kOk,    // pose from RANSAC + refinement
+  kInit,  // (re)initialised from inter-view triangulation
+  kLost,  // no pose (too few correspondences, no consensus, unreadable/black image)
+};
+const char* FrameStatusName(FrameStatus status);
+// Throws std::invalid_argument for a name other than "ok", "init", "lost".
+FrameStatus FrameStatusFromName(const std::string& name);
+
 struct FrameRecord {
   int frame = 0;
   double timestamp = 0.0;
@@ -25,7 +32,7 @@ struct FrameRecord {
   double inlier_ratio = 0.0;           // num_inliers / num_correspondences
   double mean_reproj_error_deg = 0.0;  // mean angular error of inliers after refinement
   bool keyframe = false;
-  std::string status = "ok";
+  FrameStatus status = FrameStatus::kOk;
   double time_ms = 0.0;         // wall time spent on this frame
   std::string missing_cameras;  // cameras whose image was missing or unreadable, "1;3"; "" when none
 };

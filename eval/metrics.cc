@@ -302,8 +302,8 @@ RunEvaluation EvaluateRun(const Trajectory& full_gt, const std::vector<Rigid3>& 
   double inlier_sum = 0.0, reproj_sum = 0.0, time_sum = 0.0;
   for (const FrameRecord& f : run.frames) {
     time_sum += f.time_ms;
-    if (f.status == "lost") ++m.lost_frames;
-    if (f.status != "ok") continue;
+    if (f.status == FrameStatus::kLost) ++m.lost_frames;
+    if (f.status != FrameStatus::kOk) continue;
     ++ok;
     inlier_sum += f.inlier_ratio;
     reproj_sum += f.mean_reproj_error_deg;

@@ -259,7 +259,7 @@ std::optional<VoBackend::BaUpdate> VoBackend::FinishPendingBa() {
 }
 
 void VoBackend::Lose(const Rigid3& predicted_rig_from_world, BackendFrameResult* result) {
-  result->record.status = "lost";
+  result->record.status = FrameStatus::kLost;
   initialised_ = false;
   result->world_from_rig = predicted_rig_from_world.Inverse();
   result->num_landmarks = static_cast<int>(map_.NumWithPoint());
@@ -277,7 +277,7 @@ void VoBackend::Reinitialise(int frame, const FrontendFrame& frontend, const Rig
     Lose(predicted_rig_from_world, result);
     return;
   }
-  result->record.status = "init";
+  result->record.status = FrameStatus::kInit;
   result->record.keyframe = true;
   result->world_from_rig = predicted_rig_from_world.Inverse();
 }
@@ -440,7 +440,7 @@ BackendFrameResult VoBackend::ProcessFrame(int frame, const FrontendFrame& front
   const Rigid3 rig_from_world = refined.usable ? refined.rig_from_world : ransac.rig_from_world;
   const std::vector<std::vector<char>> rejected = ClassifyUnderPose(frame, frontend, corrs, rig_from_world, &rec);
   result.ms_refine = MsSince(start);
-  rec.status = "ok";
+  rec.status = FrameStatus::kOk;
   AddObservations(frame, frontend, &rejected);
   rig_from_world_[frame] = rig_from_world;
   previous_good_frame_ = last_good_frame_;

@@ -48,18 +48,11 @@ struct BackendOptions {
   // solve starts at the end of ProcessFrame(k) and is joined and applied by FinishPendingBa, which
   // ProcessFrame(k + 1) calls first. Results equal the synchronous order exactly; the caller sees the
   // BA-refined pose and extrinsics of frame k only after FinishPendingBa.
-  bool async_ba = false;
+  bool async_ba = true;
   double max_landmark_error_deg = 2.0;  // BA observations above are dropped
   // Online calibration settles over the first `online_settle_frames` frames after the first one: in
-  // them, an observation off its landmark by less than online_max_error_deg is kept (BA sees it), as
-  // the extrinsics are still moving; afterwards one off by more than the RANSAC threshold is
-  // rejected, as in GTExt. Keeping the 0.2-2 deg observations for the whole run (as before
-  // 2026-11-21) let them into the map: canyon_multifov OnlineExt counted 1730 correspondences per
-  // frame against GTExt's 1480, and 49 % inliers against 79 %, even when started at the true
-  // extrinsics. The start-up calibration (extrinsic_bootstrap.h) leaves ~0.1 deg. Without it
-  // (--online-prior 0) the BA alone does not correct degree-sized errors at all, whatever these two
-  // are: its random-walk prior (LocalBaOptions::extrinsic_prior_deg, 0.005 deg per solve) holds them
-  // (quick cloudy_urban: 14 deg at the end, with a 2 or a 12 deg bound).
+  // them, an observation off its landmark by less than online_max_error_deg is kept, as the extrinsics
+  // are still moving; afterwards the RANSAC threshold rejects it, as in GTExt (docs/design-notes.md).
   double online_max_error_deg = 2.0;
   int online_settle_frames = 50;
   void Check() const;

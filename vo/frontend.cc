@@ -154,7 +154,6 @@ const cv::Mat& Frontend::warped_image(int camera) const { return impl_->warped.a
 const ViewTracker& Frontend::tracker(int camera) const { return impl_->trackers.at(camera); }
 const std::vector<Frontend::ViewMatch>& Frontend::last_matches() const { return impl_->last_matches; }
 const FrontendOptions& Frontend::options() const { return impl_->options; }
-void Frontend::SetMatchingOptions(const InterviewMatchOptions& matching) { impl_->options.matching = matching; }
 
 void Frontend::SetExtrinsics(const std::vector<Rigid3>& cam_from_rig) {
   Impl& s = *impl_;

@@ -47,41 +47,23 @@ struct FrontendOptions {
   int max_new_features_per_view = 0;   // TrackerOptions::max_new_per_frame (0: no limit)
   float min_feature_distance_px = 12;  // between features of one view (warped pixels)
   int fast_threshold = 12;             // FAST-9 threshold of the detector
-  // KLT forward-backward round-trip error. 0.3 px instead of 1: drops the tracks that slide over the
-  // texture (occlusion edges, strong perspective change). Measured 2026-11-21, full size, first 300
-  // frames, GTExt (with refine_matches): relative RMSE cloudy 0.026 -> 0.021 %, sunset 0.028 -> 0.025 %,
-  // static 0.046 -> 0.019 %, dynamic 0.077 -> 0.050 %, canyon_multifov 0.140 -> 0.103 %; inlier ratio
-  // +3..5 points. Why sliding tracks shorten the trajectory: README, known limitations.
+  // KLT forward-backward round trip: drops tracks that slide over the texture (docs/design-notes.md).
   float max_forward_backward_px = 0.3f;
-  // KLT: window 15 with <= 20 iterations down to 0.03 px costs ~60 % of the former 21 / 30 / 0.01
-  // px. Measured 2026-11-21 on the quick cloudy/sunset datasets (GTExt and OnlineExt of both):
-  // inlier ratio +1.2..2.1 points (mean of RANSAC seeds 0-3) and reprojection error -0.011..-0.016
-  // deg (seed 0) in all four; mean relative RMSE over seeds 0-3: GTExt cloudy 0.073 -> 0.053 %,
-  // OnlineExt cloudy 0.107 -> 0.073 %, OnlineExt sunset 0.104 -> 0.050 %, GTExt sunset 0.090 -> 0.116 %.
+  // KLT settings: cheaper and more accurate than larger windows (docs/design-notes.md).
   int klt_window_px = 15;        // KLT window side (warped pixels)
   int klt_levels = 3;            // KLT pyramid levels above the base
   int klt_max_iterations = 20;   // KLT iterations per pyramid level (at most)
   float klt_epsilon_px = 0.03f;  // KLT convergence: update below this (warped pixels)
-  // Forward pass from the last displacement (TrackerOptions explains). With the independent
-  // backward check (tracking.h), measured 2026-11-21 on full-size datasets, first 300 frames,
-  // GTExt, against a forward pass from zero flow without it: relative RMSE dynamic_urban 0.051 -> 0.046 %,
-  // canyon_multifov 0.245 -> 0.071 %, cloudy_urban 0.022 -> 0.016 %, sunset_urban 0.029 -> 0.021 %;
-  // inlier ratio +0.4..2.0 points.
+  // Forward pass from the last displacement (TrackerOptions explains; figures in docs/design-notes.md).
   bool klt_predict_flow = true;
   int klt_predicted_levels = 0;  // levels of a predicted forward pass
   // ORB descriptors upright (TrackerOptions::upright_descriptors): the hybrid views agree on "up", so
-  // rotation invariance only adds the intensity-centroid angle's noise. `rovo study projection`, half-size
-  // cloudy_urban, 100 frames: descriptor distance along tracks 76.6 -> 53.6 (frame to frame 41.7 -> 22.8),
-  // correct matches of the front-end 10634 -> 14487 (precision 94.2 -> 92.9 %). Whole sequences in the
-  // docs/results.md; canyon_multifov GTExt 0.050 -> 0.038 %. The start-up calibration keeps oriented descriptors
-  // (its views are rotated against each other by the extrinsic errors).
+  // rotation invariance only adds noise (docs/design-notes.md).
   bool upright_descriptors = true;
   HybridProjectionOptions projection;  // warp geometry (focal, extents, rebuild threshold)
   InterviewMatchOptions matching;      // inter-view filters
   bool match_between_views = true;     // inter-view matching on/off (ablation)
   // Sub-pixel refinement of new inter-view matches (RefineMatchPositions, interview_matching.h).
-  // Measured on dynamic_urban full size, first 300 frames, GTExt: relative RMSE 0.077 -> 0.070 %,
-  // inlier ratio 89.4 -> 89.9 %, reprojection error 0.078 -> 0.075 deg.
   bool refine_matches = true;
 };
 
@@ -113,9 +95,6 @@ class Frontend {
   // vehicle, operator), or none. No feature is detected or tracked where a mask is 0: they are
   // warped with each view and eroded by half an ORB patch.
   void SetStaticMasks(const std::vector<cv::Mat>& fisheye_masks);
-  // Inter-view filter thresholds from the next Process call on (the back-end loosens the epipolar
-  // and y filters while online calibration has not converged).
-  void SetMatchingOptions(const InterviewMatchOptions& matching);
   const FrontendOptions& options() const;
 
   const HybridProjection& projection(int camera) const;

@@ -39,7 +39,7 @@ struct LocalBaOptions {
   // with these standard deviations per solve (rotation, camera centre); 0 deg = no prior. The rig
   // is rigid, so one window's evidence should move the extrinsics only a little: this averages the
   // windows' estimates instead of letting each window's errors through.
-  double extrinsic_prior_deg = 0.0;
+  double extrinsic_prior_deg = 0.005;
   double extrinsic_prior_m = 0.005;
   // Online mode: every solve also pulls each free cam_from_rig towards `extrinsic_anchor` (the start-up
   // calibration's result) with this rotation standard deviation; empty or 0 deg: none. The start-up

@@ -1,11 +1,8 @@
 #pragma once
 // ScopedOpenCvThreads: OpenCV serial (cv::setNumThreads(1), process-wide) while any holder lives, the
 // caller's setting restored when the last one goes. Every vo step that calls OpenCV's parallel
-// functions (the front-end, the start-up calibration) holds one: with several VO runs in one process
-// (`rovo suite --jobs 2`) a set-and-restore per call changed OpenCV's thread pool while another
-// run's KLT or remap was inside it, which crashed. Serial OpenCV also costs nothing there: the views
-// already run in parallel under TBB, and OpenCV's nested loops only added task overhead (measured: 4 x
-// 5 remaps on 2 threads took ~20 % more wall and CPU time than with OpenCV serial inside each view).
+// functions (the front-end, the start-up calibration) holds one: a set-and-restore per call races with
+// another VO run in the same process. The views already run in parallel under TBB (docs/design-notes.md).
 
 #include <mutex>
 #include <opencv2/core.hpp>

@@ -22,25 +22,6 @@
 
 namespace rovo {
 
-ExtrinsicsMode ExtrinsicsModeFromName(const std::string& name) {
-  if (name == "gt") return ExtrinsicsMode::kGroundTruth;
-  if (name == "noisy") return ExtrinsicsMode::kNoisy;
-  if (name == "online") return ExtrinsicsMode::kOnline;
-  throw std::invalid_argument("extrinsics mode: expected 'gt', 'noisy' or 'online', got '" + name + "'");
-}
-
-std::string ExtrinsicsModeName(ExtrinsicsMode mode) {
-  switch (mode) {
-    case ExtrinsicsMode::kGroundTruth:
-      return "gt";
-    case ExtrinsicsMode::kNoisy:
-      return "noisy";
-    case ExtrinsicsMode::kOnline:
-      return "online";
-  }
-  return "gt";
-}
-
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -58,10 +39,10 @@ void CheckRangeAndFolders(const VoOptions& options, const DatasetInfo& info, int
   if (begin < 0 || end > info.frame_count || begin >= end) {
     throw std::invalid_argument("vo: --frames " + std::to_string(begin) + ":" + std::to_string(end) +
                                 " is not a non-empty range within the dataset's " + std::to_string(info.frame_count) +
-                                " frames (" + DatasetJsonPath(options.dataset_dir) + ": frame_count)");
+                                " frames (" + DatasetJsonPath(options.io.dataset_dir) + ": frame_count)");
   }
   for (const RigCamera& cam : info.rig.cameras) {
-    const std::string folder = (std::filesystem::path(options.dataset_dir) / cam.name).string();
+    const std::string folder = (std::filesystem::path(options.io.dataset_dir) / cam.name).string();
     if (!std::filesystem::is_directory(folder)) {
       throw std::runtime_error(folder + ": image folder of camera " + cam.name +
                                " (dataset.json rig.cameras) is missing");
@@ -72,59 +53,38 @@ void CheckRangeAndFolders(const VoOptions& options, const DatasetInfo& info, int
 // GTExt: the rig's; NoisyExt/OnlineExt: a fresh draw (--draw-seed) or a stored perturbed set.
 std::vector<Rigid3> StartingExtrinsics(const VoOptions& options, const DatasetInfo& info) {
   std::vector<Rigid3> cam_from_rig = info.rig.Extrinsics();
-  if (options.mode != ExtrinsicsMode::kGroundTruth && options.draw_seed >= 0) {
-    if (!(options.draw_sigma_deg >= 0.0)) {
-      throw std::invalid_argument("vo: --draw-sigma must be non-negative (degrees), got " +
-                                  std::to_string(options.draw_sigma_deg));
-    }
+  if (options.start.mode != ExtrinsicsMode::kGroundTruth && options.start.draw_seed >= 0) {
     cam_from_rig =
-        PerturbExtrinsics(info.rig, options.draw_sigma_deg, 0.0, static_cast<uint64_t>(options.draw_seed)).cam_from_rig;
-  } else if (options.mode != ExtrinsicsMode::kGroundTruth) {
-    if (options.noise_set < 0 || options.noise_set >= static_cast<int>(info.perturbed.size())) {
-      throw std::invalid_argument(DatasetJsonPath(options.dataset_dir) + ": perturbed[" +
-                                  std::to_string(options.noise_set) + "] does not exist (the dataset has " +
+        PerturbExtrinsics(info.rig, options.start.draw_sigma_deg, 0.0, static_cast<uint64_t>(options.start.draw_seed))
+            .cam_from_rig;
+  } else if (options.start.mode != ExtrinsicsMode::kGroundTruth) {
+    if (options.start.noise_set < 0 || options.start.noise_set >= static_cast<int>(info.perturbed.size())) {
+      throw std::invalid_argument(DatasetJsonPath(options.io.dataset_dir) + ": perturbed[" +
+                                  std::to_string(options.start.noise_set) + "] does not exist (the dataset has " +
                                   std::to_string(info.perturbed.size()) + " perturbed extrinsic sets)");
     }
-    cam_from_rig = info.perturbed[options.noise_set].cam_from_rig;
+    cam_from_rig = info.perturbed[options.start.noise_set].cam_from_rig;
     if (static_cast<int>(cam_from_rig.size()) != info.rig.NumCameras()) {
-      throw std::runtime_error(DatasetJsonPath(options.dataset_dir) + ": perturbed[" +
-                               std::to_string(options.noise_set) + "].cam_from_rig has the wrong camera count");
+      throw std::runtime_error(DatasetJsonPath(options.io.dataset_dir) + ": perturbed[" +
+                               std::to_string(options.start.noise_set) + "].cam_from_rig has the wrong camera count");
     }
   }
   return cam_from_rig;
 }
 
-BackendOptions MakeBackendOptions(const VoOptions& options) {
-  BackendOptions backend_options;
-  backend_options.ransac.seed = options.seed;
-  backend_options.ransac.sampling = ViewSamplingFromName(options.sampling);
-  backend_options.ransac.views = RansacViewsFromName(options.ransac);
-  backend_options.ba.optimize_extrinsics = options.mode == ExtrinsicsMode::kOnline;
-  backend_options.async_ba = options.async_ba;
-  backend_options.ransac.tau_rad = options.ransac_tau_deg * M_PI / 180.0;
-  if (options.keyframe_distance_m > 0.0) backend_options.keyframes.min_translation_m = options.keyframe_distance_m;
-  if (options.online_settle_frames >= 0) backend_options.online_settle_frames = options.online_settle_frames;
-  // Online: each keyframe BA may move an extrinsic by about this much (random-walk prior, local_ba.h):
-  // measured on cloudy_urban quick, it halves the wander of the estimate between windows.
-  backend_options.ba.extrinsic_prior_deg = 0.005;
-  return backend_options;
-}
-
 bool RunsStartupCalibration(const VoOptions& options) {
-  return options.mode == ExtrinsicsMode::kOnline && options.online_prior_deg > 0.0;
+  return options.start.mode == ExtrinsicsMode::kOnline && options.startup.enabled;
 }
 
 StartupCalibrationReport RunStartupCalibration(const VoOptions& options, const DatasetInfo& info, int begin, int end,
                                                const std::vector<Rigid3>& cam_from_rig) {
   StartupCalibrationOptions sopt;
-  sopt.shots = options.online_startup_shots;
-  sopt.shot_spacing = options.online_startup_spacing;
-  sopt.fallback_prior_deg = options.online_prior_deg;
-  sopt.refine_rounds = options.online_bootstrap_rounds;
-  auto load = [&](int frame) { return LoadFrameImages(options.dataset_dir, info.rig, frame); };
-  StartupCalibrationReport startup =
-      CalibrateAtStartup(info.rig, cam_from_rig, load, begin, end,
-                         LoadStaticMasks(options.dataset_dir, info.rig, info.has_static_masks), sopt, options.quiet);
+  sopt.shots = options.startup.shots;
+  sopt.shot_spacing = options.startup.spacing;
+  auto load = [&](int frame) { return LoadFrameImages(options.io.dataset_dir, info.rig, frame); };
+  StartupCalibrationReport startup = CalibrateAtStartup(
+      info.rig, cam_from_rig, load, begin, end,
+      LoadStaticMasks(options.io.dataset_dir, info.rig, info.has_static_masks), sopt, options.io.quiet);
   if (!startup.converged) {
     std::fprintf(stderr, "vo online: WARNING: start-up calibration not converged: %s\n", startup.status.c_str());
   }
@@ -132,18 +92,18 @@ StartupCalibrationReport RunStartupCalibration(const VoOptions& options, const D
 }
 
 // The lenses the VO sees through: the dataset's, or scaled by the converged start-up's angle scale
-// (VoOptions::online_apply_lens_scale); `applied` receives the scale used (1: the dataset's).
+// (VoStartupOptions::apply_lens_scale); `applied` receives the scale used (1: the dataset's).
 Rig LensesForVo(const VoOptions& options, const Rig& rig, const StartupCalibrationReport& startup, double* applied) {
   *applied = 1.0;
   const double scale = startup.ring.angle_scale;
-  if (!RunsStartupCalibration(options) || !options.online_apply_lens_scale || !startup.converged || scale == 1.0) {
+  if (!RunsStartupCalibration(options) || !options.startup.apply_lens_scale || !startup.converged || scale == 1.0) {
     return rig;
   }
   try {
     double error_deg = 0.0;
     Rig scaled = WithLensAngleScale(rig, scale, &error_deg);
     *applied = scale;
-    if (!options.quiet) {
+    if (!options.io.quiet) {
       std::fprintf(stderr, "vo online: lenses' off-axis angles scaled by the start-up's %.4f (refit within %.3f deg)\n",
                    scale, error_deg);
     }
@@ -182,34 +142,12 @@ void AddStageTimes(const FrontendFrame& features, const BackendFrameResult& resu
   ms->ba += result.ms_ba;  // synchronous BA; async BA is counted when it is joined
 }
 
-// The settings RunVo checks before it reads the dataset.
-void CheckVoOptions(const VoOptions& options) {
-  if (options.dataset_dir.empty()) throw std::invalid_argument("vo: no dataset folder given");
-  if (options.out_dir.empty()) throw std::invalid_argument("vo: no output (run) folder given");
-  if (!(options.ransac_tau_deg > 0.0)) {
-    throw std::invalid_argument("vo: the RANSAC inlier threshold must be positive (--tau, degrees), got " +
-                                std::to_string(options.ransac_tau_deg));
-  }
-  if (!(options.online_anchor_deg >= 0.0) || !(options.online_anchor_mm >= 0.0)) {
-    throw std::invalid_argument("vo: the OnlineExt anchor's sigmas must be >= 0 (--online-anchor " +
-                                std::to_string(options.online_anchor_deg) + " deg, --online-anchor-mm " +
-                                std::to_string(options.online_anchor_mm) + ")");
-  }
-}
-
-FrontendOptions MakeFrontendOptions(const VoOptions& options) {
-  FrontendOptions frontend_options;
-  frontend_options.max_new_features_per_view = options.max_new_features;
-  frontend_options.projection.vertical_fov_below_deg = options.warp_below_deg;
-  return frontend_options;
-}
-
 // --preload (bench): every frame decoded before the clock starts, as a live rig delivers images.
 std::vector<LoadedFrame> PreloadImages(const VoOptions& options, const DatasetInfo& info, int begin, int end) {
   std::vector<LoadedFrame> preloaded;
-  Progress load_progress("vo: decoding images", end - begin, "frames", options.quiet);
+  Progress load_progress("vo: decoding images", end - begin, "frames", options.io.quiet);
   for (int frame = begin; frame < end; ++frame) {
-    preloaded.push_back(LoadFrameImages(options.dataset_dir, info.rig, frame));
+    preloaded.push_back(LoadFrameImages(options.io.dataset_dir, info.rig, frame));
     load_progress.Add();
   }
   load_progress.Finish();
@@ -242,11 +180,11 @@ void NoteMissingImages(const LoadedFrame& loaded, FrameRecord* rec, VoSummary* s
 // Counts a frame by status; "ok" frames add to the sums of inlier ratio and error.
 void CountFrame(const FrameRecord& rec, VoSummary* summary, double* ok_ratio_sum, double* ok_error_sum) {
   ++summary->frames;
-  if (rec.status == "ok") {
+  if (rec.status == FrameStatus::kOk) {
     ++summary->frames_ok;
     *ok_ratio_sum += rec.inlier_ratio;
     *ok_error_sum += rec.mean_reproj_error_deg;
-  } else if (rec.status == "init") {
+  } else if (rec.status == FrameStatus::kInit) {
     ++summary->frames_init;
   } else {
     ++summary->frames_lost;
@@ -257,49 +195,31 @@ void CountFrame(const FrameRecord& rec, VoSummary* summary, double* ok_ratio_sum
 nlohmann::json RunInfoJson(const VoOptions& options, const DatasetInfo& info, const BackendOptions& backend_options,
                            const VoSummary& summary, const StartupCalibrationReport& startup, int begin, int end,
                            const Rigid3& world_from_rig0) {
-  const std::string dataset_json = ReadFile(DatasetJsonPath(options.dataset_dir));
+  const std::string dataset_json = ReadFile(DatasetJsonPath(options.io.dataset_dir));
   const VoStageTimes& ms = summary.stage_ms;
-  nlohmann::json j;
-  j["mode"] = ExtrinsicsModeName(options.mode);
-  j["dataset"] = std::filesystem::absolute(options.dataset_dir).lexically_normal().string();
+  nlohmann::json j = VoOptionsJson(options);  // the registry's fields (vo_options.h)
+  j["dataset"] = std::filesystem::absolute(options.io.dataset_dir).lexically_normal().string();
   j["dataset_json_hash"] = HashHex(dataset_json.data(), dataset_json.size());
   j["scene_hash"] = info.scene_hash;
   j["dataset_seed"] = info.seed;
-  j["seed"] = options.seed;
-  j["noise_set"] = options.noise_set;
-  j["draw_seed"] = options.draw_seed;
-  j["draw_sigma_deg"] = options.draw_sigma_deg;
   j["frames"] = {begin, end};
-  j["threads"] = options.threads;
-  j["sampling"] = options.sampling;
-  j["ransac"] = options.ransac;
   j["generator"] = "rovo vo";
   j["version"] = ROVO_VERSION;
   j["initial_world_from_rig"] = PoseJson(world_from_rig0);
-  j["online_prior_deg"] = options.online_prior_deg;
-  j["online_startup_shots"] = options.online_startup_shots;
-  j["online_startup_spacing"] = options.online_startup_spacing;
-  j["online_anchor_deg"] = options.online_anchor_deg;
-  j["online_anchor_mm"] = options.online_anchor_mm;
-  j["online_apply_lens_scale"] = options.online_apply_lens_scale;
   j["lens_angle_scale_applied"] = summary.lens_angle_scale;
-  j["max_new_features"] = options.max_new_features;
-  j["warp_below_deg"] = options.warp_below_deg;
   if (RunsStartupCalibration(options)) j["startup_calibration"] = startup.ToJson();
-  j["backend"] = {{"ransac_tau_deg", backend_options.ransac.tau_rad * 180.0 / M_PI},
-                  {"ransac_max_iterations", backend_options.ransac.max_iterations},
-                  {"ransac_confidence", backend_options.ransac.confidence},
-                  {"refine_cauchy_scale_deg", backend_options.refine.cauchy_scale_rad * 180.0 / M_PI},
-                  {"ba_cauchy_scale_deg", backend_options.ba.cauchy_scale_rad * 180.0 / M_PI},
-                  {"ba_max_iterations", backend_options.ba.max_iterations},
-                  {"ba_online_extrinsics", backend_options.ba.optimize_extrinsics},
-                  {"ba_extrinsic_prior_deg", backend_options.ba.extrinsic_prior_deg},
-                  {"window_keyframes", backend_options.window_keyframes},
-                  {"async_ba", backend_options.async_ba},
-                  {"keyframe_distance_m", backend_options.keyframes.min_translation_m},
-                  {"keyframe_max_frame_gap", backend_options.keyframes.max_frame_gap},
-                  {"online_max_error_deg", backend_options.online_max_error_deg},
-                  {"online_settle_frames", backend_options.online_settle_frames}};
+  // The back-end's other settings (its user-set ones are in the registry's "backend." keys).
+  nlohmann::json& backend = j["backend"];
+  backend["ransac_max_iterations"] = backend_options.ransac.max_iterations;
+  backend["ransac_confidence"] = backend_options.ransac.confidence;
+  backend["refine_cauchy_scale_deg"] = backend_options.refine.cauchy_scale_rad * 180.0 / M_PI;
+  backend["ba_cauchy_scale_deg"] = backend_options.ba.cauchy_scale_rad * 180.0 / M_PI;
+  backend["ba_max_iterations"] = backend_options.ba.max_iterations;
+  backend["ba_online_extrinsics"] = backend_options.ba.optimize_extrinsics;
+  backend["ba_extrinsic_prior_deg"] = backend_options.ba.extrinsic_prior_deg;
+  backend["window_keyframes"] = backend_options.window_keyframes;
+  backend["keyframe_max_frame_gap"] = backend_options.keyframes.max_frame_gap;
+  backend["online_max_error_deg"] = backend_options.online_max_error_deg;
   j["summary"] = {{"frames", summary.frames},
                   {"frames_ok", summary.frames_ok},
                   {"frames_init", summary.frames_init},
@@ -314,22 +234,41 @@ nlohmann::json RunInfoJson(const VoOptions& options, const DatasetInfo& info, co
   return j;
 }
 
+// OnlineExt's start-up calibration when it runs: `cam_from_rig` becomes its result and a converged one
+// anchors the BA's extrinsics.
+StartupCalibrationReport StartUp(const VoOptions& options, const DatasetInfo& info, int begin, int end,
+                                 std::vector<Rigid3>* cam_from_rig, BackendOptions* backend_options) {
+  StartupCalibrationReport startup;
+  if (!RunsStartupCalibration(options)) return startup;
+  startup = RunStartupCalibration(options, info, begin, end, *cam_from_rig);
+  *cam_from_rig = startup.cam_from_rig;
+  if (startup.converged) {
+    backend_options->ba.extrinsic_anchor = startup.cam_from_rig;
+    backend_options->ba.extrinsic_anchor_deg = options.startup.anchor_deg;
+    // The centres are held only where the start-up knew them (it turned them by a well-determined turn).
+    backend_options->ba.extrinsic_anchor_m = startup.ring.centres_known ? 0.001 * options.startup.anchor_mm : 0.0;
+  }
+  return startup;
+}
+
+// The dataset's ground truth (the first pose gives the metric start); empty without one.
+Trajectory GroundTruthIfAny(const std::string& dataset_dir) {
+  if (!std::filesystem::exists(GroundTruthPath(dataset_dir))) return {};
+  return ReadTum(GroundTruthPath(dataset_dir));
+}
+
 }  // namespace
 
 VoSummary RunVo(const VoOptions& options) {
   const auto run_start = Clock::now();
-  CheckVoOptions(options);
-  const DatasetInfo info = ReadDatasetInfo(options.dataset_dir);
+  options.Check();
+  const DatasetInfo info = ReadDatasetInfo(options.io.dataset_dir);
   const int num_cams = info.rig.NumCameras();
-  const int begin = options.frame_begin;
-  const int end = options.frame_end < 0 ? info.frame_count : options.frame_end;
+  const int begin = options.io.frames.begin;
+  const int end = options.io.frames.end < 0 ? info.frame_count : options.io.frames.end;
   CheckRangeAndFolders(options, info, begin, end);
   std::vector<Rigid3> cam_from_rig = StartingExtrinsics(options, info);
-  // Ground truth: the first pose (metric start) and time stamps.
-  Trajectory ground_truth;
-  if (std::filesystem::exists(GroundTruthPath(options.dataset_dir))) {
-    ground_truth = ReadTum(GroundTruthPath(options.dataset_dir));
-  }
+  const Trajectory ground_truth = GroundTruthIfAny(options.io.dataset_dir);  // first pose, time stamps
   auto timestamp_of = [&](int frame) {
     return frame < static_cast<int>(ground_truth.size()) ? ground_truth[frame].timestamp : frame / info.frame_rate;
   };
@@ -337,42 +276,33 @@ VoSummary RunVo(const VoOptions& options) {
       begin < static_cast<int>(ground_truth.size()) ? ground_truth[begin].world_from_rig : Rigid3::Identity();
 
   std::unique_ptr<tbb::global_control> threads;
-  if (options.threads > 0) {
-    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, options.threads);
+  if (options.io.threads > 0) {
+    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, options.io.threads);
   }
-  EnsureWritableDir(options.out_dir);
+  EnsureWritableDir(options.io.out_dir);
 
-  BackendOptions backend_options = MakeBackendOptions(options);
-  StartupCalibrationReport startup;
-  if (RunsStartupCalibration(options)) {
-    startup = RunStartupCalibration(options, info, begin, end, cam_from_rig);
-    cam_from_rig = startup.cam_from_rig;
-    if (startup.converged) {
-      backend_options.ba.extrinsic_anchor = startup.cam_from_rig;
-      backend_options.ba.extrinsic_anchor_deg = options.online_anchor_deg;
-      // The centres are held only where the start-up knew them (it turned them by a well-determined turn).
-      backend_options.ba.extrinsic_anchor_m = startup.ring.centres_known ? 0.001 * options.online_anchor_mm : 0.0;
-    }
-  }
+  BackendOptions backend_options = options.backend;
+  backend_options.ba.optimize_extrinsics = options.start.mode == ExtrinsicsMode::kOnline;
+  const StartupCalibrationReport startup = StartUp(options, info, begin, end, &cam_from_rig, &backend_options);
   VoSummary summary;
   const Rig lenses = LensesForVo(options, info.rig, startup, &summary.lens_angle_scale);
-  Frontend frontend(lenses.WithExtrinsics(cam_from_rig), MakeFrontendOptions(options));
-  frontend.SetStaticMasks(LoadStaticMasks(options.dataset_dir, info.rig, info.has_static_masks));
+  Frontend frontend(lenses.WithExtrinsics(cam_from_rig), options.frontend);
+  frontend.SetStaticMasks(LoadStaticMasks(options.io.dataset_dir, info.rig, info.has_static_masks));
   VoBackend backend(cam_from_rig, world_from_rig0, backend_options);
 
   RunData run;
   VoStageTimes& ms = summary.stage_ms;
   int total_hypotheses = 0;
   double ok_ratio_sum = 0.0, ok_error_sum = 0.0;
-  Progress progress("vo " + ExtrinsicsModeName(options.mode), end - begin, "frames", options.quiet);
+  Progress progress("vo " + ExtrinsicsModeName(options.start.mode), end - begin, "frames", options.io.quiet);
   std::vector<LoadedFrame> preloaded;
-  if (options.preload_images) preloaded = PreloadImages(options, info, begin, end);
-  ImagePrefetcher prefetcher(options.dataset_dir, info.rig, begin, options.preload_images ? begin : end);
+  if (options.io.preload) preloaded = PreloadImages(options, info, begin, end);
+  ImagePrefetcher prefetcher(options.io.dataset_dir, info.rig, begin, options.io.preload ? begin : end);
   for (int frame = begin; frame < end; ++frame) {
     const auto frame_start = Clock::now();
-    const LoadedFrame loaded = options.preload_images ? std::move(preloaded[frame - begin]) : prefetcher.Get(frame);
+    const LoadedFrame loaded = options.io.preload ? std::move(preloaded[frame - begin]) : prefetcher.Get(frame);
     ms.load += MsSince(frame_start);
-    if (!loaded.problems.empty() && !options.quiet) {
+    if (!loaded.problems.empty() && !options.io.quiet) {
       std::fprintf(stderr, "vo: frame %d: %s\n", frame, loaded.problems.c_str());
     }
     const FrontendFrame features = frontend.Process(loaded.images);  // beside the previous keyframe's BA
@@ -380,7 +310,7 @@ VoSummary RunVo(const VoOptions& options) {
     if (auto update = backend.FinishPendingBa()) ApplyBaUpdate(*update, backend.cam_from_rig(), &run, &ms);
     BackendFrameResult result = backend.ProcessFrame(frame, features);
     ms.backend_total += MsSince(backend_start);
-    if (options.mode == ExtrinsicsMode::kOnline) frontend.SetExtrinsics(backend.cam_from_rig());
+    if (options.start.mode == ExtrinsicsMode::kOnline) frontend.SetExtrinsics(backend.cam_from_rig());
     AddStageTimes(features, result, &ms);
     total_hypotheses += result.ransac_hypotheses;
 
@@ -403,7 +333,7 @@ VoSummary RunVo(const VoOptions& options) {
   summary.mean_reproj_error_deg = summary.frames_ok > 0 ? ok_error_sum / summary.frames_ok : 0.0;
   summary.seconds = std::chrono::duration<double>(Clock::now() - run_start).count();
   run.info = RunInfoJson(options, info, backend_options, summary, startup, begin, end, world_from_rig0);
-  WriteRun(options.out_dir, run);
+  WriteRun(options.io.out_dir, run);
   return summary;
 }
 

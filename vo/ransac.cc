@@ -88,6 +88,90 @@ ViewScore ScoreView(const std::vector<BearingPointCorrespondence>& corrs, const 
   return s;
 }
 
+// The rig's multi-view P3P estimator: a sample is three correspondences of one view; each P3P
+// solution becomes a rig pose scored over every scored view (truncated angular cost).
+class MultiViewP3PEstimator {
+ public:
+  static constexpr int kMinNumSamples = 3;
+  struct Sample {
+    int view = 0;
+    uint64_t index[3] = {0, 0, 0};
+  };
+  using Model = Rigid3;  // rig_from_world
+
+  MultiViewP3PEstimator(const std::vector<std::vector<BearingPointCorrespondence>>& correspondences,
+                        const std::vector<Rigid3>& cam_from_rig, const std::vector<char>& scored, int total, double tau)
+      : correspondences_(correspondences),
+        cam_from_rig_(cam_from_rig),
+        scored_(scored),
+        total_(total),
+        tau_(tau),
+        cos_tau_(std::cos(tau)) {
+    for (const Rigid3& x : cam_from_rig) rig_from_cam_.push_back(x.Inverse());
+  }
+  std::vector<Model> Estimate(const Sample& s) const {
+    const auto& corrs = correspondences_[s.view];
+    const auto& a = corrs[s.index[0]];
+    const auto& b = corrs[s.index[1]];
+    const auto& c = corrs[s.index[2]];
+    std::vector<Model> rig_from_world;
+    for (const Rigid3& cam_from_world : SolveP3P({a.bearing_in_cam, b.bearing_in_cam, c.bearing_in_cam},
+                                                 {a.point_in_world, b.point_in_world, c.point_in_world})) {
+      rig_from_world.push_back(rig_from_cam_[s.view] * cam_from_world);
+    }
+    return rig_from_world;
+  }
+  // The score summed over the scored views; `inlier_masks` (optional) receives each view's inliers.
+  RansacScore Score(const Model& rig_from_world, std::vector<std::vector<char>>* inlier_masks = nullptr) const {
+    RansacScore total;
+    for (size_t j = 0; j < correspondences_.size(); ++j) {
+      if (!scored_[j]) continue;
+      const ViewScore s = ScoreView(correspondences_[j], cam_from_rig_[j] * rig_from_world, tau_, cos_tau_,
+                                    inlier_masks ? &(*inlier_masks)[j] : nullptr);
+      total.score += s.score;
+      total.inliers += s.inliers;
+    }
+    return total;
+  }
+  int NumData() const { return total_; }
+
+ private:
+  const std::vector<std::vector<BearingPointCorrespondence>>& correspondences_;
+  const std::vector<Rigid3>& cam_from_rig_;
+  std::vector<Rigid3> rig_from_cam_;
+  const std::vector<char>& scored_;
+  int total_;
+  double tau_, cos_tau_;
+};
+
+// Picks a view with probability weights[j] / sum (PPS: the view's correspondence count; uniform: 1),
+// then three distinct correspondences of it; counts the draws per view.
+class ViewSampler {
+ public:
+  ViewSampler(const std::vector<std::vector<BearingPointCorrespondence>>& correspondences,
+              const std::vector<double>& weights, std::vector<int>* view_draws)
+      : correspondences_(correspondences), weights_(weights), view_draws_(view_draws) {}
+  MultiViewP3PEstimator::Sample Draw(std::mt19937_64& rng) {
+    MultiViewP3PEstimator::Sample s;
+    s.view = SampleProportional(rng, weights_);
+    ++(*view_draws_)[s.view];
+    const uint64_t n = correspondences_[s.view].size();
+    s.index[0] = UniformIndex(rng, n);
+    do {
+      s.index[1] = UniformIndex(rng, n);
+    } while (s.index[1] == s.index[0]);
+    do {
+      s.index[2] = UniformIndex(rng, n);
+    } while (s.index[2] == s.index[0] || s.index[2] == s.index[1]);
+    return s;
+  }
+
+ private:
+  const std::vector<std::vector<BearingPointCorrespondence>>& correspondences_;
+  const std::vector<double>& weights_;
+  std::vector<int>* view_draws_;
+};
+
 }  // namespace
 
 MultiViewRansacReport MultiViewP3PRansac(const std::vector<std::vector<BearingPointCorrespondence>>& correspondences,
@@ -125,66 +209,17 @@ MultiViewRansacReport MultiViewP3PRansac(const std::vector<std::vector<BearingPo
   for (double w : weights) weight_sum += w;
   if (weight_sum <= 0.0 || total < options.min_inliers) return report;
 
-  std::vector<Rigid3> rig_from_cam(num_views);
-  for (int j = 0; j < num_views; ++j) rig_from_cam[j] = cam_from_rig[j].Inverse();
-
+  const MultiViewP3PEstimator estimator(correspondences, cam_from_rig, scored, total, options.tau_rad);
+  ViewSampler sampler(correspondences, weights, &report.view_draws);
   std::mt19937_64 rng(options.seed);
-  const double cos_tau = std::cos(options.tau_rad);
-  double best_score = -1.0;
-  int64_t bound = options.max_iterations;
-  int iteration = 0;
-  for (; iteration < std::max<int64_t>(options.min_iterations, std::min<int64_t>(bound, options.max_iterations));
-       ++iteration) {
-    const int view = SampleProportional(rng, weights);
-    ++report.view_draws[view];
-    const auto& corrs = correspondences[view];
-    const uint64_t n = corrs.size();
-    uint64_t i0 = UniformIndex(rng, n), i1, i2;
-    do {
-      i1 = UniformIndex(rng, n);
-    } while (i1 == i0);
-    do {
-      i2 = UniformIndex(rng, n);
-    } while (i2 == i0 || i2 == i1);
-    const std::vector<Rigid3> cam_from_world =
-        SolveP3P({corrs[i0].bearing_in_cam, corrs[i1].bearing_in_cam, corrs[i2].bearing_in_cam},
-                 {corrs[i0].point_in_world, corrs[i1].point_in_world, corrs[i2].point_in_world});
-    for (const Rigid3& candidate : cam_from_world) {
-      ++report.num_hypotheses;
-      const Rigid3 rig_from_world = rig_from_cam[view] * candidate;
-      double score = 0.0;
-      int inliers = 0;
-      for (int j = 0; j < num_views; ++j) {
-        if (!scored[j]) continue;
-        const ViewScore s =
-            ScoreView(correspondences[j], cam_from_rig[j] * rig_from_world, options.tau_rad, cos_tau, nullptr);
-        score += s.score;
-        inliers += s.inliers;
-      }
-      if (score > best_score) {
-        best_score = score;
-        report.rig_from_world = rig_from_world;
-        const double w = static_cast<double>(inliers) / total;
-        const double p_good = w * w * w;
-        if (p_good >= 1.0 - 1e-12) {
-          bound = 0;
-        } else if (p_good > 0.0) {
-          const double k = std::log(1.0 - options.confidence) / std::log(1.0 - p_good);
-          bound = static_cast<int64_t>(std::min<double>(std::ceil(k), options.max_iterations));
-        }
-      }
-    }
-  }
-  report.num_iterations = iteration;
-  if (best_score < 0.0) return report;
-  report.score = best_score;
-  int inliers = 0;
-  for (int j = 0; j < num_views; ++j) {
-    if (!scored[j]) continue;
-    inliers += ScoreView(correspondences[j], cam_from_rig[j] * report.rig_from_world, options.tau_rad, cos_tau,
-                         &report.inliers[j])
-                   .inliers;
-  }
+  const RansacResult<Rigid3> result =
+      Ransac(estimator, sampler, rng, {options.min_iterations, options.max_iterations, options.confidence});
+  report.num_iterations = result.num_iterations;
+  report.num_hypotheses = result.num_hypotheses;
+  if (!result.found) return report;
+  report.rig_from_world = result.best;
+  report.score = result.best_score;
+  const int inliers = estimator.Score(report.rig_from_world, &report.inliers).inliers;
   report.num_inliers = inliers;
   report.inlier_ratio = static_cast<double>(inliers) / total;
   report.success = inliers >= options.min_inliers;

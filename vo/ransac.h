@@ -18,6 +18,8 @@
 // the same on every platform for a given seed.
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <string>
@@ -38,11 +40,11 @@ ViewSampling ViewSamplingFromName(const std::string& name);  // "pps" | "uniform
 RansacViews RansacViewsFromName(const std::string& name);    // "multiview" | "single-view"
 
 struct MultiViewRansacOptions {
-  double tau_rad = 0.01;      // inlier threshold and truncation of the cost (0.57 deg)
-  int min_iterations = 20;    // at least this many hypotheses draws
-  int max_iterations = 1000;  // hard bound on draws
-  double confidence = 0.999;  // for the adaptive iteration bound
-  int min_inliers = 10;       // fewer: no consensus
+  double tau_rad = 0.2 * M_PI / 180.0;  // inlier threshold and truncation of the cost (0.2 deg)
+  int min_iterations = 20;              // at least this many hypotheses draws
+  int max_iterations = 1000;            // hard bound on draws
+  double confidence = 0.999;            // for the adaptive iteration bound
+  int min_inliers = 10;                 // fewer: no consensus
   ViewSampling sampling = ViewSampling::kPps;
   RansacViews views = RansacViews::kMultiView;
   uint64_t seed = 0;
@@ -67,6 +69,62 @@ struct MultiViewRansacReport {
 MultiViewRansacReport MultiViewP3PRansac(const std::vector<std::vector<BearingPointCorrespondence>>& correspondences,
                                          const std::vector<Rigid3>& cam_from_rig,
                                          const MultiViewRansacOptions& options);
+
+// ---- The generic loop (PoseLib's robust/ransac_impl.h and COLMAP's RANSAC are the models) ----
+// Estimator: `static constexpr int kMinNumSamples`, `using Sample` (a minimal sample), `using Model`,
+// `std::vector<Model> Estimate(const Sample&) const`, `RansacScore Score(const Model&) const` (larger
+// is better) and `int NumData() const` (the inlier ratio's denominator). Sampler: `Sample
+// Draw(std::mt19937_64&)`. The loop keeps the first model of the best score and stops at the adaptive
+// bound N = log(1 - confidence) / log(1 - w^kMinNumSamples) (w: the best model's inlier ratio), within
+// [min_iterations, max_iterations].
+struct RansacScore {
+  double score = 0.0;
+  int inliers = 0;
+};
+struct RansacLoopOptions {
+  int min_iterations = 20;
+  int max_iterations = 1000;
+  double confidence = 0.999;
+};
+template <typename Model>
+struct RansacResult {
+  bool found = false;  // some model was scored
+  Model best{};        // the first model with the best score
+  double best_score = -1.0;
+  int num_iterations = 0;  // samples drawn
+  int num_hypotheses = 0;  // models scored
+};
+
+template <typename Estimator, typename Sampler>
+RansacResult<typename Estimator::Model> Ransac(const Estimator& estimator, Sampler& sampler, std::mt19937_64& rng,
+                                               const RansacLoopOptions& options) {
+  RansacResult<typename Estimator::Model> result;
+  int64_t bound = options.max_iterations;
+  int iteration = 0;
+  for (; iteration < std::max<int64_t>(options.min_iterations, std::min<int64_t>(bound, options.max_iterations));
+       ++iteration) {
+    const typename Estimator::Sample sample = sampler.Draw(rng);
+    for (const typename Estimator::Model& model : estimator.Estimate(sample)) {
+      ++result.num_hypotheses;
+      const RansacScore s = estimator.Score(model);
+      if (!(s.score > result.best_score)) continue;
+      result.found = true;
+      result.best_score = s.score;
+      result.best = model;
+      const double w = static_cast<double>(s.inliers) / estimator.NumData();
+      double p_good = w;
+      for (int k = 1; k < Estimator::kMinNumSamples; ++k) p_good *= w;
+      if (p_good >= 1.0 - 1e-12) {
+        bound = 0;
+      } else if (p_good > 0.0) {
+        const double n = std::log(1.0 - options.confidence) / std::log(1.0 - p_good);
+        bound = static_cast<int64_t>(std::min<double>(std::ceil(n), options.max_iterations));
+      }
+    }
+  }
+  result.num_iterations = iteration;
+  return result;
+}
 
 // Portable uniform helpers on std::mt19937_64 (the standard distributions differ between libraries).
 uint64_t UniformIndex(std::mt19937_64& rng, uint64_t n);  // in [0, n), unbiased; n >= 1

@@ -6,64 +6,15 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "datasets/lens_angle_scale.h"
-#include "vo/extrinsic_bootstrap.h"
-#include "vo/frontend.h"
-#include "vo/local_ba.h"
 #include "vo/opencv_threads.h"
 
 namespace rovo {
 namespace {
 
-// Inter-view filters loosened for an extrinsic rotation uncertainty of `uncertainty_deg`: the
-// epipolar angle grows with it, the rectified y-distance by the warped focal length times its tangent.
-InterviewMatchOptions LoosenedMatching(InterviewMatchOptions matching, double uncertainty_deg, double focal_px) {
-  matching.max_epipolar_angle_deg = std::max(matching.max_epipolar_angle_deg, uncertainty_deg);
-  matching.max_y_distance_px += focal_px * std::tan(uncertainty_deg * M_PI / 180.0);
-  return matching;
-}
-
 double LargestChangeDeg(const std::vector<Rigid3>& a, const std::vector<Rigid3>& b) {
   double worst = 0.0;
   for (size_t j = 0; j < a.size(); ++j) worst = std::max(worst, RotationDistanceDeg(a[j].rotation, b[j].rotation));
   return worst;
-}
-
-// Stage 2: rounds of (match at the shot with filters loosened to the current uncertainty ->
-// CalibrateExtrinsicsFromFrame -> rebuild the warps), shrinking the uncertainty.
-std::vector<Rigid3> RefineOnShot(const Rig& rig, std::vector<Rigid3> cam_from_rig, const std::vector<cv::Mat>& images,
-                                 double uncertainty_deg, int max_rounds, bool quiet,
-                                 std::vector<StartupRound>* rounds) {
-  const std::vector<double> baselines = RingBaselineLengths(cam_from_rig);
-  for (int round = 0; round < max_rounds; ++round) {
-    // The full default warp, not VoOptions::warp_below_deg: the calibration needs the overlaps' matches
-    // below the rig plane too. Oriented descriptors: with extrinsics off, neighbouring warped views are
-    // rotated against each other.
-    FrontendOptions probe_options;
-    probe_options.upright_descriptors = false;
-    Frontend probe(rig.WithExtrinsics(cam_from_rig), probe_options);
-    probe.SetMatchingOptions(
-        LoosenedMatching(probe.options().matching, uncertainty_deg, probe.projection(0).focal_px()));
-    const FrontendFrame frame = probe.Process(images);
-    ExtrinsicBootstrapOptions bopt;
-    bopt.max_error_deg = uncertainty_deg;
-    const ExtrinsicBootstrapReport report = CalibrateExtrinsicsFromFrame(frame, cam_from_rig, baselines, bopt);
-    rounds->push_back({uncertainty_deg, report.num_points, report.points_per_pair_min, report.median_error_deg_before,
-                       report.median_error_deg_after, report.max_change_deg, report.usable});
-    if (!quiet) {
-      std::fprintf(stderr,
-                   "vo online: start-up refinement round %d: uncertainty %.2f deg, %d shared points (>= %d per "
-                   "overlap), median error %.3f -> %.3f deg, largest change %.3f deg%s\n",
-                   round + 1, uncertainty_deg, report.num_points, report.points_per_pair_min,
-                   report.median_error_deg_before, report.median_error_deg_after, report.max_change_deg,
-                   report.usable ? "" : " (not usable: kept)");
-    }
-    if (!report.usable) break;
-    cam_from_rig = report.cam_from_rig;
-    uncertainty_deg = std::max(0.5, std::min(0.5 * uncertainty_deg, 3.0 * report.max_change_deg));
-    if (report.max_change_deg < 0.02) break;
-  }
-  return cam_from_rig;
 }
 
 void PrintRing(const RingCalibrationReport& ring) {
@@ -225,18 +176,6 @@ RingCalibrationReport RunRingStage(const Rig& rig, const std::vector<Rigid3>& ca
   return ring;
 }
 
-// Stage 2's lenses: scaled by a converged ring stage's angle scale where the lens model allows it
-// (whatever VoOptions::online_apply_lens_scale says: stage 2 refines the ring's solution, which was
-// found with the scaled lenses; the lenses the VO then uses are the pipeline's choice).
-Rig RefinementRig(const Rig& rig, const RingCalibrationReport& ring) {
-  if (!ring.converged || ring.angle_scale == 1.0) return rig;
-  try {
-    return WithLensAngleScale(rig, ring.angle_scale);
-  } catch (const std::invalid_argument&) {
-    return rig;
-  }
-}
-
 }  // namespace
 
 nlohmann::json StartupCalibrationReport::ToJson() const {
@@ -249,16 +188,6 @@ nlohmann::json StartupCalibrationReport::ToJson() const {
                      {"change_deg", p.change_deg},
                      {"median_residual_deg_given", p.median_residual_deg_given},
                      {"median_residual_deg_result", p.median_residual_deg_result}});
-  }
-  nlohmann::json round_list = nlohmann::json::array();
-  for (const StartupRound& r : rounds) {
-    round_list.push_back({{"uncertainty_deg", r.uncertainty_deg},
-                          {"points", r.points},
-                          {"points_per_pair_min", r.points_per_pair_min},
-                          {"median_error_deg_before", r.median_error_deg_before},
-                          {"median_error_deg_after", r.median_error_deg_after},
-                          {"max_change_deg", r.max_change_deg},
-                          {"usable", r.usable}});
   }
   nlohmann::json extrinsics = nlohmann::json::array();
   for (const Rigid3& x : cam_from_rig) extrinsics.push_back(Rigid3ToJson(x));
@@ -280,7 +209,7 @@ nlohmann::json StartupCalibrationReport::ToJson() const {
             {"placements_averaged", placements_averaged},
             {"placement_spread_deg", placement_spread_deg},
             {"pairs", pairs}}},
-          {"refinement_rounds", round_list},
+          {"refinement_rounds", nlohmann::json::array()},  // kept in the format: always empty
           {"cam_from_rig", extrinsics}};
 }
 
@@ -309,29 +238,11 @@ StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Ri
     return report;
   }
   report.ring = RunRingStage(rig, cam_from_rig, shots, static_masks, options, quiet, &report);
-  const std::vector<cv::Mat>& first_images = shots.front();
-  const std::vector<Rigid3> start = report.ring.converged ? report.ring.cam_from_rig : cam_from_rig;
-  const double uncertainty = report.ring.converged ? options.refine_start_deg : options.fallback_prior_deg;
-  std::vector<Rigid3> refined = start;
-  if (options.refine) {
-    refined = RefineOnShot(RefinementRig(rig, report.ring), start, first_images, uncertainty, options.refine_rounds,
-                           quiet, &report.rounds);
-  }
   if (!report.ring.converged) {
-    report.cam_from_rig = refined;
-    report.status =
-        "ring stage failed (" + report.ring.reason + ")" +
-        (options.refine ? "; the loose-filter refinement alone may be wrong" : "; starting extrinsics kept");
+    report.status = "ring stage failed (" + report.ring.reason + "); starting extrinsics kept";
     return report;
   }
-  const double moved = LargestChangeDeg(refined, start);
-  if (moved > options.max_refine_change_deg) {
-    report.cam_from_rig = start;
-    report.status =
-        "refinement moved a camera " + std::to_string(moved) + " deg from the ring result; ring result kept";
-    return report;
-  }
-  report.cam_from_rig = refined;
+  report.cam_from_rig = report.ring.cam_from_rig;
   report.converged = true;
   report.status = "converged";
   return report;

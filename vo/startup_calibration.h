@@ -2,22 +2,13 @@
 // OnlineExt's start-up calibration: from extrinsics that may be off by any sigma = 5 deg draw to
 // within a fraction of a degree, before the local BA takes over (local_ba.h).
 //
-//   1. Ring stage (ring_calibration.h), no extrinsic prior: the rotation of each ring pair from
-//      descriptor matches over its whole overlap (rotation-only RANSAC on bearings, then epipolar
-//      residuals with the known baseline), pooled over `shots` synchronous shots, averaged around the
-//      ring into cam_j_from_cam0 and refined jointly. Later passes (ring_passes) place the overlap
-//      views by the previous result, refine the matches by KLT and detect more, weaker corners on
-//      denser views; each must confirm the pass before it. The last pass is repeated from slightly
-//      turned view placements and the results averaged (`placements`).
-//      The joint refinement also estimates one angle scale of every lens (a real lens calibration
-//      that understates angles near the rim). When this fails, it runs once more as a rescue
-//      (StartupCalibrationOptions::rescue) with more and weaker features.
-//   2. Refinement (extrinsic_bootstrap.h): rounds of the front-end's inter-view matching at the first
-//      shot with filters loosened to the current uncertainty and a one-pose BA with the rig's
-//      baseline lengths, the uncertainty shrinking with the change of each round.
-// When the ring stage cannot calibrate (too few matches, an open or inconsistent ring) the
-// refinement runs alone from `fallback_prior_deg`, and the report says "not converged" with the
-// reason: the caller writes it to run.json and stderr.
+// The ring stage (ring_calibration.h), no extrinsic prior: each ring pair's rotation from descriptor
+// matches over its whole overlap, pooled over `shots` synchronous shots, averaged around the ring and
+// refined jointly with one angle scale of every lens; later passes on views placed by the previous
+// result, the last one averaged over several view placements, and a rescue with weaker features.
+// When the ring stage cannot calibrate (too few matches, an open or inconsistent ring) the starting
+// extrinsics are kept and the report says "not converged" with the reason: the caller writes it to
+// run.json and stderr.
 
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -56,22 +47,6 @@ struct StartupCalibrationOptions {
   bool rescue = true;
   int rescue_orb_features = 6000;
   int rescue_orb_fast_threshold = 5;
-  bool refine = false;               // stage 2 (off: measured worse than the ring stage alone)
-  double refine_start_deg = 2.0;     // stage 2's first uncertainty after a converged ring stage
-  double fallback_prior_deg = 15.0;  // stage 2's first uncertainty when the ring stage fails
-  int refine_rounds = 6;
-  // A refinement that moves a camera further than this from the ring stage's result is not trusted
-  // (the ring result is kept and the report says so).
-  double max_refine_change_deg = 3.0;
-};
-
-struct StartupRound {
-  double uncertainty_deg = 0.0;
-  int points = 0;
-  int points_per_pair_min = 0;
-  double median_error_deg_before = 0.0, median_error_deg_after = 0.0;
-  double max_change_deg = 0.0;
-  bool usable = false;
 };
 
 struct StartupCalibrationReport {
@@ -86,7 +61,6 @@ struct StartupCalibrationReport {
   std::string ring_failure;            // why the ring passes failed, when the rescue ran
   int placements_averaged = 0;         // converged view placements averaged (StartupCalibrationOptions::placements)
   double placement_spread_deg = -1.0;  // largest angle of one of them from their mean (cam_j_from_cam0)
-  std::vector<StartupRound> rounds;    // stage 2
   std::vector<Rigid3> cam_from_rig;    // the result (the start when nothing could be done)
   nlohmann::json ToJson() const;
 };

@@ -30,9 +30,8 @@ struct TrackerOptions {
   float klt_epsilon_px = 0.03f;           // LK stops a level when its update is below this (pixels)
   // Forward-backward check: the backward pass tracks the forward result back into the previous
   // image from scratch (all levels, no initial guess), and the track is kept when it lands within
-  // this distance of where it started (FrontendOptions explains the value). Starting the backward
-  // pass at the known start (as before 2026-11-21) let gross forward errors pass: LK barely moves
-  // from a start whose patch does not match, so the round trip looked closed.
+  // this distance of where it started (FrontendOptions explains the value); a backward pass from the
+  // known start would let gross forward errors pass (docs/design-notes.md).
   float max_forward_backward_px = 0.3f;
   // The forward pass of a track tracked before starts at its position plus its last displacement
   // (constant image velocity) with klt_predicted_levels levels; a track this loses (LK failure or

@@ -1,9 +1,7 @@
 #pragma once
 // The options `rovo vo` and `rovo bench vo` share (defined in vo_commands.cc).
 
-#include <string>
-
-#include "vo/pipeline.h"
+#include "vo/vo_options.h"
 
 namespace CLI {
 class App;
@@ -14,16 +12,12 @@ namespace rovo {
 
 struct VoArgs {
   VoOptions options;
-  std::string extrinsics = "gt";
-  std::string frames;
-  bool realtime = false;
-  CLI::Option* warp_below = nullptr;  // given explicitly, it overrides --realtime
-  CLI::Option* max_new_features = nullptr;
+  bool realtime = false;  // --realtime: the real-time front-end profile where its flags are not given
 };
 
 // The dataset argument and every run option of `rovo vo` except --out.
 void AddVoRunOptions(CLI::App* cmd, VoArgs* args);
-// After parsing: the mode from --extrinsics, the frame range, the --realtime profile.
-void FinaliseVoArgs(VoArgs* args);
+// After parsing `cmd`: the --realtime profile for the flags that were not given.
+void FinaliseVoArgs(CLI::App* cmd, VoArgs* args);
 
 }  // namespace rovo

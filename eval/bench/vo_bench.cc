@@ -44,15 +44,15 @@ double MachineReferenceWarpMs(int cores) {
 }
 
 void RunVoBenchmark(VoOptions options) {
-  if (options.out_dir.empty()) options.out_dir = options.dataset_dir + "_bench_vo_run";
+  if (options.io.out_dir.empty()) options.io.out_dir = options.io.dataset_dir + "_bench_vo_run";
   const int cores =
-      options.threads > 0 ? options.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+      options.io.threads > 0 ? options.io.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   const double reference_before_ms = MachineReferenceWarpMs(cores);
   const VoSummary s = RunVo(options);
   const double reference_after_ms = MachineReferenceWarpMs(cores);
   const VoStageTimes& t = s.stage_ms;
-  std::printf("rovo bench vo: %s, mode %s, %d frames, threads %d\n", options.dataset_dir.c_str(),
-              ExtrinsicsModeName(options.mode).c_str(), s.frames, options.threads);
+  std::printf("rovo bench vo: %s, mode %s, %d frames, threads %d\n", options.io.dataset_dir.c_str(),
+              ExtrinsicsModeName(options.start.mode).c_str(), s.frames, options.io.threads);
   // CPU = process CPU time of all threads (FrontendFrame::cpu_ms_*); measured for the front-end only. It
   // includes the image decoder and an async BA running meanwhile: use --preload --sync-ba for the
   // front-end's own CPU time.
@@ -85,11 +85,11 @@ void RunVoBenchmark(VoOptions options) {
     }
   }
   std::printf("RANSAC: %.2f us per hypothesis\n", t.ransac_us_per_hypothesis);
-  std::printf("local BA: %s\n", options.async_ba ? "solved on its own thread beside the next frame's front-end "
-                                                   "(in-line total = wait for it + the rest)"
-                                                 : "solved in line (--sync-ba)");
+  std::printf("local BA: %s\n", options.backend.async_ba ? "solved on its own thread beside the next frame's front-end "
+                                                           "(in-line total = wait for it + the rest)"
+                                                         : "solved in line (--sync-ba)");
   std::printf("whole pipeline: %.2f frames/s (target 10 Hz)%s\n", t.total > 0 ? 1000.0 / t.total : 0.0,
-              options.preload_images ? ", images decoded beforehand" : ", images decoded on a second thread");
+              options.io.preload ? ", images decoded beforehand" : ", images decoded on a second thread");
   std::printf(
       "machine reference: one full-size hybrid warp per core on %d core%s at once: %.2f ms before the run, "
       "%.2f ms after\n",

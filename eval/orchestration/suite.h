@@ -69,8 +69,10 @@ struct SuiteOptions {
   std::string out_dir;
   uint64_t scene_seed = 0;    // scene / render seed
   uint64_t vo_seed = 0;       // RANSAC seed of every run
-  int max_new_features = -1;  // VoOptions::max_new_features of every run; < 0: its default
-  int MaxNewFeatures() const { return max_new_features >= 0 ? max_new_features : VoOptions{}.max_new_features; }
+  int max_new_features = -1;  // FrontendOptions::max_new_features_per_view of every run; < 0: its default
+  int MaxNewFeatures() const {
+    return max_new_features >= 0 ? max_new_features : VoOptions{}.frontend.max_new_features_per_view;
+  }
   bool plots = true;
   bool quiet = false;
 };

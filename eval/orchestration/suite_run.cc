@@ -24,9 +24,27 @@
 #include "scenes/city.h"
 #include "scenes/rng.h"
 #include "vo/pipeline.h"
+#include "vo/vo_options.h"
 
 namespace rovo {
 namespace fs = std::filesystem;
+
+namespace {
+
+// The options of a suite run (RunSettings recorded by RunVo).
+VoOptions VoOptionsFor(const RunSettings& settings) {
+  VoOptions vo;
+  vo.start.mode = settings.mode;
+  vo.start.noise_set = settings.noise_set;
+  vo.start.draw_seed = settings.draw_seed;
+  vo.start.draw_sigma_deg = settings.draw_sigma_deg;
+  vo.frontend.max_new_features_per_view = settings.max_new_features;
+  vo.backend.ransac.seed = settings.seed;
+  vo.io.frames.end = settings.frame_end;
+  return vo;
+}
+
+}  // namespace
 
 bool RunReusable(const std::string& run_dir, const RunSettings& want, std::string* mismatch) {
   mismatch->clear();
@@ -44,28 +62,7 @@ bool RunReusable(const std::string& run_dir, const RunSettings& want, std::strin
       !fs::is_regular_file(RunExtrinsicsPath(run_dir), ec)) {
     return false;  // incomplete (a run writes run.json last)
   }
-  // Runs from before max_new_features was recorded had no limit.
-  const nlohmann::json recorded_limit = info.value("max_new_features", nlohmann::json(0));
-  const std::pair<const char*, std::pair<nlohmann::json, nlohmann::json>> checks[] = {
-      {"mode", {info.value("mode", nlohmann::json()), ExtrinsicsModeName(want.mode)}},
-      {"noise_set", {info.value("noise_set", nlohmann::json()), want.noise_set}},
-      // Runs from before draws were recorded started from a stored set.
-      {"draw_seed", {info.value("draw_seed", nlohmann::json(-1)), want.draw_seed}},
-      {"seed", {info.value("seed", nlohmann::json()), want.seed}},
-      {"max_new_features", {recorded_limit, want.max_new_features}},
-  };
-  for (const auto& [field, values] : checks) {
-    if (values.first != values.second) {
-      *mismatch = std::string(field) + ": " + values.first.dump() + " vs " + values.second.dump();
-      return false;
-    }
-  }
-  if (want.draw_seed >= 0 && info.value("draw_sigma_deg", nlohmann::json()) != nlohmann::json(want.draw_sigma_deg)) {
-    *mismatch = "draw_sigma_deg: " + info.value("draw_sigma_deg", nlohmann::json()).dump() + " vs " +
-                nlohmann::json(want.draw_sigma_deg).dump();
-    return false;
-  }
-  return true;
+  return VoRunSettingsMatch(info, VoOptionsFor(want), mismatch);
 }
 
 namespace {
@@ -212,18 +209,11 @@ bool RunSuiteRun(const SuitePlan& plan, const SuiteRun& run, int threads, bool q
                  run.run_dir.c_str(), mismatch.c_str());
   }
   CheckSuiteDataset(plan, run.preset_index);
-  VoOptions vo;
-  vo.dataset_dir = plan.dataset_dirs[run.preset_index];
-  vo.out_dir = run.run_dir;
-  vo.mode = run.settings.mode;
-  vo.noise_set = run.settings.noise_set;
-  vo.draw_seed = run.settings.draw_seed;
-  vo.draw_sigma_deg = run.settings.draw_sigma_deg;
-  vo.max_new_features = run.settings.max_new_features;
-  vo.seed = run.settings.seed;
-  vo.threads = threads;
-  vo.quiet = quiet;
-  vo.frame_end = run.settings.frame_end;
+  VoOptions vo = VoOptionsFor(run.settings);
+  vo.io.dataset_dir = plan.dataset_dirs[run.preset_index];
+  vo.io.out_dir = run.run_dir;
+  vo.io.threads = threads;
+  vo.io.quiet = quiet;
   RunVo(vo);
   return true;
 }

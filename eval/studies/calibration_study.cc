@@ -43,8 +43,8 @@ bool RunReusable(const std::string& dir, uint64_t seed, int frame_end, int start
     const nlohmann::json j = nlohmann::json::parse(ReadFile(RunInfoPath(dir)));
     return j.value("draw_seed", int64_t{-1}) == static_cast<int64_t>(seed) && j.at("frames")[1] == frame_end &&
            j.value("online_startup_shots", -1) == startup_shots && j.value("online_startup_spacing", -1) == spacing &&
-           j.value("online_anchor_deg", -1.0) == VoOptions{}.online_anchor_deg &&
-           j.value("online_anchor_mm", -1.0) == VoOptions{}.online_anchor_mm &&
+           j.value("online_anchor_deg", -1.0) == VoOptions{}.startup.anchor_deg &&
+           j.value("online_anchor_mm", -1.0) == VoOptions{}.startup.anchor_mm &&
            j.value("version", "") == ROVO_VERSION && j.contains("startup_calibration");
   } catch (const std::exception&) {
     return false;
@@ -92,16 +92,16 @@ CalibrationDraw RunDraw(const CalibrationStudyOptions& o, const DatasetInfo& inf
   const std::string dir = RunDir(o, seed);
   if (!RunReusable(dir, seed, frame_end, o.startup_shots, o.shot_spacing)) {
     VoOptions v;
-    v.dataset_dir = o.dataset_dir;
-    v.out_dir = dir;
-    v.mode = ExtrinsicsMode::kOnline;
-    v.draw_seed = static_cast<int64_t>(seed);
-    v.draw_sigma_deg = o.sigma_deg;
-    v.frame_end = frame_end;
-    v.threads = o.threads;
-    v.online_startup_shots = o.startup_shots;
-    v.online_startup_spacing = o.shot_spacing;
-    v.quiet = true;
+    v.io.dataset_dir = o.dataset_dir;
+    v.io.out_dir = dir;
+    v.start.mode = ExtrinsicsMode::kOnline;
+    v.start.draw_seed = static_cast<int64_t>(seed);
+    v.start.draw_sigma_deg = o.sigma_deg;
+    v.io.frames.end = frame_end;
+    v.io.threads = o.threads;
+    v.startup.shots = o.startup_shots;
+    v.startup.spacing = o.shot_spacing;
+    v.io.quiet = true;
     RunVo(v);
   }
   const RunData run = ReadRun(dir);
@@ -157,7 +157,7 @@ std::string ReproduceCommand(const CalibrationStudyOptions& o) {
   } else {
     s << "rovo vo " << o.dataset_dir << " --extrinsics online --draw-seed {seed} --draw-sigma " << o.sigma_deg;
     if (o.frames > 0) s << " --frames 0:" << o.frames;
-    if (o.startup_shots != VoOptions{}.online_startup_shots || o.shot_spacing != VoOptions{}.online_startup_spacing) {
+    if (o.startup_shots != VoOptions{}.startup.shots || o.shot_spacing != VoOptions{}.startup.spacing) {
       s << " --online-startup-shots " << o.startup_shots << " --online-startup-spacing " << o.shot_spacing;
     }
     s << " --out run_{seed}";
@@ -302,7 +302,7 @@ double ExtrinsicTranslationErrorM(const std::vector<Rigid3>& est, const std::vec
 
 CalibrationStudyResult RunCalibrationStudy(const CalibrationStudyOptions& options) {
   CalibrationStudyOptions o = options;
-  if (o.startup_shots == 0) o.startup_shots = o.shot_only ? 1 : VoOptions{}.online_startup_shots;
+  if (o.startup_shots == 0) o.startup_shots = o.shot_only ? 1 : VoOptions{}.startup.shots;
   if (o.draws < 1) throw std::invalid_argument("study calibration: --draws must be at least 1");
   if (!(o.sigma_deg >= 0.0)) throw std::invalid_argument("study calibration: --sigma must be non-negative");
   const DatasetInfo info = ReadDatasetInfo(o.dataset_dir);

@@ -274,7 +274,7 @@ TEST(EvaluateRun, SummarisesFramesAndExtrinsics) {
     f.num_inliers = i == 4 ? 0 : 50 + (i % 2) * 10;
     f.inlier_ratio = f.num_inliers / 100.0;
     f.mean_reproj_error_deg = i == 4 ? 0.0 : 0.2;
-    f.status = i == 4 ? "lost" : (i == 0 ? "init" : "ok");
+    f.status = i == 4 ? FrameStatus::kLost : (i == 0 ? FrameStatus::kInit : FrameStatus::kOk);
     f.time_ms = 10.0;
     run.frames.push_back(f);
   }

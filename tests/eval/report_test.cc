@@ -57,7 +57,7 @@ class ReportTest : public ::testing::Test {
       f.num_inliers = i == skip ? 0 : 120;
       f.inlier_ratio = f.num_inliers / 200.0;
       f.mean_reproj_error_deg = i == skip ? 0.0 : 0.15;
-      f.status = i == skip ? "lost" : "ok";
+      f.status = i == skip ? FrameStatus::kLost : FrameStatus::kOk;
       f.time_ms = 20.0;
       run.frames.push_back(f);
       for (int c = 0; c < 4; ++c) run.extrinsics.push_back({i, i * 0.1, c, extrinsics[static_cast<size_t>(c)]});

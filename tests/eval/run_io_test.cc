@@ -37,7 +37,7 @@ class RunIoTest : public ::testing::Test {
       f.inlier_ratio = 150.0 / (300 + i);
       f.mean_reproj_error_deg = 0.123456789;
       f.keyframe = i % 2 == 0;
-      f.status = i == 1 ? "lost" : "ok";
+      f.status = i == 1 ? FrameStatus::kLost : FrameStatus::kOk;
       f.time_ms = 12.5;
       run.frames.push_back(f);
       for (int c = 0; c < 2; ++c) {

@@ -140,6 +140,7 @@ TEST(LocalBa, OnlineCalibrationRecoversPerturbedExtrinsics) {
   p.baseline_lengths = baselines;
 
   LocalBaOptions options;
+  options.extrinsic_prior_deg = 0.0;  // no random-walk prior
   options.optimize_extrinsics = true;
   options.max_iterations = 50;
   const LocalBaReport report = SolveLocalBa(p, options);
@@ -168,6 +169,7 @@ TEST(LocalBa, TheAnchorHoldsTheCentresWhenAsked) {
   for (double sigma_m : {0.0, 1e-6}) {
     LocalBaProblem p = s.problem;
     LocalBaOptions options;
+    options.extrinsic_prior_deg = 0.0;  // no random-walk prior
     options.optimize_extrinsics = true;
     options.max_iterations = 30;
     options.extrinsic_anchor = anchor;
@@ -188,6 +190,7 @@ TEST(LocalBa, FixedExtrinsicsStayFixedAndPosesImprove) {
     p.rig_from_world[i].translation += Eigen::Vector3d(0.1, -0.05, 0.02);
   }
   LocalBaOptions options;
+  options.extrinsic_prior_deg = 0.0;  // no random-walk prior
   options.max_iterations = 30;
   const LocalBaReport report = SolveLocalBa(p, options);
   ASSERT_TRUE(report.usable);
@@ -207,6 +210,7 @@ TEST(LocalBa, DeterministicForSameInput) {
       Rigid3(test::RandomRotation(rng, 2.0) * a.cam_from_rig[2].rotation, a.cam_from_rig[2].translation);
   LocalBaProblem b = a;
   LocalBaOptions options;
+  options.extrinsic_prior_deg = 0.0;  // no random-walk prior
   options.optimize_extrinsics = true;
   SolveLocalBa(a, options);
   SolveLocalBa(b, options);

@@ -15,9 +15,9 @@ double PositionError(const Rigid3& a, const Rigid3& b) { return (a.translation -
 
 TEST(RunVo, RejectsANonPositiveInlierThresholdBeforeReadingTheDataset) {
   VoOptions options;
-  options.dataset_dir = "/nonexistent/dataset";
-  options.out_dir = "/nonexistent/run";
-  options.ransac_tau_deg = 0.0;
+  options.io.dataset_dir = "/nonexistent/dataset";
+  options.io.out_dir = "/nonexistent/run";
+  options.backend.ransac.tau_rad = 0.0;
   try {
     RunVo(options);
     FAIL() << "expected std::invalid_argument";
@@ -30,12 +30,12 @@ TEST(VoBackend, TracksExactSequenceWithGroundTruthExtrinsics) {
   const int frames = 30;
   const test::World w = test::MakeWorld(frames, 1);
   std::mt19937_64 rng(2);
-  BackendOptions options;
+  BackendOptions options = test::SyntheticBackendOptions();
   VoBackend backend(w.cam_from_rig, w.world_from_rig[0], options);
   int keyframes = 0;
   for (int f = 0; f < frames; ++f) {
     const BackendFrameResult r = backend.ProcessFrame(f, test::Observe(w, f, rng, 0.0, 0.0));
-    EXPECT_EQ(r.record.status, f == 0 ? "init" : "ok") << "frame " << f;
+    EXPECT_EQ(r.record.status, f == 0 ? FrameStatus::kInit : FrameStatus::kOk) << "frame " << f;
     if (f > 0) {
       EXPECT_GT(r.record.inlier_ratio, 0.9) << "frame " << f;
       EXPECT_LT(r.record.mean_reproj_error_deg, 0.01) << "frame " << f;
@@ -51,12 +51,12 @@ TEST(VoBackend, NoiseAndOutliersStayAccurate) {
   const int frames = 40;
   const test::World w = test::MakeWorld(frames, 3);
   std::mt19937_64 rng(4);
-  BackendOptions options;
+  BackendOptions options = test::SyntheticBackendOptions();
   VoBackend backend(w.cam_from_rig, w.world_from_rig[0], options);
   double max_error = 0.0;
   for (int f = 0; f < frames; ++f) {
     const BackendFrameResult r = backend.ProcessFrame(f, test::Observe(w, f, rng, 0.0005, 0.2));
-    EXPECT_NE(r.record.status, "lost") << "frame " << f;
+    EXPECT_NE(r.record.status, FrameStatus::kLost) << "frame " << f;
     max_error = std::max(max_error, PositionError(r.world_from_rig, w.world_from_rig[f]));
     if (f > 0) {
       EXPECT_GT(r.record.inlier_ratio, 0.6) << "frame " << f;
@@ -71,17 +71,17 @@ TEST(VoBackend, RecoversAfterGapOfBlackFrames) {
   const int frames = 36;
   const test::World w = test::MakeWorld(frames, 5);
   std::mt19937_64 rng(6);
-  VoBackend backend(w.cam_from_rig, w.world_from_rig[0], BackendOptions{});
+  VoBackend backend(w.cam_from_rig, w.world_from_rig[0], test::SyntheticBackendOptions());
   for (int f = 0; f < frames; ++f) {
     const bool black = f >= 15 && f < 18;
     const FrontendFrame input = black ? FrontendFrame{} : test::Observe(w, f, rng, 0.0003, 0.0);
     const BackendFrameResult r = backend.ProcessFrame(f, input);
     if (black) {
-      EXPECT_EQ(r.record.status, "lost") << "frame " << f;
+      EXPECT_EQ(r.record.status, FrameStatus::kLost) << "frame " << f;
     } else if (f == 0 || f == 18) {
-      EXPECT_EQ(r.record.status, "init") << "frame " << f;
+      EXPECT_EQ(r.record.status, FrameStatus::kInit) << "frame " << f;
     } else {
-      EXPECT_EQ(r.record.status, "ok") << "frame " << f;
+      EXPECT_EQ(r.record.status, FrameStatus::kOk) << "frame " << f;
     }
     // The constant-velocity prediction keeps the pose near the truth through the gap.
     EXPECT_LT(PositionError(r.world_from_rig, w.world_from_rig[f]), 0.5) << "frame " << f;
@@ -95,13 +95,13 @@ TEST(VoBackend, OnlineCalibrationReducesExtrinsicError) {
   std::vector<Rigid3> noisy = w.cam_from_rig;
   for (int j = 1; j < 4; ++j)
     noisy[j] = Rigid3(test::RandomRotation(rng, 3.0) * noisy[j].rotation, noisy[j].translation);
-  BackendOptions options;
+  BackendOptions options = test::SyntheticBackendOptions();
   options.ba.optimize_extrinsics = true;
   VoBackend backend(noisy, w.world_from_rig[0], options);
   for (int f = 0; f < frames; ++f) {
     const auto r = backend.ProcessFrame(f, test::Observe(w, f, rng, 0.0002, 0.0));
     if (getenv("ROVO_DEBUG")) {
-      printf("%d %s corr %d inl %d ratio %.2f kf %d lm %d err %.3f\n", f, r.record.status.c_str(),
+      printf("%d %s corr %d inl %d ratio %.2f kf %d lm %d err %.3f\n", f, FrameStatusName(r.record.status),
              r.record.num_correspondences, r.record.num_inliers, r.record.inlier_ratio, r.record.keyframe,
              r.num_landmarks, PositionError(r.world_from_rig, w.world_from_rig[f]));
     }
@@ -123,7 +123,7 @@ TEST(VoBackend, OnlineRejectsDriftingTracksOnceSettled) {
   const test::World w = test::MakeWorld(frames, 9);
   const auto mean_late_inlier_ratio = [&](int settle_frames) {
     std::mt19937_64 rng(10);
-    BackendOptions options;
+    BackendOptions options = test::SyntheticBackendOptions();
     options.ba.optimize_extrinsics = true;
     options.online_settle_frames = settle_frames;
     VoBackend backend(w.cam_from_rig, w.world_from_rig[0], options);
@@ -138,7 +138,7 @@ TEST(VoBackend, OnlineRejectsDriftingTracksOnceSettled) {
         }
       }
       const BackendFrameResult r = backend.ProcessFrame(f, input);
-      EXPECT_NE(r.record.status, "lost") << "frame " << f;
+      EXPECT_NE(r.record.status, FrameStatus::kLost) << "frame " << f;
       EXPECT_LT(PositionError(r.world_from_rig, w.world_from_rig[f]), 0.05) << "frame " << f;
       if (f >= 15) {
         sum += r.record.inlier_ratio;

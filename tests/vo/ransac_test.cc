@@ -56,6 +56,7 @@ TEST(MultiViewRansac, FindsPoseWithHalfOutliers) {
     const Rigid3 rig_from_world(test::RandomRotation(rng, 40.0), Eigen::Vector3d(1.0, -2.0, 0.5) * trial * 0.3);
     const auto corrs = MakeProblem(rng, cam_from_rig, rig_from_world, {80, 40, 20, 60}, 0.5);
     MultiViewRansacOptions options;
+    options.tau_rad = 0.01;  // the threshold these tests were written for
     options.seed = trial;
     const MultiViewRansacReport report = MultiViewP3PRansac(corrs, cam_from_rig, options);
     ASSERT_TRUE(report.success) << "trial " << trial;
@@ -73,6 +74,7 @@ TEST(MultiViewRansac, SameSeedSameResult) {
   const Rigid3 rig_from_world(test::RandomRotation(rng, 20.0), Eigen::Vector3d(0.3, 0.1, 0.0));
   const auto corrs = MakeProblem(rng, cam_from_rig, rig_from_world, {50, 50, 50, 50}, 0.6, 0.002);
   MultiViewRansacOptions options;
+  options.tau_rad = 0.01;  // the threshold these tests were written for
   options.seed = 42;
   const auto a = MultiViewP3PRansac(corrs, cam_from_rig, options);
   const auto b = MultiViewP3PRansac(corrs, cam_from_rig, options);
@@ -89,6 +91,7 @@ TEST(MultiViewRansac, PpsDrawsViewsInProportionToSize) {
   const std::vector<int> sizes = {100, 50, 10, 40};
   const auto corrs = MakeProblem(rng, cam_from_rig, Rigid3(), sizes, 0.9);
   MultiViewRansacOptions options;
+  options.tau_rad = 0.01;  // the threshold these tests were written for
   options.min_iterations = options.max_iterations = 4000;
   const auto report = MultiViewP3PRansac(corrs, cam_from_rig, options);
   ASSERT_EQ(report.num_iterations, 4000);
@@ -109,6 +112,7 @@ TEST(MultiViewRansac, SingleViewScoresOneView) {
   const Rigid3 rig_from_world(test::RandomRotation(rng, 10.0), Eigen::Vector3d(0.5, 0.0, 0.0));
   const auto corrs = MakeProblem(rng, cam_from_rig, rig_from_world, {30, 90, 30, 30}, 0.3);
   MultiViewRansacOptions options;
+  options.tau_rad = 0.01;  // the threshold these tests were written for
   options.views = RansacViews::kSingleView;
   const auto report = MultiViewP3PRansac(corrs, cam_from_rig, options);
   ASSERT_TRUE(report.success);
@@ -126,6 +130,7 @@ TEST(MultiViewRansac, NoConsensusOnPureNoise) {
   const auto cam_from_rig = test::SquareRigExtrinsics();
   const auto corrs = MakeProblem(rng, cam_from_rig, Rigid3(), {30, 30, 30, 30}, 1.0);
   MultiViewRansacOptions options;
+  options.tau_rad = 0.01;  // the threshold these tests were written for
   options.min_inliers = 30;
   EXPECT_FALSE(MultiViewP3PRansac(corrs, cam_from_rig, options).success);
   // Too few correspondences: no draws at all.
@@ -137,6 +142,7 @@ TEST(MultiViewRansac, NoConsensusOnPureNoise) {
 
 TEST(MultiViewRansac, OptionsCheckRejectsBadValues) {
   MultiViewRansacOptions options;
+  options.tau_rad = 0.01;  // the threshold these tests were written for
   options.tau_rad = 0.0;
   EXPECT_THROW(options.Check(), std::invalid_argument);
   EXPECT_THROW(ViewSamplingFromName("ppss"), std::invalid_argument);

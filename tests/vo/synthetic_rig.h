@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "datasets/rigid3.h"
+#include "vo/backend.h"
 #include "vo/frontend.h"
 #include "vo/ransac.h"
 
@@ -15,6 +16,16 @@ namespace rovo::test {
 
 // cam_from_rig of camera j of a four-camera rig on a square of half-size `half` metres, camera j
 // looking along rig yaw j * 90 deg (front, left, back, right), OpenCV camera axes.
+// The back-end settings these synthetic tests were written for: a 0.01 rad RANSAC threshold, BA in
+// line, no random-walk prior on the extrinsics.
+inline BackendOptions SyntheticBackendOptions() {
+  BackendOptions options;
+  options.ransac.tau_rad = 0.01;
+  options.ba.extrinsic_prior_deg = 0.0;
+  options.async_ba = false;
+  return options;
+}
+
 inline std::vector<Rigid3> SquareRigExtrinsics(double half = 0.4) {
   std::vector<Rigid3> out;
   for (int j = 0; j < 4; ++j) {

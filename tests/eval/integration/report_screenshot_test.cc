@@ -56,8 +56,8 @@ TEST(ReportScreenshot, HeadlessChromiumRendersTheReport) {
       StampedPose p = gt[static_cast<size_t>(i)];
       p.world_from_rig.translation += noise * Eigen::Vector3d(std::sin(i * 0.3), std::cos(i * 0.2), 0.1 * (i % 3));
       run.trajectory.push_back(p);
-      run.frames.push_back(
-          {i, i * 0.1, 300, 180 - i % 20, (180.0 - i % 20) / 300.0, 0.1 + 0.01 * (i % 5), i % 5 == 0, "ok", 30.0, ""});
+      run.frames.push_back({i, i * 0.1, 300, 180 - i % 20, (180.0 - i % 20) / 300.0, 0.1 + 0.01 * (i % 5), i % 5 == 0,
+                            FrameStatus::kOk, 30.0, ""});
       // Online: extrinsics converge from the perturbed set to the ground truth over the sequence.
       for (int c = 0; c < 4; ++c) {
         const Rigid3& truth = info.rig.cameras[static_cast<size_t>(c)].cam_from_rig;

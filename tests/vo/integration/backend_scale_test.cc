@@ -18,11 +18,11 @@ TEST(BackendScale, ZeroMeanNoiseGivesTheTrueLength) {
   const test::World w = test::MakeWorld(frames, 3, /*far_per_metre=*/5);
   for (const double noise_rad : {0.0005, 0.0015}) {  // 0.03 and 0.09 deg
     std::mt19937_64 rng(4);
-    VoBackend backend(w.cam_from_rig, w.world_from_rig[0], BackendOptions{});
+    VoBackend backend(w.cam_from_rig, w.world_from_rig[0], test::SyntheticBackendOptions());
     std::vector<Eigen::Vector3d> estimated;
     for (int f = 0; f < frames; ++f) {
       const BackendFrameResult r = backend.ProcessFrame(f, test::Observe(w, f, rng, noise_rad, 0.1, 100.0));
-      ASSERT_NE(r.record.status, "lost") << "frame " << f;
+      ASSERT_NE(r.record.status, FrameStatus::kLost) << "frame " << f;
       estimated.push_back(r.world_from_rig.translation);
     }
     // Chord lengths over 25-frame segments (free of the noise that inflates a sum of steps).

@@ -47,10 +47,11 @@ TEST(PipelineIntegration, RecoversFromGapOfBlackFrames) {
   const RunData run = ReadRun(run_dir);
   ASSERT_EQ(run.frames.size(), 30u);
   ASSERT_EQ(run.trajectory.size(), 30u);
-  EXPECT_EQ(run.frames[0].status, "init");
-  for (int frame = gap_begin; frame < gap_end; ++frame) EXPECT_EQ(run.frames[frame].status, "lost") << frame;
+  EXPECT_EQ(run.frames[0].status, FrameStatus::kInit);
+  for (int frame = gap_begin; frame < gap_end; ++frame)
+    EXPECT_EQ(run.frames[frame].status, FrameStatus::kLost) << frame;
   int ok_after = 0;
-  for (int frame = gap_end; frame < 30; ++frame) ok_after += run.frames[frame].status == "ok";
+  for (int frame = gap_end; frame < 30; ++frame) ok_after += run.frames[frame].status == FrameStatus::kOk;
   EXPECT_GE(ok_after, 30 - gap_end - 3);  // re-initialised, then tracking
   const Trajectory gt = ReadTum(GroundTruthPath(dataset));
   const double length = PathLength(Trajectory(gt.begin(), gt.begin() + 30));

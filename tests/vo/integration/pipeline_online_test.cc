@@ -65,7 +65,7 @@ TEST(PipelineIntegration, OnlineCalibrationIsDeterministicAndConverges) {
   const RunData run = ReadRun(runs[0]);
   ASSERT_EQ(run.frames.size(), static_cast<size_t>(kFrames));
   int ok = 0;
-  for (const FrameRecord& f : run.frames) ok += f.status == "ok";
+  for (const FrameRecord& f : run.frames) ok += f.status == FrameStatus::kOk;
   EXPECT_GE(ok, kFrames - 2);
   // After the start-up calibration (frame 0) the error is a fraction of a degree: one frame pins the
   // relative yaw only through far points, so a few tenths may remain (up to 0.43 deg seen); the online
