@@ -7,8 +7,34 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 #include <stdexcept>
+#include <string>
 
 namespace rovo {
+
+void InterviewMatchOptions::Check() const {
+  const auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("InterviewMatchOptions.") + what);
+  };
+  require(max_y_distance_px >= 0.0, "max_y_distance_px must be >= 0");
+  require(max_descriptor_distance >= 0, "max_descriptor_distance must be >= 0");
+  require(max_orientation_diff_deg >= 0.0, "max_orientation_diff_deg must be >= 0");
+  require(max_epipolar_angle_deg >= 0.0, "max_epipolar_angle_deg must be >= 0");
+  require(zncc_patch_px >= 1, "zncc_patch_px must be >= 1");
+  require(max_ratio > 0.0 && max_ratio <= 1.0, "max_ratio must be in (0, 1]");
+  require(uniqueness_range_deg >= 0.0, "uniqueness_range_deg must be >= 0");
+  require(uniqueness_exclusion_px >= 0.0, "uniqueness_exclusion_px must be >= 0");
+}
+
+void SubpixelMatchOptions::Check() const {
+  const auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("SubpixelMatchOptions.") + what);
+  };
+  require(window_px >= 3, "window_px must be >= 3");
+  require(max_iterations >= 1, "max_iterations must be >= 1");
+  require(epsilon_px >= 0.0, "epsilon_px must be >= 0");
+  require(max_shift_px >= 0.0, "max_shift_px must be >= 0");
+  require(max_round_trip_px >= 0.0, "max_round_trip_px must be >= 0");
+}
 
 double EpipolarAngle(const Eigen::Vector3d& centre_a, const Eigen::Vector3d& bearing_a, const Eigen::Vector3d& centre_b,
                      const Eigen::Vector3d& bearing_b) {
@@ -338,6 +364,7 @@ struct Best {
 
 std::vector<InterviewMatch> MatchViews(const PairGeometry& pair, const MatchView& a, const MatchView& b,
                                        const InterviewMatchOptions& options) {
+  options.Check();
   const std::vector<TrackedPoint>& pa = *a.points;
   const std::vector<TrackedPoint>& pb = *b.points;
   const int na = static_cast<int>(pa.size()), nb = static_cast<int>(pb.size());
@@ -419,6 +446,7 @@ std::vector<std::optional<cv::Point2f>> RefineMatchPositions(const cv::Mat& imag
                                                              const std::vector<cv::Point2f>& from,
                                                              const std::vector<cv::Point2f>& to,
                                                              const SubpixelMatchOptions& options) {
+  options.Check();
   if (from.size() != to.size()) throw std::invalid_argument("RefineMatchPositions: from and to differ in size");
   if (image_from.type() != CV_8UC1 || image_to.type() != CV_8UC1) {
     throw std::invalid_argument("RefineMatchPositions: images must be 8-bit gray");

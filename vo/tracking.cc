@@ -7,8 +7,26 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 #include <stdexcept>
+#include <string>
 
 namespace rovo {
+
+void TrackerOptions::Check() const {
+  const auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("TrackerOptions.") + what);
+  };
+  require(target_features >= 0, "target_features must be >= 0");
+  require(max_new_per_frame >= 0, "max_new_per_frame must be >= 0");
+  require(min_feature_distance_px >= 0.0f, "min_feature_distance_px must be >= 0");
+  require(fast_threshold >= 0, "fast_threshold must be >= 0");
+  require(klt_window_px >= 3, "klt_window_px must be >= 3");
+  require(klt_levels >= 0, "klt_levels must be >= 0");
+  require(klt_max_iterations >= 1, "klt_max_iterations must be >= 1");
+  require(klt_epsilon_px >= 0.0f, "klt_epsilon_px must be >= 0");
+  require(max_forward_backward_px >= 0.0f, "max_forward_backward_px must be >= 0");
+  require(klt_predicted_levels >= 0, "klt_predicted_levels must be >= 0");
+  require(border_px >= 0, "border_px must be >= 0");
+}
 namespace {
 
 constexpr int kOrbPatchRadius = 15;
@@ -112,7 +130,7 @@ float IntensityCentroidAngleDeg(const cv::Mat& image, cv::Point2f px) {
 
 int HammingDistance(const cv::Mat& a, const cv::Mat& b) { return static_cast<int>(cv::norm(a, b, cv::NORM_HAMMING)); }
 
-ViewTracker::ViewTracker(const TrackerOptions& options) : options_(options) {}
+ViewTracker::ViewTracker(const TrackerOptions& options) : options_(options) { options_.Check(); }
 
 void ViewTracker::Clear() {
   image_.release();

@@ -44,6 +44,7 @@ struct TrackerOptions {
   // angle_deg is still computed (the inter-view orientation filter). Rectified-like views agree on
   // "up", so they need no rotation invariance; raw fisheye views do not agree.
   bool upright_descriptors = false;
+  void Check() const;  // throws std::invalid_argument naming the field
 };
 
 struct TrackedPoint {
