@@ -124,7 +124,7 @@ RingPairEstimate EstimatePair(const OverlapPair& p, const Rig& rig, const RingCa
 
 namespace {
 
-// Averages the pair rotations into cam_j_from_cam0 (see the header); `rotations[0]` stays fixed.
+// Residual of one pair rotation in the ring average (AverageRing): Log(R_b R_a^T R_ba^T).
 struct PairRotationError {
   explicit PairRotationError(const Eigen::Quaterniond& camb_from_cama) : measured_inverse(camb_from_cama.inverse()) {}
   template <typename T>
