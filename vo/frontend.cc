@@ -18,6 +18,24 @@
 #include "vo/opencv_threads.h"
 
 namespace rovo {
+
+void FrontendOptions::Check() const {
+  const auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("FrontendOptions.") + what);
+  };
+  require(target_features_per_view >= 0, "target_features_per_view must be >= 0");
+  require(max_new_features_per_view >= 0, "max_new_features_per_view must be >= 0");
+  require(min_feature_distance_px >= 0.0f, "min_feature_distance_px must be >= 0");
+  require(fast_threshold >= 0, "fast_threshold must be >= 0");
+  require(max_forward_backward_px >= 0.0f, "max_forward_backward_px must be >= 0");
+  require(klt_window_px >= 3, "klt_window_px must be >= 3");
+  require(klt_levels >= 0, "klt_levels must be >= 0");
+  require(klt_max_iterations >= 1, "klt_max_iterations must be >= 1");
+  require(klt_epsilon_px >= 0.0f, "klt_epsilon_px must be >= 0");
+  require(klt_predicted_levels >= 0, "klt_predicted_levels must be >= 0");
+  projection.Check();
+  matching.Check();
+}
 namespace {
 
 double MsSince(std::chrono::steady_clock::time_point start) {
@@ -111,6 +129,7 @@ struct Frontend::Impl {
 };
 
 Frontend::Frontend(const Rig& rig, const FrontendOptions& options) : impl_(std::make_unique<Impl>()) {
+  options.Check();
   Impl& s = *impl_;
   s.rig = rig;
   s.options = options;

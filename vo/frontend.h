@@ -65,6 +65,7 @@ struct FrontendOptions {
   bool match_between_views = true;     // inter-view matching on/off (ablation)
   // Sub-pixel refinement of new inter-view matches (RefineMatchPositions, interview_matching.h).
   bool refine_matches = true;
+  void Check() const;  // throws std::invalid_argument naming the field
 };
 
 // The tracker settings of a front-end configuration (its per-view target and KLT/detector fields).

@@ -11,6 +11,18 @@
 #include <string>
 
 namespace rovo {
+
+void HybridProjectionOptions::Check() const {
+  const auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("HybridProjectionOptions.") + what);
+  };
+  require(focal_px >= 0.0, "focal_px must be >= 0 (0: automatic)");
+  require(focal_scale > 0.0, "focal_scale must be > 0");
+  require(max_plane_angle_deg > 0.0 && max_plane_angle_deg < 90.0, "max_plane_angle_deg must be in (0, 90)");
+  require(vertical_fov_above_deg > 0.0 && vertical_fov_above_deg < 90.0, "vertical_fov_above_deg must be in (0, 90)");
+  require(vertical_fov_below_deg > 0.0 && vertical_fov_below_deg < 90.0, "vertical_fov_below_deg must be in (0, 90)");
+  require(rebuild_threshold_deg >= 0.0, "rebuild_threshold_deg must be >= 0");
+}
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
@@ -134,6 +146,7 @@ double HybridLayoutChangeDeg(const HybridLayout& a, const Rigid3& a_cam_from_rig
 }
 
 std::vector<HybridProjection> HybridProjection::ForRig(const Rig& rig, const HybridProjectionOptions& options) {
+  options.Check();
   const std::vector<HybridLayout> layouts = ComputeHybridLayouts(rig);
   std::vector<HybridProjection> projections;
   projections.reserve(layouts.size());
@@ -146,6 +159,7 @@ std::vector<HybridProjection> HybridProjection::ForRig(const Rig& rig, const Hyb
 HybridProjection::HybridProjection(const Camera& camera, const Rigid3& cam_from_rig, const HybridLayout& layout,
                                    const HybridProjectionOptions& options)
     : camera_(camera), cam_from_rig_(cam_from_rig), layout_(layout), options_(options) {
+  options_.Check();
   const Eigen::Matrix3d cam_from_rig_rotation = cam_from_rig.RotationMatrix();
   rig_from_cam_rotation_ = cam_from_rig_rotation.transpose();
   up_ = cam_from_rig_rotation * layout.up_in_rig;

@@ -59,6 +59,7 @@ struct HybridProjectionOptions {
   double vertical_fov_above_deg = 50.0;  // the warp reaches this far above the rig plane
   double vertical_fov_below_deg = 50.0;  // and this far below it
   double rebuild_threshold_deg = 1.0;    // see "Online extrinsics" above
+  void Check() const;                    // throws std::invalid_argument naming the field
 };
 
 // The rig-level layout of one camera's hybrid projection, in the RIG frame.

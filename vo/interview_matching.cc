@@ -7,8 +7,34 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 #include <stdexcept>
+#include <string>
 
 namespace rovo {
+
+void InterviewMatchOptions::Check() const {
+  const auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("InterviewMatchOptions.") + what);
+  };
+  require(max_y_distance_px >= 0.0, "max_y_distance_px must be >= 0");
+  require(max_descriptor_distance >= 0, "max_descriptor_distance must be >= 0");
+  require(max_orientation_diff_deg >= 0.0, "max_orientation_diff_deg must be >= 0");
+  require(max_epipolar_angle_deg >= 0.0, "max_epipolar_angle_deg must be >= 0");
+  require(zncc_patch_px >= 1, "zncc_patch_px must be >= 1");
+  require(max_ratio > 0.0 && max_ratio <= 1.0, "max_ratio must be in (0, 1]");
+  require(uniqueness_range_deg >= 0.0, "uniqueness_range_deg must be >= 0");
+  require(uniqueness_exclusion_px >= 0.0, "uniqueness_exclusion_px must be >= 0");
+}
+
+void SubpixelMatchOptions::Check() const {
+  const auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("SubpixelMatchOptions.") + what);
+  };
+  require(window_px >= 3, "window_px must be >= 3");
+  require(max_iterations >= 1, "max_iterations must be >= 1");
+  require(epsilon_px >= 0.0, "epsilon_px must be >= 0");
+  require(max_shift_px >= 0.0, "max_shift_px must be >= 0");
+  require(max_round_trip_px >= 0.0, "max_round_trip_px must be >= 0");
+}
 
 double EpipolarAngle(const Eigen::Vector3d& centre_a, const Eigen::Vector3d& bearing_a, const Eigen::Vector3d& centre_b,
                      const Eigen::Vector3d& bearing_b) {
@@ -195,6 +221,74 @@ std::vector<std::optional<double>> ZnccAtPixels(const cv::Mat& image_a, cv::Poin
   return zncc;
 }
 
+namespace {
+
+constexpr int kKnot = 4;  // curve pixels exact every kKnot steps, linear between
+
+// ZNCC of the reference patch every pixel (1 / f rad) along the epipolar curve through `along`
+// (rotating towards `across`) within range_deg each side, with each sample's distance from
+// `centre_px`; NaN where the curve leaves the view, the patch or positive disparity.
+struct CurveSamples {
+  int count = 0;
+  std::vector<std::optional<Eigen::Vector2d>> knots;  // exact pixels every kKnot samples
+  std::vector<float> score, distance;
+};
+
+CurveSamples SampleEpipolarCurve(const ReferencePatch& reference, const MatchView& view,
+                                 const Eigen::Vector3d& centre_fixed, const Eigen::Vector3d& bearing_fixed,
+                                 const Eigen::Vector3d& centre_moving, const Eigen::Vector3d& along,
+                                 const Eigen::Vector3d& across, const Eigen::Vector2d& centre_px, double focal_px,
+                                 double range_deg) {
+  CurveSamples c;
+  const double step = 1.0 / focal_px;
+  const int half_steps = static_cast<int>(std::ceil(range_deg * M_PI / 180.0 / step / kKnot)) * kKnot;
+  c.count = 2 * half_steps + 1;
+  const auto direction = [&](int k) {
+    const double angle = (k - half_steps) * step;
+    return Eigen::Vector3d(std::cos(angle) * along + std::sin(angle) * across);
+  };
+  c.knots.resize(c.count / kKnot + 1);
+  for (int k = 0; k < c.count; k += kKnot) {
+    const Eigen::Vector3d d = direction(k);
+    if (PositiveDisparity(centre_fixed, bearing_fixed, centre_moving, d))
+      c.knots[k / kKnot] = view.pixel_from_direction_in_rig(d);
+  }
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  c.score.assign(c.count, nan);
+  c.distance.assign(c.count, nan);
+  for (int k = 0; k < c.count; ++k) {
+    const int knot = k / kKnot;
+    const auto& p0 = c.knots[knot];
+    if (!p0) continue;
+    Eigen::Vector2d px = *p0;
+    if (k % kKnot != 0) {
+      if (knot + 1 >= static_cast<int>(c.knots.size()) || !c.knots[knot + 1]) continue;
+      const double t = static_cast<double>(k % kKnot) / kKnot;
+      px = (1.0 - t) * *p0 + t * *c.knots[knot + 1];
+    }
+    const auto z = ZnccWithReference(reference, *view.image, px);
+    if (!z) continue;
+    c.score[k] = static_cast<float>(*z);
+    c.distance[k] = static_cast<float>((px - centre_px).norm());
+  }
+  return c;
+}
+
+// Best ZNCC over the 3x3 pixels around px (a sampled peak may sit a pixel off the true one); -2: none.
+double BestZnccAround(const ReferencePatch& reference, const cv::Mat& image, const Eigen::Vector2d& px) {
+  double best = -2.0;
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      if (const auto z = ZnccWithReference(reference, image, px + Eigen::Vector2d(dx, dy))) {
+        best = std::max(best, *z);
+      }
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
 bool UniqueAlongEpipolarCurve(const cv::Mat& patch_image, cv::Point2f patch_centre, const Eigen::Vector3d& centre_fixed,
                               const Eigen::Vector3d& bearing_fixed, const MatchView& view,
                               const Eigen::Vector3d& centre_moving, const Eigen::Vector3d& bearing_moving,
@@ -214,58 +308,17 @@ bool UniqueAlongEpipolarCurve(const cv::Mat& patch_image, cv::Point2f patch_cent
   const Eigen::Vector3d across = normal.cross(along);
   const auto centre_px = view.pixel_from_direction_in_rig(along);
   if (!centre_px) return false;
-  // Directions every pixel (1 / f rad) along the curve; pixels exact every kKnot steps, linear between.
-  constexpr int kKnot = 4;
-  const double step = 1.0 / focal_px;
-  const int half_steps =
-      static_cast<int>(std::ceil(options.uniqueness_range_deg * M_PI / 180.0 / step / kKnot)) * kKnot;
-  const int count = 2 * half_steps + 1;
-  const auto direction = [&](int k) {
-    const double angle = (k - half_steps) * step;
-    return Eigen::Vector3d(std::cos(angle) * along + std::sin(angle) * across);
-  };
-  std::vector<std::optional<Eigen::Vector2d>> knots(count / kKnot + 1);
-  for (int k = 0; k < count; k += kKnot) {
-    const Eigen::Vector3d d = direction(k);
-    if (PositiveDisparity(centre_fixed, bearing_fixed, centre_moving, d))
-      knots[k / kKnot] = view.pixel_from_direction_in_rig(d);
-  }
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  std::vector<float> score(count, nan), distance(count, nan);
-  for (int k = 0; k < count; ++k) {
-    const int knot = k / kKnot;
-    const auto& p0 = knots[knot];
-    if (!p0) continue;
-    Eigen::Vector2d px = *p0;
-    if (k % kKnot != 0) {
-      if (knot + 1 >= static_cast<int>(knots.size()) || !knots[knot + 1]) continue;
-      const double t = static_cast<double>(k % kKnot) / kKnot;
-      px = (1.0 - t) * *p0 + t * *knots[knot + 1];
-    }
-    const auto z = ZnccWithReference(reference, *view.image, px);
-    if (!z) continue;
-    score[k] = static_cast<float>(*z);
-    distance[k] = static_cast<float>((px - *centre_px).norm());
-  }
-  // Best ZNCC over the 3x3 pixels around px (a sampled peak may sit a pixel off the true one).
-  const auto refined = [&](const Eigen::Vector2d& px) {
-    double best = -2.0;
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dx = -1; dx <= 1; ++dx) {
-        if (const auto z = ZnccWithReference(reference, *view.image, px + Eigen::Vector2d(dx, dy))) {
-          best = std::max(best, *z);
-        }
-      }
-    }
-    return best;
-  };
-  double z0 = refined(*centre_px);
-  for (int k = 0; k < count; ++k) {
+  const CurveSamples c = SampleEpipolarCurve(reference, view, centre_fixed, bearing_fixed, centre_moving, along, across,
+                                             *centre_px, focal_px, options.uniqueness_range_deg);
+  const std::vector<float>& score = c.score;
+  const std::vector<float>& distance = c.distance;
+  double z0 = BestZnccAround(reference, *view.image, *centre_px);
+  for (int k = 0; k < c.count; ++k) {
     if (!std::isnan(score[k]) && distance[k] <= options.uniqueness_exclusion_px) z0 = std::max(z0, double(score[k]));
   }
   if (z0 < -1.0) return false;
   const double limit = z0 - options.uniqueness_margin;
-  for (int k = 1; k + 1 < count; ++k) {
+  for (int k = 1; k + 1 < c.count; ++k) {
     if (std::isnan(score[k]) || std::isnan(score[k - 1]) || std::isnan(score[k + 1])) continue;
     if (distance[k] <= options.uniqueness_exclusion_px || score[k] < score[k - 1] || score[k] < score[k + 1]) continue;
     if (score[k] >= limit) return false;
@@ -275,8 +328,8 @@ bool UniqueAlongEpipolarCurve(const cv::Mat& patch_image, cv::Point2f patch_cent
       const int knot = k / kKnot;
       const double t = static_cast<double>(k % kKnot) / kKnot;
       const Eigen::Vector2d px =
-          t == 0.0 ? *knots[knot] : Eigen::Vector2d((1.0 - t) * *knots[knot] + t * *knots[knot + 1]);
-      if (refined(px) >= limit) return false;
+          t == 0.0 ? *c.knots[knot] : Eigen::Vector2d((1.0 - t) * *c.knots[knot] + t * *c.knots[knot + 1]);
+      if (BestZnccAround(reference, *view.image, px) >= limit) return false;
     }
   }
   return true;
@@ -311,6 +364,7 @@ struct Best {
 
 std::vector<InterviewMatch> MatchViews(const PairGeometry& pair, const MatchView& a, const MatchView& b,
                                        const InterviewMatchOptions& options) {
+  options.Check();
   const std::vector<TrackedPoint>& pa = *a.points;
   const std::vector<TrackedPoint>& pb = *b.points;
   const int na = static_cast<int>(pa.size()), nb = static_cast<int>(pb.size());
@@ -392,6 +446,7 @@ std::vector<std::optional<cv::Point2f>> RefineMatchPositions(const cv::Mat& imag
                                                              const std::vector<cv::Point2f>& from,
                                                              const std::vector<cv::Point2f>& to,
                                                              const SubpixelMatchOptions& options) {
+  options.Check();
   if (from.size() != to.size()) throw std::invalid_argument("RefineMatchPositions: from and to differ in size");
   if (image_from.type() != CV_8UC1 || image_to.type() != CV_8UC1) {
     throw std::invalid_argument("RefineMatchPositions: images must be 8-bit gray");

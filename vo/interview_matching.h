@@ -58,6 +58,7 @@ struct InterviewMatchOptions {
   bool use_y_distance = true;
   bool use_mutual = true;
   bool use_positive_disparity = true;
+  void Check() const;  // throws std::invalid_argument naming the field
 };
 
 // One view's features for matching.
@@ -137,6 +138,7 @@ struct SubpixelMatchOptions {
   double epsilon_px = 0.01;
   double max_shift_px = 2.0;
   double max_round_trip_px = 0.3;
+  void Check() const;  // throws std::invalid_argument naming the field
 };
 std::vector<std::optional<cv::Point2f>> RefineMatchPositions(const cv::Mat& image_from, const cv::Mat& image_to,
                                                              const std::vector<cv::Point2f>& from,

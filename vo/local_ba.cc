@@ -302,102 +302,161 @@ void AddExtrinsicPriors(const LocalBaProblem& problem, const LocalBaOptions& opt
 
 }  // namespace
 
-LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& options) {
-  options.Check();
-  LocalBaReport report;
-  const int num_poses = static_cast<int>(problem.rig_from_world.size());
-  const int num_cams = static_cast<int>(problem.cam_from_rig.size());
-  if (num_poses < 1 || problem.observations.empty()) return report;
+namespace {
+
+// One local BA as COLMAP's BundleAdjuster runs it: SetUp builds the Ceres problem, Solve runs it,
+// WriteBack copies the free blocks into the LocalBaProblem.
+class LocalBaSolver {
+ public:
+  LocalBaSolver(LocalBaProblem& problem, const LocalBaOptions& options)
+      : problem_(problem),
+        options_(options),
+        num_poses_(static_cast<int>(problem.rig_from_world.size())),
+        num_cams_(static_cast<int>(problem.cam_from_rig.size())),
+        blocks_(num_poses_ + num_cams_),
+        poses_(blocks_.data()),
+        cams_(blocks_.data() + num_poses_),
+        cauchy_(options.cauchy_scale_rad),
+        loss_single_(&cauchy_, 1.0, ceres::DO_NOT_TAKE_OWNERSHIP),
+        loss_multi_(&cauchy_, options.multi_camera_weight, ceres::DO_NOT_TAKE_OWNERSHIP),
+        ceres_problem_(ProblemOptions()) {}
+
+  // The parameter blocks, residuals and priors; returns the number of observation residuals.
+  int SetUp() {
+    for (int i = 0; i < num_poses_; ++i) poses_[i] = ToParams(problem_.rig_from_world[i]);
+    for (int j = 0; j < num_cams_; ++j) cams_[j] = ToParams(problem_.cam_from_rig[j]);
+    const std::vector<double> baselines =
+        problem_.baseline_lengths.empty() ? RingBaselineLengths(problem_.cam_from_rig) : problem_.baseline_lengths;
+    const int num_residuals = AddObservations();
+    if (pose_used_[0]) ceres_problem_.SetParameterBlockConstant(poses_[0].data());
+    if (options_.optimize_extrinsics && options_.baseline_weight > 0.0) AddBaselines(baselines);
+    // Fixed cameras that a baseline term brought in stay constant.
+    for (int j = 0; j < num_cams_; ++j) {
+      if (CameraFree(j) || !ceres_problem_.HasParameterBlock(cams_[j].data())) continue;
+      ceres_problem_.SetParameterBlockConstant(cams_[j].data());
+    }
+    if (options_.optimize_extrinsics) AddExtrinsicPriors(problem_, options_, cam_used_, cams_, &ceres_problem_);
+    return num_residuals;
+  }
+
+  ceres::Solver::Summary Solve() {
+    ceres::Solver::Options solver_options;
+    solver_options.linear_solver_type = ceres::DENSE_SCHUR;
+    solver_options.linear_solver_ordering.reset(SchurOrdering());
+    solver_options.max_num_iterations = options_.max_iterations;
+    if (options_.max_time_s > 0.0) solver_options.max_solver_time_in_seconds = options_.max_time_s;
+    solver_options.num_threads = options_.num_threads;
+    solver_options.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options, &ceres_problem_, &summary);
+    return summary;
+  }
+
+  // Writes back only what was free (a round trip through angle-axis would perturb fixed blocks).
+  void WriteBack() {
+    for (int i = 1; i < num_poses_; ++i) {
+      if (pose_used_[i]) problem_.rig_from_world[i] = FromParams(poses_[i]);
+    }
+    for (int j = 1; j < num_cams_ && options_.optimize_extrinsics; ++j) {
+      if (cam_used_[j]) problem_.cam_from_rig[j] = FromParams(cams_[j]);
+    }
+  }
+
+ private:
+  static ceres::Problem::Options ProblemOptions() {
+    ceres::Problem::Options problem_options;
+    problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    return problem_options;
+  }
+
+  bool CameraFree(int j) const { return options_.optimize_extrinsics && j != 0; }
+
+  // The bearing residuals. A camera held fixed (all of them without online calibration, camera 0
+  // always) enters its residuals as constants (FixedCameraBearingResidual); the others as parameter
+  // blocks.
+  int AddObservations() {
+    std::vector<Eigen::Matrix3d> cam_rotations(num_cams_);
+    for (int j = 0; j < num_cams_; ++j) RotationAndRightJacobian(cams_[j].data(), &cam_rotations[j], nullptr);
+    pose_used_.assign(num_poses_, 0);
+    cam_used_.assign(num_cams_, 0);
+    point_used_.assign(problem_.points_in_world.size(), 0);
+    int num_residuals = 0;
+    for (const LocalBaObservation& o : problem_.observations) {
+      const bool multi = o.point_index < static_cast<int>(problem_.point_num_cameras.size()) &&
+                         problem_.point_num_cameras[o.point_index] >= 2;
+      ceres::LossFunction* loss = multi ? &loss_multi_ : &loss_single_;
+      double* point = problem_.points_in_world[o.point_index].data();
+      if (CameraFree(o.camera)) {
+        ceres_problem_.AddResidualBlock(CreateBearingResidual(o.bearing_in_cam), loss, poses_[o.pose_index].data(),
+                                        cams_[o.camera].data(), point);
+      } else {
+        ceres_problem_.AddResidualBlock(
+            new FixedCameraBearingResidual(o.bearing_in_cam, cam_rotations[o.camera], cams_[o.camera].tail<3>()), loss,
+            poses_[o.pose_index].data(), point);
+      }
+      pose_used_[o.pose_index] = cam_used_[o.camera] = point_used_[o.point_index] = 1;
+      ++num_residuals;
+    }
+    return num_residuals;
+  }
+
+  // The baseline length terms of the ring's neighbours that the window sees.
+  void AddBaselines(const std::vector<double>& baselines) {
+    for (size_t p = 0; p < baselines.size(); ++p) {
+      const int a = static_cast<int>(p), b = static_cast<int>((p + 1) % num_cams_);
+      if (!cam_used_[a] || !cam_used_[b]) continue;
+      ceres_problem_.AddResidualBlock(BaselineCost::Create(baselines[p], options_.baseline_weight), nullptr,
+                                      cams_[a].data(), cams_[b].data());
+    }
+  }
+
+  // Schur ordering: landmarks first, then poses and extrinsics.
+  ceres::ParameterBlockOrdering* SchurOrdering() {
+    auto* ordering = new ceres::ParameterBlockOrdering;
+    for (size_t i = 0; i < problem_.points_in_world.size(); ++i) {
+      if (point_used_[i]) ordering->AddElementToGroup(problem_.points_in_world[i].data(), 0);
+    }
+    for (int i = 0; i < num_poses_; ++i) {
+      if (pose_used_[i]) ordering->AddElementToGroup(poses_[i].data(), 1);
+    }
+    for (int j = 0; j < num_cams_; ++j) {
+      if (ceres_problem_.HasParameterBlock(cams_[j].data())) ordering->AddElementToGroup(cams_[j].data(), 1);
+    }
+    return ordering;
+  }
+
+  LocalBaProblem& problem_;
+  const LocalBaOptions& options_;
+  const int num_poses_, num_cams_;
   // Poses and extrinsics live in ONE array, poses first: Ceres orders the blocks of an elimination
   // group by address, so two separate heap arrays would make the reduced system's order (and the
   // floating-point result) depend on the heap layout, i.e. differ from run to run.
-  std::vector<PoseParams> blocks(num_poses + num_cams);
-  PoseParams* poses = blocks.data();
-  PoseParams* cams = blocks.data() + num_poses;
-  for (int i = 0; i < num_poses; ++i) poses[i] = ToParams(problem.rig_from_world[i]);
-  for (int j = 0; j < num_cams; ++j) cams[j] = ToParams(problem.cam_from_rig[j]);
-  std::vector<double> baselines =
-      problem.baseline_lengths.empty() ? RingBaselineLengths(problem.cam_from_rig) : problem.baseline_lengths;
-
+  std::vector<PoseParams> blocks_;
+  PoseParams* poses_;
+  PoseParams* cams_;
+  std::vector<char> pose_used_, cam_used_, point_used_;
   // Two shared losses (single- and multi-camera weight), owned here.
-  ceres::CauchyLoss cauchy(options.cauchy_scale_rad);
-  ceres::ScaledLoss loss_single(&cauchy, 1.0, ceres::DO_NOT_TAKE_OWNERSHIP);
-  ceres::ScaledLoss loss_multi(&cauchy, options.multi_camera_weight, ceres::DO_NOT_TAKE_OWNERSHIP);
-  ceres::Problem::Options problem_options;
-  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem ceres_problem(problem_options);
-  // A camera held fixed (all of them without online calibration, camera 0 always) enters its
-  // residuals as constants (FixedCameraBearingResidual); the others as parameter blocks.
-  std::vector<Eigen::Matrix3d> cam_rotations(num_cams);
-  for (int j = 0; j < num_cams; ++j) RotationAndRightJacobian(cams[j].data(), &cam_rotations[j], nullptr);
-  const auto camera_free = [&](int j) { return options.optimize_extrinsics && j != 0; };
-  std::vector<char> pose_used(num_poses, 0), cam_used(num_cams, 0), point_used(problem.points_in_world.size(), 0);
-  for (const LocalBaObservation& o : problem.observations) {
-    const bool multi = o.point_index < static_cast<int>(problem.point_num_cameras.size()) &&
-                       problem.point_num_cameras[o.point_index] >= 2;
-    ceres::LossFunction* loss = multi ? &loss_multi : &loss_single;
-    double* point = problem.points_in_world[o.point_index].data();
-    if (camera_free(o.camera)) {
-      ceres_problem.AddResidualBlock(CreateBearingResidual(o.bearing_in_cam), loss, poses[o.pose_index].data(),
-                                     cams[o.camera].data(), point);
-    } else {
-      ceres_problem.AddResidualBlock(
-          new FixedCameraBearingResidual(o.bearing_in_cam, cam_rotations[o.camera], cams[o.camera].tail<3>()), loss,
-          poses[o.pose_index].data(), point);
-    }
-    pose_used[o.pose_index] = cam_used[o.camera] = point_used[o.point_index] = 1;
-    ++report.num_residuals;
-  }
-  if (pose_used[0]) ceres_problem.SetParameterBlockConstant(poses[0].data());
-  if (options.optimize_extrinsics && options.baseline_weight > 0.0) {
-    for (size_t p = 0; p < baselines.size(); ++p) {
-      const int a = static_cast<int>(p), b = static_cast<int>((p + 1) % num_cams);
-      if (!cam_used[a] || !cam_used[b]) continue;
-      ceres_problem.AddResidualBlock(BaselineCost::Create(baselines[p], options.baseline_weight), nullptr,
-                                     cams[a].data(), cams[b].data());
-    }
-  }
-  // Fixed cameras that a baseline term brought in stay constant.
-  for (int j = 0; j < num_cams; ++j) {
-    if (camera_free(j) || !ceres_problem.HasParameterBlock(cams[j].data())) continue;
-    ceres_problem.SetParameterBlockConstant(cams[j].data());
-  }
+  ceres::CauchyLoss cauchy_;
+  ceres::ScaledLoss loss_single_, loss_multi_;
+  ceres::Problem ceres_problem_;
+};
 
-  if (options.optimize_extrinsics) AddExtrinsicPriors(problem, options, cam_used, cams, &ceres_problem);
+}  // namespace
 
-  // Schur ordering: landmarks first, then poses and extrinsics.
-  auto* ordering = new ceres::ParameterBlockOrdering;
-  for (size_t i = 0; i < problem.points_in_world.size(); ++i) {
-    if (point_used[i]) ordering->AddElementToGroup(problem.points_in_world[i].data(), 0);
-  }
-  for (int i = 0; i < num_poses; ++i) {
-    if (pose_used[i]) ordering->AddElementToGroup(poses[i].data(), 1);
-  }
-  for (int j = 0; j < num_cams; ++j) {
-    if (ceres_problem.HasParameterBlock(cams[j].data())) ordering->AddElementToGroup(cams[j].data(), 1);
-  }
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
-  solver_options.linear_solver_ordering.reset(ordering);
-  solver_options.max_num_iterations = options.max_iterations;
-  if (options.max_time_s > 0.0) solver_options.max_solver_time_in_seconds = options.max_time_s;
-  solver_options.num_threads = options.num_threads;
-  solver_options.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &ceres_problem, &summary);
+LocalBaReport SolveLocalBa(LocalBaProblem& problem, const LocalBaOptions& options) {
+  options.Check();
+  LocalBaReport report;
+  if (problem.rig_from_world.empty() || problem.observations.empty()) return report;
+  LocalBaSolver solver(problem, options);
+  report.num_residuals = solver.SetUp();
+  const ceres::Solver::Summary summary = solver.Solve();
   report.usable = summary.IsSolutionUsable();
   report.iterations = static_cast<int>(summary.iterations.size());
   report.initial_cost = summary.initial_cost;
   report.final_cost = summary.final_cost;
   report.seconds = summary.total_time_in_seconds;
   if (!report.usable) return report;
-  // Write back only what was free (a round trip through angle-axis would perturb fixed blocks).
-  for (int i = 1; i < num_poses; ++i) {
-    if (pose_used[i]) problem.rig_from_world[i] = FromParams(poses[i]);
-  }
-  for (int j = 1; j < num_cams && options.optimize_extrinsics; ++j) {
-    if (cam_used[j]) problem.cam_from_rig[j] = FromParams(cams[j]);
-  }
+  solver.WriteBack();
   return report;
 }
 

@@ -4,10 +4,19 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 #include "vo/p3p.h"
 
 namespace rovo {
+
+void RansacLoopOptions::Check() const {
+  if (min_iterations < 0) throw std::invalid_argument("RansacLoopOptions.min_iterations must be >= 0");
+  if (max_iterations < 0) throw std::invalid_argument("RansacLoopOptions.max_iterations must be >= 0");
+  if (!(confidence > 0.0 && confidence <= 1.0)) {
+    throw std::invalid_argument("RansacLoopOptions.confidence must be in (0, 1]");
+  }
+}
 
 ViewSampling ViewSamplingFromName(const std::string& name) {
   if (name == "pps") return ViewSampling::kPps;

@@ -85,6 +85,7 @@ struct RansacLoopOptions {
   int min_iterations = 20;
   int max_iterations = 1000;
   double confidence = 0.999;
+  void Check() const;  // throws std::invalid_argument naming the field
 };
 template <typename Model>
 struct RansacResult {
@@ -98,6 +99,7 @@ struct RansacResult {
 template <typename Estimator, typename Sampler>
 RansacResult<typename Estimator::Model> Ransac(const Estimator& estimator, Sampler& sampler, std::mt19937_64& rng,
                                                const RansacLoopOptions& options) {
+  options.Check();
   RansacResult<typename Estimator::Model> result;
   int64_t bound = options.max_iterations;
   int iteration = 0;

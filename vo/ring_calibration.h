@@ -28,6 +28,9 @@
 // pairs' consistency. Camera 0 stays the gauge (its cam_from_rig is kept); the joint solution's
 // common turn of the cameras against their centres (camera 0's own error, seen through the
 // baselines' directions) turns the other centres about camera 0's instead (turn_centres).
+//
+// Code: the overlap views in ring_views.h, the pair and joint model in ring_model.h, the policy (passes,
+// starts, convergence, what is reported) in ring_calibration.cc.
 
 #include <memory>
 #include <opencv2/core.hpp>

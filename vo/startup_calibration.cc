@@ -5,10 +5,29 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <string>
 
 #include "vo/opencv_threads.h"
 
 namespace rovo {
+
+void StartupCalibrationOptions::Check() const {
+  const auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("StartupCalibrationOptions.") + what);
+  };
+  require(shots >= 1, "shots must be >= 1");
+  require(shot_spacing >= 1, "shot_spacing must be >= 1");
+  require(ring_passes >= 1, "ring_passes must be >= 1");
+  require(later_orb_features >= 10, "later_orb_features must be >= 10");
+  require(later_orb_fast_threshold >= 0, "later_orb_fast_threshold must be >= 0");
+  require(later_view_focal_px >= 0.0, "later_view_focal_px must be >= 0");
+  require(max_pass_change_deg >= 0.0, "max_pass_change_deg must be >= 0");
+  require(placements >= 1, "placements must be >= 1");
+  require(placement_jitter_deg >= 0.0, "placement_jitter_deg must be >= 0");
+  require(rescue_orb_features >= 10, "rescue_orb_features must be >= 10");
+  require(rescue_orb_fast_threshold >= 0, "rescue_orb_fast_threshold must be >= 0");
+  ring.Check();
+}
 namespace {
 
 double LargestChangeDeg(const std::vector<Rigid3>& a, const std::vector<Rigid3>& b) {
@@ -217,6 +236,7 @@ StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Ri
                                             const std::function<LoadedFrame(int)>& load, int first_frame, int end_frame,
                                             const std::vector<cv::Mat>& static_masks,
                                             const StartupCalibrationOptions& options, bool quiet) {
+  options.Check();
   const ScopedOpenCvThreads serial_opencv;  // another run's front-end may be in the same process
   StartupCalibrationReport report;
   report.cam_from_rig = cam_from_rig;

@@ -47,6 +47,7 @@ struct StartupCalibrationOptions {
   bool rescue = true;
   int rescue_orb_features = 6000;
   int rescue_orb_fast_threshold = 5;
+  void Check() const;  // throws std::invalid_argument naming the field
 };
 
 struct StartupCalibrationReport {

@@ -7,8 +7,26 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 #include <stdexcept>
+#include <string>
 
 namespace rovo {
+
+void TrackerOptions::Check() const {
+  const auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("TrackerOptions.") + what);
+  };
+  require(target_features >= 0, "target_features must be >= 0");
+  require(max_new_per_frame >= 0, "max_new_per_frame must be >= 0");
+  require(min_feature_distance_px >= 0.0f, "min_feature_distance_px must be >= 0");
+  require(fast_threshold >= 0, "fast_threshold must be >= 0");
+  require(klt_window_px >= 3, "klt_window_px must be >= 3");
+  require(klt_levels >= 0, "klt_levels must be >= 0");
+  require(klt_max_iterations >= 1, "klt_max_iterations must be >= 1");
+  require(klt_epsilon_px >= 0.0f, "klt_epsilon_px must be >= 0");
+  require(max_forward_backward_px >= 0.0f, "max_forward_backward_px must be >= 0");
+  require(klt_predicted_levels >= 0, "klt_predicted_levels must be >= 0");
+  require(border_px >= 0, "border_px must be >= 0");
+}
 namespace {
 
 constexpr int kOrbPatchRadius = 15;
@@ -112,7 +130,7 @@ float IntensityCentroidAngleDeg(const cv::Mat& image, cv::Point2f px) {
 
 int HammingDistance(const cv::Mat& a, const cv::Mat& b) { return static_cast<int>(cv::norm(a, b, cv::NORM_HAMMING)); }
 
-ViewTracker::ViewTracker(const TrackerOptions& options) : options_(options) {}
+ViewTracker::ViewTracker(const TrackerOptions& options) : options_(options) { options_.Check(); }
 
 void ViewTracker::Clear() {
   image_.release();
@@ -134,6 +152,80 @@ void ViewTracker::ResetImage(const cv::Mat& image, const cv::Mat& mask, std::vec
   }
 }
 
+namespace {
+
+// KLT rounds from the previous image's pyramid into the current one, for ViewTracker::Track.
+struct KltPass {
+  const std::vector<cv::Mat>& previous_pyramid;
+  const std::vector<cv::Mat>& pyramid;
+  const std::vector<TrackedPoint>& points;  // of the previous image
+  const cv::Mat& detect_mask;
+  cv::Size window;
+  cv::TermCriteria criteria;
+  float max_fb2;     // squared forward-backward bound
+  int check_levels;  // levels of the backward (check) pass
+
+  // One KLT round for the points `which`: the forward pass starts at start[k] with `levels` levels
+  // when `guided`, else at the point itself with all levels; the backward (check) pass runs for the
+  // forward successes that land in the detection area. Appends the survivors to `kept`, returns the
+  // lost ones.
+  std::vector<int> Run(const std::vector<int>& which, const std::vector<cv::Point2f>& start, bool guided, int levels,
+                       std::vector<TrackedPoint>* kept) const {
+    std::vector<cv::Point2f> previous, forward = start;
+    previous.reserve(which.size());
+    for (int i : which) previous.push_back(points[i].px);
+    std::vector<uint8_t> status_fw, status_bw;
+    cv::calcOpticalFlowPyrLK(previous_pyramid, pyramid, previous, forward, status_fw, cv::noArray(), window, levels,
+                             criteria, guided ? cv::OPTFLOW_USE_INITIAL_FLOW : 0);
+    std::vector<int> candidates, lost;
+    std::vector<cv::Point2f> forward_ok, backward;
+    for (size_t k = 0; k < which.size(); ++k) {
+      if (!status_fw[k] || !MaskAt(detect_mask, forward[k])) {
+        lost.push_back(which[k]);
+        continue;
+      }
+      candidates.push_back(static_cast<int>(k));
+      forward_ok.push_back(forward[k]);
+    }
+    if (!candidates.empty()) {
+      cv::calcOpticalFlowPyrLK(pyramid, previous_pyramid, forward_ok, backward, status_bw, cv::noArray(), window,
+                               check_levels, criteria);
+    }
+    for (size_t c = 0; c < candidates.size(); ++c) {
+      const int k = candidates[c];
+      const cv::Point2f d = backward[c] - previous[k];
+      if (!status_bw[c] || d.dot(d) > max_fb2) {
+        lost.push_back(which[k]);
+        continue;
+      }
+      TrackedPoint p = points[which[k]];
+      p.flow = forward[k] - p.px;
+      p.px = forward[k];
+      ++p.age;
+      p.has_descriptor = false;
+      kept->push_back(std::move(p));
+    }
+    return lost;
+  }
+};
+
+// The minimum distance among tracks too (converging tracks): older tracks win.
+std::vector<TrackedPoint> SpacedOut(std::vector<TrackedPoint> kept, int width, int height, float min_distance) {
+  std::stable_sort(kept.begin(), kept.end(),
+                   [](const TrackedPoint& a, const TrackedPoint& b) { return a.age > b.age; });
+  OccupancyGrid grid(width, height, min_distance);
+  std::vector<TrackedPoint> spaced;
+  spaced.reserve(kept.size());
+  for (TrackedPoint& p : kept) {
+    if (!grid.Free(p.px)) continue;
+    grid.Add(p.px);
+    spaced.push_back(std::move(p));
+  }
+  return spaced;
+}
+
+}  // namespace
+
 int ViewTracker::Track(const cv::Mat& image, const cv::Mat& mask) {
   if (image.type() != CV_8UC1) throw std::invalid_argument("ViewTracker: image must be 8-bit gray");
   if (mask.size() != image.size()) throw std::invalid_argument("ViewTracker: mask size differs from the image");
@@ -145,51 +237,15 @@ int ViewTracker::Track(const cv::Mat& image, const cv::Mat& mask) {
   }
   std::vector<TrackedPoint> kept;
   if (!points_.empty() && !pyramid_.empty()) {
-    const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, options_.klt_max_iterations,
-                                    options_.klt_epsilon_px);
-    const float max_fb2 = options_.max_forward_backward_px * options_.max_forward_backward_px;
-    // One KLT round for the points `which`: the forward pass starts at start[k] with `levels`
-    // levels when `guided`, else at the point itself with all levels; the backward (check) pass runs
-    // for the forward successes that land in the detection area. Appends the survivors to `kept`,
-    // returns the lost ones.
-    const auto round = [&](const std::vector<int>& which, const std::vector<cv::Point2f>& start, bool guided,
-                           int levels) {
-      std::vector<cv::Point2f> previous, forward = start;
-      previous.reserve(which.size());
-      for (int i : which) previous.push_back(points_[i].px);
-      std::vector<uint8_t> status_fw, status_bw;
-      cv::calcOpticalFlowPyrLK(pyramid_, pyramid, previous, forward, status_fw, cv::noArray(), window, levels, criteria,
-                               guided ? cv::OPTFLOW_USE_INITIAL_FLOW : 0);
-      std::vector<int> candidates, lost;
-      std::vector<cv::Point2f> forward_ok, backward;
-      for (size_t k = 0; k < which.size(); ++k) {
-        if (!status_fw[k] || !MaskAt(detect_mask_, forward[k])) {
-          lost.push_back(which[k]);
-          continue;
-        }
-        candidates.push_back(static_cast<int>(k));
-        forward_ok.push_back(forward[k]);
-      }
-      if (!candidates.empty()) {
-        cv::calcOpticalFlowPyrLK(pyramid, pyramid_, forward_ok, backward, status_bw, cv::noArray(), window,
-                                 options_.klt_levels, criteria);
-      }
-      for (size_t c = 0; c < candidates.size(); ++c) {
-        const int k = candidates[c];
-        const cv::Point2f d = backward[c] - previous[k];
-        if (!status_bw[c] || d.dot(d) > max_fb2) {
-          lost.push_back(which[k]);
-          continue;
-        }
-        TrackedPoint p = points_[which[k]];
-        p.flow = forward[k] - p.px;
-        p.px = forward[k];
-        ++p.age;
-        p.has_descriptor = false;
-        kept.push_back(std::move(p));
-      }
-      return lost;
-    };
+    const KltPass klt{pyramid_,
+                      pyramid,
+                      points_,
+                      detect_mask_,
+                      window,
+                      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, options_.klt_max_iterations,
+                                       options_.klt_epsilon_px),
+                      options_.max_forward_backward_px * options_.max_forward_backward_px,
+                      options_.klt_levels};
     std::vector<int> predicted, unpredicted;
     std::vector<cv::Point2f> predicted_start;
     for (int i = 0; i < static_cast<int>(points_.size()); ++i) {
@@ -201,23 +257,12 @@ int ViewTracker::Track(const cv::Mat& image, const cv::Mat& mask) {
       }
     }
     if (!predicted.empty()) {
-      const std::vector<int> lost = round(predicted, predicted_start, true, options_.klt_predicted_levels);
+      const std::vector<int> lost = klt.Run(predicted, predicted_start, true, options_.klt_predicted_levels, &kept);
       unpredicted.insert(unpredicted.end(), lost.begin(), lost.end());
       std::sort(unpredicted.begin(), unpredicted.end());
     }
-    if (!unpredicted.empty()) round(unpredicted, {}, false, options_.klt_levels);
-    // Enforce the minimum distance among tracks too (converging tracks): older tracks win.
-    std::stable_sort(kept.begin(), kept.end(),
-                     [](const TrackedPoint& a, const TrackedPoint& b) { return a.age > b.age; });
-    OccupancyGrid grid(image.cols, image.rows, options_.min_feature_distance_px);
-    std::vector<TrackedPoint> spaced;
-    spaced.reserve(kept.size());
-    for (TrackedPoint& p : kept) {
-      if (!grid.Free(p.px)) continue;
-      grid.Add(p.px);
-      spaced.push_back(std::move(p));
-    }
-    kept = std::move(spaced);
+    if (!unpredicted.empty()) klt.Run(unpredicted, {}, false, options_.klt_levels, &kept);
+    kept = SpacedOut(std::move(kept), image.cols, image.rows, options_.min_feature_distance_px);
   }
   points_ = std::move(kept);
   image_ = image;

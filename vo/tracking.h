@@ -19,8 +19,8 @@ namespace rovo {
 struct TrackerOptions {
   int target_features = 600;  // per view; re-detect when fewer are tracked
   // At most this many new detections per frame while the view has tracks (0: no limit, fill to
-  // target_features). About four in five fresh detections die at their first KLT step (README, known limitations), so a
-  // limit saves tracking work; a view without tracks (first frame, after a loss) still fills up.
+  // target_features); most fresh detections die at once (docs/design-notes.md), so a limit saves
+  // tracking work. A view without tracks (first frame, after a loss) still fills up.
   int max_new_per_frame = 0;
   float min_feature_distance_px = 12.0f;  // between any two features (detections and tracks)
   int fast_threshold = 12;                // FAST-9 intensity threshold
@@ -44,6 +44,7 @@ struct TrackerOptions {
   // angle_deg is still computed (the inter-view orientation filter). Rectified-like views agree on
   // "up", so they need no rotation invariance; raw fisheye views do not agree.
   bool upright_descriptors = false;
+  void Check() const;  // throws std::invalid_argument naming the field
 };
 
 struct TrackedPoint {

@@ -2,12 +2,25 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "datasets/rigid3.h"
 
 namespace rovo {
 
+void TriangulationOptions::Check() const {
+  const auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("TriangulationOptions.") + what);
+  };
+  require(min_parallax_deg >= 0.0, "min_parallax_deg must be >= 0");
+  require(max_error_deg > 0.0, "max_error_deg must be > 0");
+  require(max_distance > 0.0, "max_distance must be > 0");
+  require(gauss_newton_iterations >= 0, "gauss_newton_iterations must be >= 0");
+}
+
 std::optional<TriangulatedPoint> TriangulateRays(const std::vector<Ray>& rays, const TriangulationOptions& options) {
+  options.Check();
   if (rays.size() < 2) return std::nullopt;
   TriangulatedPoint out;
   double max_parallax = 0.0;

@@ -27,6 +27,7 @@ struct TriangulationOptions {
   double max_error_deg = 0.5;
   double max_distance = 1e4;  // in world units (m)
   int gauss_newton_iterations = 5;
+  void Check() const;  // throws std::invalid_argument naming the field
 };
 
 struct TriangulatedPoint {

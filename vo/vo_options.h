@@ -107,109 +107,161 @@ struct InvertedFlag {  // a flag that sets the field to false
   bool* value;
 };
 
-// Calls visitor(OptionSpec, field) for each user-set field of `o`, in the command line's order. Field
-// types: double, int, int64_t, uint64_t, bool (a flag), std::string, FrameRange, Named<E>,
-// Named<bool>, DegreesOfRadians, InvertedFlag. A table of one entry per field: long by design.
+// The registry, one function per group of VoOptions. Each calls visitor(OptionSpec, field) for its
+// fields; a group whose flags lie apart on the command line is visited in parts (`part`, in order).
+// Field types: double, int, int64_t, uint64_t, bool (a flag), std::string, FrameRange, Named<E>,
+// Named<bool>, DegreesOfRadians, InvertedFlag.
+namespace vo_option_groups {
+
+// The dataset (part 0); the frame range and threads (1); progress output (2).
 template <typename Visitor>
-void ForEachVoOption(VoOptions& o, Visitor& visitor) {
+void VisitIo(VoIoOptions& io, Visitor& visitor, int part) {
+  if (part == 0) {
+    visitor(OptionSpec{"dataset", nullptr, "Dataset folder (datasets/FORMAT.md)", -kUnbounded, kUnbounded, false},
+            io.dataset_dir);
+  } else if (part == 1) {
+    visitor(OptionSpec{"--frames", nullptr, "Frame range A:B (B exclusive; default: all frames)", -kUnbounded,
+                       kUnbounded, false},
+            io.frames);
+    visitor(OptionSpec{"--threads", "threads", "Worker threads of the front-end (0: all cores)"}, io.threads);
+  } else {
+    visitor(OptionSpec{"--quiet", nullptr, "No progress output"}, io.quiet);
+  }
+}
+
+template <typename Visitor>
+void VisitStart(VoStartOptions& start, Visitor& visitor) {
   using R = Reuse;
-  visitor(OptionSpec{"dataset", nullptr, "Dataset folder (datasets/FORMAT.md)", -kUnbounded, kUnbounded, false},
-          o.io.dataset_dir);
   visitor(OptionSpec{"--extrinsics", "mode",
                      "Extrinsics: gt (GTExt), noisy (NoisyExt: a perturbed set, fixed) or online (OnlineExt: a "
                      "perturbed set, calibrated online in the local BA)",
                      -kUnbounded, kUnbounded, true, R::kYes},
-          Named<ExtrinsicsMode>{&o.start.mode,
+          Named<ExtrinsicsMode>{&start.mode,
                                 {{ExtrinsicsMode::kGroundTruth, "gt"},
                                  {ExtrinsicsMode::kNoisy, "noisy"},
                                  {ExtrinsicsMode::kOnline, "online"}}});
   visitor(OptionSpec{"--noise-set", "noise_set", "Index of the perturbed extrinsic set in dataset.json", -kUnbounded,
                      kUnbounded, true, R::kYes},
-          o.start.noise_set);
+          start.noise_set);
   visitor(OptionSpec{"--draw-seed", "draw_seed",
                      "noisy/online: start from a fresh perturbation draw with this seed instead of a stored set "
                      "(sigma --draw-sigma on roll, pitch and yaw of every camera; recorded in run.json)",
                      0, kUnbounded, false, R::kYesMissingIsDefault},
-          o.start.draw_seed);
+          start.draw_seed);
   visitor(OptionSpec{"--draw-sigma", "draw_sigma_deg", "Sigma of a --draw-seed draw in degrees", 0.0, 45.0, true,
                      R::kYesWhenDrawn},
-          o.start.draw_sigma_deg);
-  visitor(OptionSpec{"--seed", "seed", "RANSAC seed (recorded in run.json)", -kUnbounded, kUnbounded, true, R::kYes},
-          o.backend.ransac.seed);
-  visitor(OptionSpec{"--frames", nullptr, "Frame range A:B (B exclusive; default: all frames)", -kUnbounded, kUnbounded,
-                     false},
-          o.io.frames);
-  visitor(OptionSpec{"--threads", "threads", "Worker threads of the front-end (0: all cores)"}, o.io.threads);
-  visitor(OptionSpec{"--sampling", "sampling", "RANSAC view sampling: pps (paper) or uniform (ablation)"},
-          Named<ViewSampling>{&o.backend.ransac.sampling,
-                              {{ViewSampling::kPps, "pps"}, {ViewSampling::kUniform, "uniform"}}});
-  visitor(OptionSpec{"--ransac", "ransac",
-                     "RANSAC scoring: multiview (paper: all views) or single-view (ablation: one view)"},
-          Named<RansacViews>{&o.backend.ransac.views,
-                             {{RansacViews::kMultiView, "multiview"}, {RansacViews::kSingleView, "single-view"}}});
+          start.draw_sigma_deg);
+}
+
+template <typename Visitor>
+void VisitStartup(VoStartupOptions& startup, Visitor& visitor) {
   visitor(OptionSpec{"--online-startup", "online_startup",
                      "OnlineExt: on (default) | off. on: the start-up calibration corrects the starting extrinsics "
                      "before the first frame; off: the local BA alone (an ablation, which does not correct errors "
                      "of degrees)",
                      -kUnbounded, kUnbounded, false},
-          Named<bool>{&o.startup.enabled, {{true, "on"}, {false, "off"}}});
+          Named<bool>{&startup.enabled, {{true, "on"}, {false, "off"}}});
   visitor(OptionSpec{"--online-startup-shots", "online_startup_shots",
                      "OnlineExt: synchronous shots (every --online-startup-spacing frames from the first) pooled by "
                      "the start-up calibration",
                      1, 100},
-          o.startup.shots);
+          startup.shots);
   visitor(OptionSpec{"--online-anchor", "online_anchor_deg",
                      "OnlineExt: rotation sigma (degrees) with which every keyframe BA pulls the extrinsics towards a "
                      "converged start-up calibration's result; 0: none",
                      0.0, 45.0},
-          o.startup.anchor_deg);
+          startup.anchor_deg);
   visitor(OptionSpec{"--online-anchor-mm", "online_anchor_mm",
                      "OnlineExt: with --online-anchor, the camera centres' sigma (mm) towards the start-up's result; "
                      "0: the centres are not held",
                      0.0, 1000.0},
-          o.startup.anchor_mm);
+          startup.anchor_mm);
   visitor(OptionSpec{"--online-lens-scale", "online_apply_lens_scale",
                      "OnlineExt: apply (default) | report. apply: when the start-up calibration converges with an "
                      "angle scale of the lenses (a lens calibration that misjudges angles near the rim), the VO sees "
                      "through lenses scaled by it; report: the dataset's lenses, the scale only in run.json",
                      -kUnbounded, kUnbounded, false},
-          Named<bool>{&o.startup.apply_lens_scale, {{true, "apply"}, {false, "report"}}});
+          Named<bool>{&startup.apply_lens_scale, {{true, "apply"}, {false, "report"}}});
   visitor(OptionSpec{"--online-startup-spacing", "online_startup_spacing",
                      "OnlineExt: frames between two shots of --online-startup-shots", 1, 100000},
-          o.startup.spacing);
-  visitor(OptionSpec{"--tau", "backend.ransac_tau_deg",
-                     "RANSAC inlier threshold in degrees: the angle between observed and predicted bearing, the same "
-                     "for every rig (recorded in run.json)",
-                     0.01, 10.0},
-          DegreesOfRadians{&o.backend.ransac.tau_rad});
-  visitor(OptionSpec{"--online-settle", "backend.online_settle_frames",
-                     "OnlineExt: frames during which the calibration settles and observations up to 2 deg off are "
-                     "kept; afterwards the RANSAC threshold rejects them, as in GTExt (default 50, recorded in "
-                     "run.json)",
-                     0, 1000000, false},
-          o.backend.online_settle_frames);
+          startup.spacing);
+}
+
+template <typename Visitor>
+void VisitFrontend(FrontendOptions& frontend, Visitor& visitor) {
+  using R = Reuse;
   visitor(OptionSpec{"--max-new-features", "max_new_features",
                      "New detections per view and frame at most, while the view has tracks (0: fill up to the target "
                      "count of 600). 150 makes the front-end about a fifth cheaper and the trajectories slightly less "
                      "accurate (docs/design-notes.md, docs/results.md)",
                      0, 100000, true, R::kYesMissingIsDefault},
-          o.frontend.max_new_features_per_view);
+          frontend.max_new_features_per_view);
   visitor(OptionSpec{"--warp-below", "warp_below_deg",
                      "Degrees below the rig plane that the hybrid warp reaches; features are tracked and detected "
                      "only inside it (recorded in run.json). 25 makes the full-size front-end about 18 % cheaper "
                      "(the road beside the vehicle, where fresh features die at once) at neutral full-size accuracy, "
                      "but costs accuracy at small image sizes (docs/design-notes.md: warp extents)",
                      1.0, 85.0},
-          o.frontend.projection.vertical_fov_below_deg);
-  visitor(OptionSpec{"--keyframe-distance", "backend.keyframe_distance_m",
-                     "Rig travel in metres that makes a keyframe (and a local BA; default 1, recorded in run.json)",
-                     0.0, 100.0, false},
-          o.backend.keyframes.min_translation_m);
-  visitor(OptionSpec{"--sync-ba", "backend.async_ba",
-                     "Run each keyframe BA before the next frame's front-end instead of beside it (same GTExt/NoisyExt "
-                     "result, slower; OnlineExt's front-end then sees the calibration one frame earlier)"},
-          InvertedFlag{&o.backend.async_ba});
-  visitor(OptionSpec{"--quiet", nullptr, "No progress output"}, o.io.quiet);
+          frontend.projection.vertical_fov_below_deg);
+}
+
+// The RANSAC seed (part 0); its view sampling and scoring (1); the inlier threshold and the online
+// settling (2); keyframes and the BA's scheduling (3).
+template <typename Visitor>
+void VisitBackend(BackendOptions& backend, Visitor& visitor, int part) {
+  using R = Reuse;
+  if (part == 0) {
+    visitor(OptionSpec{"--seed", "seed", "RANSAC seed (recorded in run.json)", -kUnbounded, kUnbounded, true, R::kYes},
+            backend.ransac.seed);
+  } else if (part == 1) {
+    visitor(OptionSpec{"--sampling", "sampling", "RANSAC view sampling: pps (paper) or uniform (ablation)"},
+            Named<ViewSampling>{&backend.ransac.sampling,
+                                {{ViewSampling::kPps, "pps"}, {ViewSampling::kUniform, "uniform"}}});
+    visitor(OptionSpec{"--ransac", "ransac",
+                       "RANSAC scoring: multiview (paper: all views) or single-view (ablation: one view)"},
+            Named<RansacViews>{&backend.ransac.views,
+                               {{RansacViews::kMultiView, "multiview"}, {RansacViews::kSingleView, "single-view"}}});
+  } else if (part == 2) {
+    visitor(OptionSpec{"--tau", "backend.ransac_tau_deg",
+                       "RANSAC inlier threshold in degrees: the angle between observed and predicted bearing, the same "
+                       "for every rig (recorded in run.json)",
+                       0.01, 10.0},
+            DegreesOfRadians{&backend.ransac.tau_rad});
+    visitor(OptionSpec{"--online-settle", "backend.online_settle_frames",
+                       "OnlineExt: frames during which the calibration settles and observations up to 2 deg off are "
+                       "kept; afterwards the RANSAC threshold rejects them, as in GTExt (default 50, recorded in "
+                       "run.json)",
+                       0, 1000000, false},
+            backend.online_settle_frames);
+  } else {
+    visitor(OptionSpec{"--keyframe-distance", "backend.keyframe_distance_m",
+                       "Rig travel in metres that makes a keyframe (and a local BA; default 1, recorded in run.json)",
+                       0.0, 100.0, false},
+            backend.keyframes.min_translation_m);
+    visitor(
+        OptionSpec{"--sync-ba", "backend.async_ba",
+                   "Run each keyframe BA before the next frame's front-end instead of beside it (same GTExt/NoisyExt "
+                   "result, slower; OnlineExt's front-end then sees the calibration one frame earlier)"},
+        InvertedFlag{&backend.async_ba});
+  }
+}
+
+}  // namespace vo_option_groups
+
+// Calls visitor(OptionSpec, field) for each user-set field of `o`, in the command line's order.
+template <typename Visitor>
+void ForEachVoOption(VoOptions& o, Visitor& visitor) {
+  using namespace vo_option_groups;
+  VisitIo(o.io, visitor, 0);            // dataset
+  VisitStart(o.start, visitor);         // --extrinsics ... --draw-sigma
+  VisitBackend(o.backend, visitor, 0);  // --seed
+  VisitIo(o.io, visitor, 1);            // --frames, --threads
+  VisitBackend(o.backend, visitor, 1);  // --sampling, --ransac
+  VisitStartup(o.startup, visitor);     // --online-startup ... --online-startup-spacing
+  VisitBackend(o.backend, visitor, 2);  // --tau, --online-settle
+  VisitFrontend(o.frontend, visitor);   // --max-new-features, --warp-below
+  VisitBackend(o.backend, visitor, 3);  // --keyframe-distance, --sync-ba
+  VisitIo(o.io, visitor, 2);            // --quiet
 }
 
 // run.json's record of the registry's fields (keys as OptionSpec::json_key).
