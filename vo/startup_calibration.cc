@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "datasets/lens_angle_scale.h"
+#include "datasets/rig_json.h"
 #include "vo/extrinsic_bootstrap.h"
 #include "vo/frontend.h"
 #include "vo/local_ba.h"
