@@ -12,11 +12,10 @@
 // A fit samples bearings on a dense grid (angle from the axis in 0.5-degree steps up to half the
 // FOV, azimuth in 5-degree steps), keeps those the source camera projects into its image, and
 // minimises the sum of squared pixel differences with Levenberg-Marquardt (Jacobians by forward
-// automatic differentiation). An ocam lens whose affine turns the image axes (d != -e: the real
-// rig's cameras turn by up to 1.9 degrees, 23 px at the rim) is fitted in a camera frame turned
-// about the optical axis by that angle (`roll_deg`); the exported extrinsics include the turn. A
-// source camera of the same kind (double sphere -> ds, equidistant ->
-// kb4, extended unified -> eucm) exports exactly (its parameters, zero error).
+// automatic differentiation). An ocam lens whose affine turns the image axes (d != -e) is fitted in a camera frame
+// turned about the optical axis by that angle (`roll_deg`); the exported extrinsics include the turn. A source camera
+// of the same kind (double sphere -> ds, equidistant -> kb4, extended unified -> eucm) exports exactly (its parameters,
+// zero error).
 
 #include <cmath>
 #include <optional>
