@@ -7,7 +7,10 @@
 #include <string>
 #include <vector>
 
+#include "datasets/dataset_validate.h"
+#include "datasets/exposure_csv.h"
 #include "datasets/rig.h"
+#include "datasets/rig_json.h"
 #include "datasets/trajectory.h"
 
 namespace rovo {
@@ -55,17 +58,6 @@ struct TimingRecord {
   bool operator!=(const TimingRecord& other) const { return !(*this == other); }
 };
 
-// One line of exposure.csv: the exposure of one camera at one dataset frame.
-struct ExposureRow {
-  int frame = 0;
-  std::string camera;
-  double exposure_ms = 0.0;
-  double gain = 1.0;
-  double meter_luminance = 0.0;  // the auto-exposure meter's centre-weighted mean luminance
-  double dn_per_radiance = 0.0;  // mean ADC codes per unit scene radiance (before clipping)
-  double dark_dn = 0.0;          // mean ADC codes of the dark signal
-};
-
 struct DatasetInfo {
   int schema_version = kDatasetSchemaVersion;
   std::string generator = "rovo";
@@ -103,19 +95,5 @@ std::string ExposurePath(const std::string& dir);                               
 DatasetInfo ReadDatasetInfo(const std::string& dir);
 // Atomic write of dataset.json.
 void WriteDatasetInfo(const std::string& dir, const DatasetInfo& info);
-
-// exposure.csv (datasets/FORMAT.md): atomic write; the reader checks the header, every number and
-// that the rows are frames 0..frame_count-1 with the cameras in rig order, and throws
-// std::runtime_error naming the file, line and column.
-void WriteExposureCsv(const std::string& path, const std::vector<ExposureRow>& rows);
-std::vector<ExposureRow> ReadExposureCsv(const std::string& path, int frame_count, const Rig& rig);
-
-struct ValidationIssue {
-  std::string file;   // path of the offending file
-  std::string field;  // JSON pointer, line number or image property
-  std::string message;
-};
-// Checks every field and file; returns all problems (empty when valid).
-std::vector<ValidationIssue> ValidateDataset(const std::string& dir);
 
 }  // namespace rovo

@@ -4,7 +4,6 @@
 // other cameras are estimated relative to it (the paper's Fig. 8).
 
 #include <cstdint>
-#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
 
@@ -47,20 +46,6 @@ Eigen::Vector3d CameraPositionInRig(const Rigid3& cam_from_rig);
 Eigen::Vector3d CameraAxisInRig(const Rigid3& cam_from_rig);
 double CameraYawDeg(const Rigid3& cam_from_rig);
 double CameraPitchDeg(const Rigid3& cam_from_rig);
-
-// Rig JSON (datasets/FORMAT.md), the same camera objects as dataset.json's /rig:
-//   {"cameras": [{"name", "model", "width", "height", "params", "max_fov_deg",
-//                 "cam_from_rig": {"rotation_xyzw": [x, y, z, w], "translation": [x, y, z]}}]}
-// A rig.json file adds "schema_version" and "source" at the top level.
-inline constexpr int kRigSchemaVersion = 1;
-nlohmann::json Rigid3ToJson(const Rigid3& b_from_a);
-nlohmann::json RigToJson(const Rig& rig);
-// Parses and checks a rig object; throws std::runtime_error "<file>: <json pointer>: <problem>".
-Rig RigFromJson(const nlohmann::json& json, const std::string& file, const std::string& pointer = "");
-// Reads a rig.json, or the /rig of a dataset.json. Throws naming the file and field.
-Rig ReadRigJson(const std::string& path);
-// Atomic write; `source` records where the rig came from (e.g. "preset rovo4").
-void WriteRigJson(const std::string& path, const Rig& rig, const std::string& source);
 
 // One perturbed set of extrinsics (the NoisyExt / OnlineExt starting point).
 struct PerturbedExtrinsics {

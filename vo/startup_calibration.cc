@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "datasets/rig_json.h"
 #include "vo/opencv_threads.h"
 
 namespace rovo {

@@ -23,14 +23,11 @@ using Ad = Eigen::AutoDiffScalar<Eigen::Matrix<double, kMaxParams, 1>>;
 template <typename T>
 bool ProjectT(ExchangeLensModel model, const T* params, const T* point, T* uv) {
   switch (model) {
-    case ExchangeLensModel::kDoubleSphere:
-      return DoubleSphereModel::ImgFromCam(params, 6, point, uv);
-    case ExchangeLensModel::kExtendedUnified:
-      return ExtendedUnifiedModel::ImgFromCam(params, 6, point, uv);
-    case ExchangeLensModel::kKannalaBrandt4:
-      return EquidistantModel::ImgFromCam(params, 8, point, uv);
-    case ExchangeLensModel::kOmniRadtan:
-      return OmniRadtanModel::ImgFromCam(params, point, uv);
+#define ROVO_EXCHANGE_LENS_PROJECT(id, name, model_struct, camera_model) \
+  case ExchangeLensModel::id:                                            \
+    return model_struct::ImgFromCam(params, model_struct::kNumParams, point, uv);
+    ROVO_EXCHANGE_LENS_MODELS(ROVO_EXCHANGE_LENS_PROJECT)
+#undef ROVO_EXCHANGE_LENS_PROJECT
   }
   return false;
 }
@@ -187,47 +184,56 @@ void MeasureFit(const std::vector<Sample>& samples, LensFit* fit) {
   fit->num_samples = static_cast<int>(samples.size());
 }
 
-bool SameKind(CameraModelId source, ExchangeLensModel model) {
-  return (source == CameraModelId::kDoubleSphere && model == ExchangeLensModel::kDoubleSphere) ||
-         (source == CameraModelId::kExtendedUnified && model == ExchangeLensModel::kExtendedUnified) ||
-         (source == CameraModelId::kEquidistant && model == ExchangeLensModel::kKannalaBrandt4);
-}
+bool SameKind(CameraModelId source, ExchangeLensModel model) { return ExchangeLensCameraModel(model) == source; }
+
+constexpr ExchangeLensModel kExchangeLensModels[] = {
+#define ROVO_EXCHANGE_LENS_ID(id, name, model_struct, camera_model) ExchangeLensModel::id,
+    ROVO_EXCHANGE_LENS_MODELS(ROVO_EXCHANGE_LENS_ID)
+#undef ROVO_EXCHANGE_LENS_ID
+};
 
 }  // namespace
 
 std::string ExchangeLensModelName(ExchangeLensModel model) {
   switch (model) {
-    case ExchangeLensModel::kDoubleSphere:
-      return "ds";
-    case ExchangeLensModel::kExtendedUnified:
-      return "eucm";
-    case ExchangeLensModel::kKannalaBrandt4:
-      return "kb4";
-    case ExchangeLensModel::kOmniRadtan:
-      return "omni";
+#define ROVO_EXCHANGE_LENS_NAME(id, name, model_struct, camera_model) \
+  case ExchangeLensModel::id:                                         \
+    return name;
+    ROVO_EXCHANGE_LENS_MODELS(ROVO_EXCHANGE_LENS_NAME)
+#undef ROVO_EXCHANGE_LENS_NAME
   }
   return "?";
 }
 
 ExchangeLensModel ExchangeLensModelFromName(const std::string& name) {
-  for (ExchangeLensModel m : {ExchangeLensModel::kDoubleSphere, ExchangeLensModel::kExtendedUnified,
-                              ExchangeLensModel::kKannalaBrandt4, ExchangeLensModel::kOmniRadtan}) {
+  std::string known;
+  for (ExchangeLensModel m : kExchangeLensModels) {
     if (ExchangeLensModelName(m) == name) return m;
+    known += (known.empty() ? "" : ", ") + ExchangeLensModelName(m);
   }
-  throw std::invalid_argument("unknown lens model '" + name + "' (known: ds, eucm, kb4, omni)");
+  throw std::invalid_argument("unknown lens model '" + name + "' (known: " + known + ")");
 }
 
 int ExchangeLensNumParams(ExchangeLensModel model) {
   switch (model) {
-    case ExchangeLensModel::kDoubleSphere:
-    case ExchangeLensModel::kExtendedUnified:
-      return 6;
-    case ExchangeLensModel::kKannalaBrandt4:
-      return 8;
-    case ExchangeLensModel::kOmniRadtan:
-      return 9;
+#define ROVO_EXCHANGE_LENS_NUM_PARAMS(id, name, model_struct, camera_model) \
+  case ExchangeLensModel::id:                                               \
+    return model_struct::kNumParams;
+    ROVO_EXCHANGE_LENS_MODELS(ROVO_EXCHANGE_LENS_NUM_PARAMS)
+#undef ROVO_EXCHANGE_LENS_NUM_PARAMS
   }
   return 0;
+}
+
+std::optional<CameraModelId> ExchangeLensCameraModel(ExchangeLensModel model) {
+  switch (model) {
+#define ROVO_EXCHANGE_LENS_CAMERA_MODEL(id, name, model_struct, camera_model) \
+  case ExchangeLensModel::id:                                                 \
+    return camera_model;
+    ROVO_EXCHANGE_LENS_MODELS(ROVO_EXCHANGE_LENS_CAMERA_MODEL)
+#undef ROVO_EXCHANGE_LENS_CAMERA_MODEL
+  }
+  return std::nullopt;
 }
 
 bool ProjectExchangeLens(ExchangeLensModel model, const std::vector<double>& params,
@@ -272,21 +278,12 @@ Camera CameraFromExchangeLens(ExchangeLensModel model, const std::vector<double>
   camera.height = height;
   camera.params = params;
   camera.max_fov_deg = max_fov_deg;
-  switch (model) {
-    case ExchangeLensModel::kDoubleSphere:
-      camera.model = CameraModelId::kDoubleSphere;
-      break;
-    case ExchangeLensModel::kExtendedUnified:
-      camera.model = CameraModelId::kExtendedUnified;
-      break;
-    case ExchangeLensModel::kKannalaBrandt4:
-      camera.model = CameraModelId::kEquidistant;
-      break;
-    case ExchangeLensModel::kOmniRadtan:
-      throw std::invalid_argument(what +
-                                  ": the omni (unified + radtan) lens has no rovo camera model; export "
-                                  "with ds or eucm to exchange it both ways");
-  }
+  const std::optional<CameraModelId> camera_model = ExchangeLensCameraModel(model);
+  if (!camera_model)
+    throw std::invalid_argument(what +
+                                ": the omni (unified + radtan) lens has no rovo camera model; export "
+                                "with ds or eucm to exchange it both ways");
+  camera.model = *camera_model;
   return camera;
 }
 

@@ -12,26 +12,20 @@
 // A fit samples bearings on a dense grid (angle from the axis in 0.5-degree steps up to half the
 // FOV, azimuth in 5-degree steps), keeps those the source camera projects into its image, and
 // minimises the sum of squared pixel differences with Levenberg-Marquardt (Jacobians by forward
-// automatic differentiation). An ocam lens whose affine turns the image axes (d != -e: the real
-// rig's cameras turn by up to 1.9 degrees, 23 px at the rim) is fitted in a camera frame turned
-// about the optical axis by that angle (`roll_deg`); the exported extrinsics include the turn. A
-// source camera of the same kind (double sphere -> ds, equidistant ->
-// kb4, extended unified -> eucm) exports exactly (its parameters, zero error).
+// automatic differentiation). An ocam lens whose affine turns the image axes (d != -e) is fitted in a camera frame
+// turned about the optical axis by that angle (`roll_deg`); the exported extrinsics include the turn. A source camera
+// of the same kind (double sphere -> ds, equidistant -> kb4, extended unified -> eucm) exports exactly (its parameters,
+// zero error).
 
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "datasets/camera.h"
+#include "datasets/camera_models.h"
 
 namespace rovo {
-
-enum class ExchangeLensModel { kDoubleSphere, kExtendedUnified, kKannalaBrandt4, kOmniRadtan };
-
-// "ds", "eucm", "kb4", "omni"; FromName throws std::invalid_argument naming the known ones.
-std::string ExchangeLensModelName(ExchangeLensModel model);
-ExchangeLensModel ExchangeLensModelFromName(const std::string& name);
-int ExchangeLensNumParams(ExchangeLensModel model);
 
 // Unified camera model (Mei and Rives, ICRA 2007) with radial-tangential distortion on its
 // normalised plane, as Kalibr's `omni` camera with `radtan` distortion:
@@ -43,7 +37,7 @@ int ExchangeLensNumParams(ExchangeLensModel model);
 struct OmniRadtanModel {
   static constexpr int kNumParams = 9;
   template <typename T>
-  static bool ImgFromCam(const T* params, const T* point_in_cam, T* uv) {
+  static bool ImgFromCam(const T* params, int /*num_params*/, const T* point_in_cam, T* uv) {
     using std::sqrt;
     const T& x = point_in_cam[0];
     const T& y = point_in_cam[1];
@@ -64,6 +58,29 @@ struct OmniRadtanModel {
     return true;
   }
 };
+
+// The exchange lens models, each registered once: (enum id, name in exported files and on the
+// command line, the model struct, the rovo camera model it equals (CameraModelId of
+// ROVO_CAMERA_MODELS) or std::nullopt for omni, which rovo exports only).
+#define ROVO_EXCHANGE_LENS_MODELS(X)                                                 \
+  X(kDoubleSphere, "ds", DoubleSphereModel, CameraModelId::kDoubleSphere)            \
+  X(kExtendedUnified, "eucm", ExtendedUnifiedModel, CameraModelId::kExtendedUnified) \
+  X(kKannalaBrandt4, "kb4", EquidistantModel, CameraModelId::kEquidistant)           \
+  X(kOmniRadtan, "omni", OmniRadtanModel, std::nullopt)
+
+enum class ExchangeLensModel {
+#define ROVO_EXCHANGE_LENS_ID(id, name, model, camera_model) id,
+  ROVO_EXCHANGE_LENS_MODELS(ROVO_EXCHANGE_LENS_ID)
+#undef ROVO_EXCHANGE_LENS_ID
+};
+
+// "ds", "eucm", "kb4", "omni"; FromName throws std::invalid_argument naming the known ones.
+std::string ExchangeLensModelName(ExchangeLensModel model);
+ExchangeLensModel ExchangeLensModelFromName(const std::string& name);
+int ExchangeLensNumParams(ExchangeLensModel model);
+// The rovo camera model an exchange lens is (ds -> double_sphere, eucm -> extended_unified,
+// kb4 -> equidistant); none for omni.
+std::optional<CameraModelId> ExchangeLensCameraModel(ExchangeLensModel model);
 
 struct LensFit {
   ExchangeLensModel model = ExchangeLensModel::kDoubleSphere;

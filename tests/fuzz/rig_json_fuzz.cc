@@ -1,5 +1,5 @@
 // Fuzz target: rig.json (ReadRigJson: a rig object, or the /rig of a dataset.json).
-#include "datasets/rig.h"
+#include "datasets/rig_json.h"
 #include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

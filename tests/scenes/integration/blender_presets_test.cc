@@ -31,7 +31,7 @@
 #include <vector>
 
 #include "datasets/io.h"
-#include "datasets/rig.h"
+#include "datasets/rig_json.h"
 #include "scenes/city.h"
 #include "scenes/scene.h"
 #include "tests/scenes/integration/shell_log.h"

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "datasets/rig.h"
+#include "datasets/rig_json.h"
 #include "scenes/scene.h"
 #include "tests/scenes/integration/shell_log.h"
 
