@@ -1,6 +1,7 @@
 #pragma once
 // Procedural scenes: the paper's Table I presets (urban streets) and harder worlds (an indoor hall
 // and corridor, a low-texture suburban road, a night street).
+// The presets are defined in city_presets.cc; GenerateScene's steps in city.cc and city_*.cc.
 
 #include <cstdint>
 #include <string>

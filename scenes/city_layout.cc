@@ -273,18 +273,29 @@ LanePath PathAlongRoute(const StreetGrid& grid, const GridRoute& route, double l
 
 // ---- drive timing ------------------------------------------------------------------------------
 
-bool PlanDrive(const LanePath& path, double s_begin, double length, int frames, double frame_rate,
-               DriveProfile* profile) {
-  const double ds = 0.25, pad = 4 * kSpeedSmoothing;
-  const double lo_s = std::max(0.0, s_begin - pad), hi_s = std::min(path.Length(), s_begin + length + pad);
-  if (s_begin < 0 || s_begin + length > path.Length()) return false;
-  const int n = static_cast<int>(std::ceil((hi_s - lo_s) / ds)) + 1;
-  std::vector<double> grid_s(n), curv(n);
+namespace {
+
+// Arc length sampled every `ds` metres over [lo_s, hi_s], with the path's |curvature| dilated by the
+// speed smoothing radius and the Gaussian kernel that smooths the speed.
+struct DriveGrid {
+  double ds = 0.25, lo_s = 0.0;
+  int n = 0, half = 0;  // samples; kernel half-width in samples
+  std::vector<double> grid_s, curv, kernel;
+};
+
+DriveGrid MakeDriveGrid(const LanePath& path, double lo_s, double hi_s) {
+  DriveGrid g;
+  const double ds = g.ds;
+  g.lo_s = lo_s;
+  const int n = g.n = static_cast<int>(std::ceil((hi_s - lo_s) / ds)) + 1;
+  std::vector<double>&grid_s = g.grid_s, &curv = g.curv;
+  grid_s.resize(n);
+  curv.resize(n);
   for (int i = 0; i < n; ++i) {
     grid_s[i] = std::min(hi_s, lo_s + i * ds);
     curv[i] = std::abs(path.Curvature(grid_s[i]));
   }
-  const int half = static_cast<int>(std::ceil(3 * kSpeedSmoothing / ds));
+  const int half = g.half = static_cast<int>(std::ceil(3 * kSpeedSmoothing / ds));
   // Dilate |curvature| by the smoothing radius: the speed cap is then flat over each turn and the
   // Gaussian smoothing below cannot raise the speed inside a turn above the cap.
   {
@@ -295,57 +306,62 @@ bool PlanDrive(const LanePath& path, double s_begin, double length, int frames, 
         dilated[i] = std::max(dilated[i], curv[k]);
     curv.swap(dilated);
   }
-  std::vector<double> kernel(2 * half + 1);
-  for (int k = -half; k <= half; ++k) kernel[k + half] = std::exp(-0.5 * std::pow(k * ds / kSpeedSmoothing, 2));
+  g.kernel.resize(2 * half + 1);
+  for (int k = -half; k <= half; ++k) g.kernel[k + half] = std::exp(-0.5 * std::pow(k * ds / kSpeedSmoothing, 2));
+  return g;
+}
 
-  auto speeds = [&](double top) {
-    std::vector<double> v(n);
-    for (int i = 0; i < n; ++i) {
-      const double tight = std::clamp(curv[i] * kTightTurnRadius, 0.0, 1.0);
-      v[i] = std::min(top * (1.0 - kTurnSlowdown * tight), std::sqrt(kMaxLateralAccel / std::max(curv[i], 1e-9)));
-    }
-    for (int i = 1; i < n; ++i) v[i] = std::min(v[i], std::sqrt(v[i - 1] * v[i - 1] + 2 * kMaxForwardAccel * ds));
-    for (int i = n - 2; i >= 0; --i) v[i] = std::min(v[i], std::sqrt(v[i + 1] * v[i + 1] + 2 * kMaxBrakeAccel * ds));
-    std::vector<double> smooth(n);
-    for (int i = 0; i < n; ++i) {
-      double sum = 0, wsum = 0;
-      for (int k = -half; k <= half; ++k) {
-        const int j = std::clamp(i + k, 0, n - 1);
-        sum += kernel[k + half] * v[j];
-        wsum += kernel[k + half];
-      }
-      smooth[i] = sum / wsum;
-    }
-    return smooth;
-  };
-  // Cumulative time from s_begin over the grid (trapezoid on 1/v).
-  auto times = [&](const std::vector<double>& v) {
-    std::vector<double> t(n, 0.0);
-    for (int i = 1; i < n; ++i) t[i] = t[i - 1] + (grid_s[i] - grid_s[i - 1]) * 0.5 * (1.0 / v[i] + 1.0 / v[i - 1]);
-    return t;
-  };
-  auto time_at = [&](const std::vector<double>& t, double s) {
-    const double x = (s - lo_s) / ds;
-    const int i = std::clamp(static_cast<int>(std::floor(x)), 0, n - 2);
-    const double a = std::clamp((s - grid_s[i]) / std::max(1e-12, grid_s[i + 1] - grid_s[i]), 0.0, 1.0);
-    return t[i] + a * (t[i + 1] - t[i]);
-  };
-  const double duration = (frames - 1) / frame_rate;
-  auto drive_time = [&](double top) {
-    const std::vector<double> t = times(speeds(top));
-    return time_at(t, s_begin + length) - time_at(t, s_begin);
-  };
-  double lo = 0.05, hi = kMaxSpeed;
-  if (drive_time(hi) > duration) return false;
-  for (int it = 0; it < 60; ++it) {
-    const double mid = 0.5 * (lo + hi);
-    (drive_time(mid) > duration ? lo : hi) = mid;
+// Speed per grid sample for a top speed: capped in turns and by lateral acceleration, limited by
+// the forward and braking accelerations, then Gaussian-smoothed.
+std::vector<double> Speeds(const DriveGrid& g, double top) {
+  const int n = g.n, half = g.half;
+  const double ds = g.ds;
+  const std::vector<double>&curv = g.curv, &kernel = g.kernel;
+  std::vector<double> v(n);
+  for (int i = 0; i < n; ++i) {
+    const double tight = std::clamp(curv[i] * kTightTurnRadius, 0.0, 1.0);
+    v[i] = std::min(top * (1.0 - kTurnSlowdown * tight), std::sqrt(kMaxLateralAccel / std::max(curv[i], 1e-9)));
   }
-  const std::vector<double> v = speeds(hi);
-  const std::vector<double> t = times(v);
-  const double t0 = time_at(t, s_begin);
-  // Rescale time so the last frame lands exactly at s_begin + length.
-  const double scale = (time_at(t, s_begin + length) - t0) / duration;
+  for (int i = 1; i < n; ++i) v[i] = std::min(v[i], std::sqrt(v[i - 1] * v[i - 1] + 2 * kMaxForwardAccel * ds));
+  for (int i = n - 2; i >= 0; --i) v[i] = std::min(v[i], std::sqrt(v[i + 1] * v[i + 1] + 2 * kMaxBrakeAccel * ds));
+  std::vector<double> smooth(n);
+  for (int i = 0; i < n; ++i) {
+    double sum = 0, wsum = 0;
+    for (int k = -half; k <= half; ++k) {
+      const int j = std::clamp(i + k, 0, n - 1);
+      sum += kernel[k + half] * v[j];
+      wsum += kernel[k + half];
+    }
+    smooth[i] = sum / wsum;
+  }
+  return smooth;
+}
+
+// Cumulative time from the grid's start (trapezoid on 1/v).
+std::vector<double> Times(const DriveGrid& g, const std::vector<double>& v) {
+  const int n = g.n;
+  const std::vector<double>& grid_s = g.grid_s;
+  std::vector<double> t(n, 0.0);
+  for (int i = 1; i < n; ++i) t[i] = t[i - 1] + (grid_s[i] - grid_s[i - 1]) * 0.5 * (1.0 / v[i] + 1.0 / v[i - 1]);
+  return t;
+}
+
+// Time at arc length s, interpolated in the grid.
+double TimeAt(const DriveGrid& g, const std::vector<double>& t, double s) {
+  const int n = g.n;
+  const std::vector<double>& grid_s = g.grid_s;
+  const double x = (s - g.lo_s) / g.ds;
+  const int i = std::clamp(static_cast<int>(std::floor(x)), 0, n - 2);
+  const double a = std::clamp((s - grid_s[i]) / std::max(1e-12, grid_s[i + 1] - grid_s[i]), 0.0, 1.0);
+  return t[i] + a * (t[i + 1] - t[i]);
+}
+
+// Samples arc length, speed and longitudinal acceleration at each frame: frame f at time
+// t0 + f / frame_rate * scale on the grid's clock, speeds divided by `scale`.
+void SampleDrive(const DriveGrid& g, const std::vector<double>& v, const std::vector<double>& t, double t0,
+                 double scale, int frames, double frame_rate, DriveProfile* profile) {
+  const int n = g.n;
+  const std::vector<double>& grid_s = g.grid_s;
   profile->s.assign(frames, 0.0);
   profile->speed.assign(frames, 0.0);
   profile->accel_longitudinal.assign(frames, 0.0);
@@ -359,6 +375,34 @@ bool PlanDrive(const LanePath& path, double s_begin, double length, int frames, 
     profile->accel_longitudinal[f] =
         profile->speed[f] * (v[i + 1] - v[i]) / (scale * std::max(1e-12, grid_s[i + 1] - grid_s[i]));
   }
+}
+
+}  // namespace
+
+bool PlanDrive(const LanePath& path, double s_begin, double length, int frames, double frame_rate,
+               DriveProfile* profile) {
+  const double pad = 4 * kSpeedSmoothing;
+  const double lo_s = std::max(0.0, s_begin - pad), hi_s = std::min(path.Length(), s_begin + length + pad);
+  if (s_begin < 0 || s_begin + length > path.Length()) return false;
+  const DriveGrid g = MakeDriveGrid(path, lo_s, hi_s);
+  const double duration = (frames - 1) / frame_rate;
+  auto drive_time = [&](double top) {
+    const std::vector<double> t = Times(g, Speeds(g, top));
+    return TimeAt(g, t, s_begin + length) - TimeAt(g, t, s_begin);
+  };
+  // Bisect the top speed so that the drive takes `duration`.
+  double lo = 0.05, hi = kMaxSpeed;
+  if (drive_time(hi) > duration) return false;
+  for (int it = 0; it < 60; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (drive_time(mid) > duration ? lo : hi) = mid;
+  }
+  const std::vector<double> v = Speeds(g, hi);
+  const std::vector<double> t = Times(g, v);
+  const double t0 = TimeAt(g, t, s_begin);
+  // Rescale time so the last frame lands exactly at s_begin + length.
+  const double scale = (TimeAt(g, t, s_begin + length) - t0) / duration;
+  SampleDrive(g, v, t, t0, scale, frames, frame_rate, profile);
   profile->s.front() = s_begin;
   profile->s.back() = s_begin + length;
   return true;

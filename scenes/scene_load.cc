@@ -1,41 +1,27 @@
-// Scene folder reader/writer and content hash (layout: scenes/FORMAT.md).
+// Scene folder reader (layout: scenes/FORMAT.md); every error names the file and the field.
 
 #include <OpenImageIO/imageio.h>
 #include <tbb/parallel_for.h>
 
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "datasets/io.h"
 #include "scenes/scene.h"
+#include "scenes/scene_io_internal.h"
 
 namespace rovo {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-constexpr int kFormatVersion = 1;
-const char* const kGeometryFile = "geometry.bin";
-const char* const kMotionFile = "motion.bin";
-const char* const kTrajectoryFile = "trajectory.tum";
-
-static_assert(sizeof(Eigen::Vector3f) == 12 && sizeof(Eigen::Vector2f) == 8 && sizeof(Eigen::Vector3i) == 12,
-              "mesh arrays are copied as packed float32/int32 records");
-
-bool HostIsLittleEndian() {
-  const uint32_t probe = 1;
-  unsigned char first;
-  std::memcpy(&first, &probe, 1);
-  return first == 1;
-}
+using namespace scene_io_internal;
 
 [[noreturn]] void Fail(const std::string& file, const std::string& field, const std::string& what) {
   throw std::runtime_error(file + ": " + field + ": " + what);
@@ -120,19 +106,6 @@ Rigid3 RigidFromJson(const Field& f) {
   return out;
 }
 
-json RigidToJson(const Rigid3& r) {
-  const auto& q = r.rotation;
-  return json{{"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}},
-              {"translation", {r.translation.x(), r.translation.y(), r.translation.z()}}};
-}
-
-template <typename V>
-json VecJson(const V& v) {
-  json a = json::array();
-  for (int i = 0; i < v.size(); ++i) a.push_back(static_cast<double>(v[i]));
-  return a;
-}
-
 // ---- TUM: datasets' parser, our quaternion handling (bit-exact round trips) ----
 
 Trajectory ParseSceneTum(const std::string& path) {
@@ -147,12 +120,6 @@ Trajectory ParseSceneTum(const std::string& path) {
     out.push_back(pose);
   }
   return out;
-}
-
-// ---- binary buffers ----
-
-void AppendBytes(std::string& buffer, const void* data, size_t bytes) {
-  buffer.append(static_cast<const char*>(data), bytes);
 }
 
 class BufferCache {
@@ -189,20 +156,6 @@ void CopyFromBuffer(const std::string& buffer, int64_t offset, size_t count, siz
 
 // ---- textures ----
 
-void WritePng(const std::string& path, const Texture& texture) {
-  const std::string tmp = TempPathFor(path);
-  auto out = OIIO::ImageOutput::create("png");
-  if (!out) throw std::runtime_error(path + ": cannot create PNG writer: " + OIIO::geterror());
-  OIIO::ImageSpec spec(texture.width, texture.height, 3, OIIO::TypeDesc::UINT8);
-  spec.attribute("png:compressionLevel", 1);
-  if (!out->open(tmp, spec) || !out->write_image(OIIO::TypeDesc::UINT8, texture.rgb.data()) || !out->close()) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    throw std::runtime_error(path + ": cannot write PNG: " + out->geterror());
-  }
-  CommitTempFile(tmp, path);
-}
-
 void ReadPng(const std::string& path, Texture& texture, const std::string& json_file, const std::string& field) {
   const std::string png_problem = PngChunkProblem(path);
   if (!png_problem.empty()) Fail(json_file, field, "cannot read texture '" + path + "': " + png_problem);
@@ -231,190 +184,7 @@ void ReadPng(const std::string& path, Texture& texture, const std::string& json_
   }
 }
 
-// ---- hashing ----
-
-class Hasher {
- public:
-  void Bytes(const void* data, size_t size) {
-    state_ = std::strtoull(HashHex(data, size, state_).c_str(), nullptr, 16);
-  }
-  void Str(const std::string& s) {
-    U64(s.size());
-    Bytes(s.data(), s.size());
-  }
-  void U64(uint64_t v) { Bytes(&v, sizeof(v)); }
-  void F64(double v) { Bytes(&v, sizeof(v)); }
-  void Rigid(const Rigid3& r) {
-    const double q[4] = {r.rotation.x(), r.rotation.y(), r.rotation.z(), r.rotation.w()};
-    Bytes(q, sizeof(q));
-    Bytes(r.translation.data(), sizeof(double) * 3);
-  }
-  template <typename T>
-  void Vec(const std::vector<T>& v) {
-    U64(v.size());
-    if (!v.empty()) Bytes(v.data(), v.size() * sizeof(T));
-  }
-  std::string Hex() const {
-    char buf[17];
-    std::snprintf(buf, sizeof(buf), "%016llx", static_cast<unsigned long long>(state_));
-    return buf;
-  }
-
- private:
-  uint64_t state_ = 0;
-};
-
-json LightsJson(const Scene& scene) {
-  json lights = json::array();
-  for (const Light& light : scene.lights) {
-    if (light.object < -1 || light.object >= static_cast<int>(scene.objects.size())) {
-      throw std::runtime_error("SaveScene: light '" + light.name + "': object index " + std::to_string(light.object) +
-                               " out of range");
-    }
-    json jl = {{"name", light.name},
-               {"position", VecJson(light.position)},
-               {"intensity", VecJson(light.intensity)},
-               {"range", light.range},
-               {"object", light.object}};
-    if (light.spot) {
-      jl["spot"] = {{"direction", VecJson(light.spot_direction)},
-                    {"angle_deg", light.spot_angle_deg},
-                    {"blend", light.spot_blend}};
-    }
-    lights.push_back(jl);
-  }
-  return lights;
-}
-
-}  // namespace
-
-// ------------------------------------------------------------------------------------------------
-
-void SaveScene(const Scene& scene, const std::string& dir) {
-  if (!HostIsLittleEndian()) throw std::runtime_error("SaveScene: big-endian hosts are not supported");
-  EnsureWritableDir(dir);
-  EnsureWritableDir((fs::path(dir) / "textures").string());
-  const int frames = static_cast<int>(scene.rig_trajectory.size());
-
-  json root;
-  root["format"] = "rovo-scene";
-  root["format_version"] = kFormatVersion;
-  root["metadata"] = {{"generator", scene.metadata.generator},
-                      {"generator_version", scene.metadata.generator_version},
-                      {"preset", scene.metadata.preset},
-                      {"seed", scene.metadata.seed},
-                      {"source", scene.metadata.source}};
-  root["frame_rate"] = scene.frame_rate;
-  root["rig_preset"] = scene.rig_preset;
-  root["trajectory"] = kTrajectoryFile;
-  const Lighting& l = scene.lighting;
-  root["lighting"] = {{"preset", l.preset},
-                      {"direction_to_sun", VecJson(l.direction_to_sun)},
-                      {"sun_radiance", VecJson(l.sun_radiance)},
-                      {"sun_angular_diameter_deg", l.sun_angular_diameter_deg},
-                      {"sky_zenith", VecJson(l.sky_zenith)},
-                      {"sky_horizon", VecJson(l.sky_horizon)},
-                      {"ground_albedo", VecJson(l.ground_albedo)},
-                      {"ambient", static_cast<double>(l.ambient)},
-                      {"exposure", static_cast<double>(l.exposure)}};
-
-  json textures = json::array();
-  std::vector<std::string> png_names(scene.textures.size());
-  for (size_t i = 0; i < scene.textures.size(); ++i) {
-    const Texture& t = scene.textures[i];
-    if (t.width <= 0 || t.height <= 0 || t.rgb.size() != static_cast<size_t>(t.width) * t.height * 3) {
-      throw std::runtime_error("SaveScene: texture " + std::to_string(i) + " ('" + t.name + "') has inconsistent size");
-    }
-    char name[64];
-    std::snprintf(name, sizeof(name), "textures/%03zu.png", i);
-    png_names[i] = name;
-    textures.push_back({{"name", t.name}, {"file", name}, {"width", t.width}, {"height", t.height}});
-  }
-  // PNG encoding dominates saving; textures are independent files.
-  tbb::parallel_for(size_t{0}, scene.textures.size(),
-                    [&](size_t i) { WritePng((fs::path(dir) / png_names[i]).string(), scene.textures[i]); });
-  root["textures"] = textures;
-
-  json materials = json::array();
-  for (const Material& m : scene.materials) {
-    json jm = {{"name", m.name}, {"base_color", VecJson(m.base_color)}, {"texture", m.texture}};
-    // Optional fields are written only when set, so matte scenes keep their exact scene.json.
-    if (m.IsEmissive()) jm["emission"] = VecJson(m.emission);
-    if (m.specular > 0.0f) {
-      jm["specular"] = static_cast<double>(m.specular);
-      jm["shininess"] = static_cast<double>(m.shininess);
-    }
-    materials.push_back(jm);
-  }
-  root["materials"] = materials;
-
-  std::string geometry;
-  json meshes = json::array();
-  for (size_t i = 0; i < scene.meshes.size(); ++i) {
-    const Mesh& m = scene.meshes[i];
-    const size_t nv = m.positions.size(), nt = m.triangles.size();
-    if (!m.uvs.empty() && m.uvs.size() != nv)
-      throw std::runtime_error("SaveScene: mesh '" + m.name + "': uvs size != positions size");
-    if (!m.triangle_materials.empty() && m.triangle_materials.size() != nt) {
-      throw std::runtime_error("SaveScene: mesh '" + m.name + "': triangle_materials size != triangles size");
-    }
-    json jm = {{"name", m.name},
-               {"material", m.material},
-               {"buffer", kGeometryFile},
-               {"vertex_count", nv},
-               {"triangle_count", nt}};
-    jm["positions_offset"] = geometry.size();
-    AppendBytes(geometry, m.positions.data(), nv * 3 * sizeof(float));
-    if (m.uvs.empty()) {
-      jm["uvs_offset"] = -1;
-    } else {
-      jm["uvs_offset"] = geometry.size();
-      AppendBytes(geometry, m.uvs.data(), nv * 2 * sizeof(float));
-    }
-    jm["triangles_offset"] = geometry.size();
-    AppendBytes(geometry, m.triangles.data(), nt * 3 * sizeof(int32_t));
-    if (m.triangle_materials.empty()) {
-      jm["triangle_materials_offset"] = -1;
-    } else {
-      jm["triangle_materials_offset"] = geometry.size();
-      AppendBytes(geometry, m.triangle_materials.data(), nt * sizeof(int32_t));
-    }
-    meshes.push_back(jm);
-  }
-  root["meshes"] = meshes;
-
-  std::string motion;
-  json objects = json::array();
-  for (const Object& o : scene.objects) {
-    json jo = {{"name", o.name}, {"mesh", o.mesh}, {"id", o.id}};
-    if (o.IsDynamic()) {
-      if (static_cast<int>(o.world_from_object_per_frame.size()) != frames) {
-        throw std::runtime_error("SaveScene: object '" + o.name + "' has " +
-                                 std::to_string(o.world_from_object_per_frame.size()) + " transforms for " +
-                                 std::to_string(frames) + " frames");
-      }
-      jo["motion"] = {{"buffer", kMotionFile}, {"offset", motion.size()}, {"frames", frames}};
-      for (const Rigid3& r : o.world_from_object_per_frame) {
-        const double rec[7] = {r.rotation.x(),    r.rotation.y(),    r.rotation.z(),   r.rotation.w(),
-                               r.translation.x(), r.translation.y(), r.translation.z()};
-        AppendBytes(motion, rec, sizeof(rec));
-      }
-    } else {
-      jo["world_from_object"] = RigidToJson(o.world_from_object);
-    }
-    objects.push_back(jo);
-  }
-  root["objects"] = objects;
-  if (!scene.lights.empty()) root["lights"] = LightsJson(scene);
-
-  WriteFileAtomic((fs::path(dir) / kGeometryFile).string(), geometry);
-  WriteFileAtomic((fs::path(dir) / kMotionFile).string(), motion);
-  WriteFileAtomic((fs::path(dir) / kTrajectoryFile).string(), FormatTum(scene.rig_trajectory));
-  // scene.json last: a folder with a scene.json is complete.
-  WriteJsonFileAtomic((fs::path(dir) / "scene.json").string(), root);
-}
-
-namespace {
+// ---- scene.json sections ----
 
 // scene.json's metadata, frame rate, rig preset and lighting.
 void ReadSceneHeader(const Field& root, const std::string& file, Scene* scene) {
@@ -640,90 +410,6 @@ Scene LoadScene(const std::string& dir) {
     scene.objects[i] = ReadObject(jo[i], buffers, file, static_cast<int64_t>(scene.meshes.size()), frames);
   ReadLights(root, &scene);
   return scene;
-}
-
-std::string SceneHash(const Scene& scene) {
-  Hasher h;
-  h.Str("rovo-scene-1");
-  h.Str(scene.metadata.generator);
-  h.Str(scene.metadata.preset);
-  h.U64(scene.metadata.seed);
-  h.Str(scene.metadata.source);
-  h.F64(scene.frame_rate);
-  h.Str(scene.rig_preset);
-  const Lighting& l = scene.lighting;
-  h.Str(l.preset);
-  h.Bytes(l.direction_to_sun.data(), sizeof(double) * 3);
-  h.Bytes(l.sun_radiance.data(), sizeof(float) * 3);
-  h.F64(l.sun_angular_diameter_deg);
-  h.Bytes(l.sky_zenith.data(), sizeof(float) * 3);
-  h.Bytes(l.sky_horizon.data(), sizeof(float) * 3);
-  h.Bytes(l.ground_albedo.data(), sizeof(float) * 3);
-  h.Bytes(&l.ambient, sizeof(float));
-  h.Bytes(&l.exposure, sizeof(float));
-  h.U64(scene.textures.size());
-  for (const Texture& t : scene.textures) {
-    h.Str(t.name);
-    h.U64(static_cast<uint64_t>(t.width));
-    h.U64(static_cast<uint64_t>(t.height));
-    h.Vec(t.rgb);
-  }
-  h.U64(scene.materials.size());
-  for (const Material& m : scene.materials) {
-    h.Str(m.name);
-    h.Bytes(m.base_color.data(), sizeof(float) * 3);
-    h.U64(static_cast<uint64_t>(static_cast<int64_t>(m.texture)));
-    // Emission and specular enter only when set (matte scenes keep their hash).
-    if (m.IsEmissive()) h.Bytes(m.emission.data(), sizeof(float) * 3);
-    if (m.specular > 0.0f) {
-      h.Bytes(&m.specular, sizeof(float));
-      h.Bytes(&m.shininess, sizeof(float));
-    }
-  }
-  h.U64(scene.meshes.size());
-  for (const Mesh& m : scene.meshes) {
-    h.Str(m.name);
-    h.U64(static_cast<uint64_t>(m.material));
-    h.Vec(m.positions);
-    h.Vec(m.uvs);
-    h.Vec(m.triangles);
-    h.Vec(m.triangle_materials);
-  }
-  h.U64(scene.objects.size());
-  for (const Object& o : scene.objects) {
-    h.Str(o.name);
-    h.U64(static_cast<uint64_t>(o.mesh));
-    h.U64(o.id);
-    h.U64(o.IsDynamic() ? 1 : 0);
-    if (o.IsDynamic()) {
-      h.U64(o.world_from_object_per_frame.size());
-      for (const Rigid3& r : o.world_from_object_per_frame) h.Rigid(r);
-    } else {
-      h.Rigid(o.world_from_object);
-    }
-  }
-  h.U64(scene.rig_trajectory.size());
-  for (const StampedPose& p : scene.rig_trajectory) {
-    h.F64(p.timestamp);
-    h.Rigid(p.world_from_rig);
-  }
-  if (!scene.lights.empty()) {  // scenes without lights keep their hash
-    h.U64(scene.lights.size());
-    for (const Light& l : scene.lights) {
-      h.Str(l.name);
-      h.Bytes(l.position.data(), sizeof(double) * 3);
-      h.Bytes(l.intensity.data(), sizeof(float) * 3);
-      h.F64(l.range);
-      h.U64(static_cast<uint64_t>(static_cast<int64_t>(l.object)));
-      h.U64(l.spot ? 1 : 0);
-      if (l.spot) {
-        h.Bytes(l.spot_direction.data(), sizeof(double) * 3);
-        h.F64(l.spot_angle_deg);
-        h.F64(l.spot_blend);
-      }
-    }
-  }
-  return h.Hex();
 }
 
 }  // namespace rovo
