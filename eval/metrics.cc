@@ -7,6 +7,7 @@
 #include <map>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace rovo {
 
@@ -234,21 +235,117 @@ double GtPathLength(const Trajectory& gt) {
   return length;
 }
 
-}  // namespace
-
-RunEvaluation EvaluateRun(const Trajectory& full_gt, const std::vector<Rigid3>& gt_cam_from_rig, const RunData& run,
-                          const std::string& label, const EvalOptions& options) {
-  // A run over frames [a, b) of the dataset (run.json "frames") is scored against that span of the
-  // ground truth: its path length, missing frames and drift segments.
-  size_t span_begin = 0, span_end = full_gt.size();
+// A run over frames [a, b) of the dataset (run.json "frames") is scored against that span of the
+// ground truth: its path length, missing frames and drift segments. Returns [begin, end) in `gt_size` frames.
+std::pair<size_t, size_t> RunSpan(const RunData& run, size_t gt_size) {
+  size_t span_begin = 0, span_end = gt_size;
   if (run.info.contains("frames") && run.info["frames"].is_array() && run.info["frames"].size() == 2 &&
       run.info["frames"][0].is_number_integer() && run.info["frames"][1].is_number_integer()) {
     const long a = run.info["frames"][0].get<long>(), b = run.info["frames"][1].get<long>();
-    if (a >= 0 && a < b && b <= static_cast<long>(full_gt.size())) {
+    if (a >= 0 && a < b && b <= static_cast<long>(gt_size)) {
       span_begin = static_cast<size_t>(a);
       span_end = static_cast<size_t>(b);
     }
   }
+  return {span_begin, span_end};
+}
+
+// Associates the run's poses with `gt` (the run's span, starting at `span_begin` of the full ground
+// truth), aligns them and fills the trajectory metrics, gt_from_est and the per-frame errors.
+void ScoreTrajectory(const Trajectory& gt, const RunData& run, size_t span_begin, const EvalOptions& options,
+                     RunEvaluation* out) {
+  RunMetrics& m = out->metrics;
+  double tolerance = options.time_tolerance_s;
+  if (tolerance <= 0.0) {
+    const double interval = MedianInterval(gt);
+    tolerance = interval > 0.0 ? 0.25 * interval : 1e-3;
+  }
+  const Association association = AssociateByTimestamp(gt, run.trajectory, tolerance);
+  m.associated_frames = static_cast<int>(association.pairs.size());
+  m.missing_frames = static_cast<int>(association.gt_without_estimate.size());
+
+  if (association.pairs.empty()) {
+    m.alignment_note = "no estimated pose matches a ground-truth timestamp";
+    return;
+  }
+  const Rigid3 origin = AlignOrigin(gt, run.trajectory, association);
+  m.rmse_origin_m = TranslationRmse(gt, run.trajectory, association, origin);
+  out->gt_from_est = origin;
+  try {
+    out->gt_from_est = AlignSe3(gt, run.trajectory, association);
+    m.rmse_se3_m = TranslationRmse(gt, run.trajectory, association, out->gt_from_est);
+    if (m.path_length_m > 0.0) m.relative_rmse_pct = 100.0 * *m.rmse_se3_m / m.path_length_m;
+  } catch (const std::invalid_argument& e) {
+    m.alignment_note =
+        std::string("SE(3) alignment impossible: ") + e.what() + "; error along path uses origin alignment";
+  }
+  for (const auto& [i, j] : association.pairs) {
+    FrameError fe;
+    fe.gt_index = static_cast<int>(i + span_begin);  // index in the full ground truth
+    fe.estimate_index = j;
+    fe.timestamp = gt[i].timestamp;
+    fe.gt_position = gt[i].world_from_rig.translation;
+    fe.aligned_position = out->gt_from_est * run.trajectory[j].world_from_rig.translation;
+    fe.error_m = (fe.gt_position - fe.aligned_position).norm();
+    out->frame_errors.push_back(fe);
+  }
+  m.drift = RelativeDrift(gt, run.trajectory, association);
+}
+
+// Lost frames, mean inlier ratio and reprojection error over ok frames, mean time over all frames.
+void ScoreFrameRecords(const std::vector<FrameRecord>& frames, RunMetrics* m) {
+  int ok = 0;
+  double inlier_sum = 0.0, reproj_sum = 0.0, time_sum = 0.0;
+  for (const FrameRecord& f : frames) {
+    time_sum += f.time_ms;
+    if (f.status == FrameStatus::kLost) ++m->lost_frames;
+    if (f.status != FrameStatus::kOk) continue;
+    ++ok;
+    inlier_sum += f.inlier_ratio;
+    reproj_sum += f.mean_reproj_error_deg;
+  }
+  if (ok > 0) {
+    m->mean_inlier_ratio = inlier_sum / ok;
+    m->mean_reproj_error_deg = reproj_sum / ok;
+  }
+  if (!frames.empty()) m->mean_time_ms = time_sum / static_cast<double>(frames.size());
+}
+
+// Per camera i >= 1: final (latest frame) and mean extrinsic errors, and the largest final ones.
+void ScoreExtrinsics(const std::vector<ExtrinsicError>& errors, int num_cameras, RunMetrics* m) {
+  if (num_cameras <= 1) return;
+  const size_t k = static_cast<size_t>(num_cameras - 1);
+  m->final_ext_rotation_deg.assign(k, 0.0);
+  m->final_ext_translation_m.assign(k, 0.0);
+  m->mean_ext_rotation_deg.assign(k, 0.0);
+  m->mean_ext_translation_m.assign(k, 0.0);
+  std::vector<int> count(k, 0), last_frame(k, -1);
+  for (const ExtrinsicError& e : errors) {
+    const size_t c = static_cast<size_t>(e.camera - 1);
+    m->mean_ext_rotation_deg[c] += e.rotation_error_deg;
+    m->mean_ext_translation_m[c] += e.translation_error_m;
+    ++count[c];
+    if (e.frame >= last_frame[c]) {
+      last_frame[c] = e.frame;
+      m->final_ext_rotation_deg[c] = e.rotation_error_deg;
+      m->final_ext_translation_m[c] = e.translation_error_m;
+    }
+  }
+  for (size_t c = 0; c < k; ++c) {
+    if (count[c] > 0) {
+      m->mean_ext_rotation_deg[c] /= count[c];
+      m->mean_ext_translation_m[c] /= count[c];
+    }
+    m->max_final_ext_rotation_deg = std::max(m->max_final_ext_rotation_deg, m->final_ext_rotation_deg[c]);
+    m->max_final_ext_translation_m = std::max(m->max_final_ext_translation_m, m->final_ext_translation_m[c]);
+  }
+}
+
+}  // namespace
+
+RunEvaluation EvaluateRun(const Trajectory& full_gt, const std::vector<Rigid3>& gt_cam_from_rig, const RunData& run,
+                          const std::string& label, const EvalOptions& options) {
+  const auto [span_begin, span_end] = RunSpan(run, full_gt.size());
   const Trajectory gt(full_gt.begin() + static_cast<long>(span_begin), full_gt.begin() + static_cast<long>(span_end));
   RunEvaluation out;
   RunMetrics& m = out.metrics;
@@ -262,87 +359,10 @@ RunEvaluation EvaluateRun(const Trajectory& full_gt, const std::vector<Rigid3>& 
   m.estimated_frames = static_cast<int>(run.trajectory.size());
   m.path_length_m = GtPathLength(gt);
 
-  double tolerance = options.time_tolerance_s;
-  if (tolerance <= 0.0) {
-    const double interval = MedianInterval(gt);
-    tolerance = interval > 0.0 ? 0.25 * interval : 1e-3;
-  }
-  const Association association = AssociateByTimestamp(gt, run.trajectory, tolerance);
-  m.associated_frames = static_cast<int>(association.pairs.size());
-  m.missing_frames = static_cast<int>(association.gt_without_estimate.size());
-
-  if (!association.pairs.empty()) {
-    const Rigid3 origin = AlignOrigin(gt, run.trajectory, association);
-    m.rmse_origin_m = TranslationRmse(gt, run.trajectory, association, origin);
-    out.gt_from_est = origin;
-    try {
-      out.gt_from_est = AlignSe3(gt, run.trajectory, association);
-      m.rmse_se3_m = TranslationRmse(gt, run.trajectory, association, out.gt_from_est);
-      if (m.path_length_m > 0.0) m.relative_rmse_pct = 100.0 * *m.rmse_se3_m / m.path_length_m;
-    } catch (const std::invalid_argument& e) {
-      m.alignment_note =
-          std::string("SE(3) alignment impossible: ") + e.what() + "; error along path uses origin alignment";
-    }
-    for (const auto& [i, j] : association.pairs) {
-      FrameError fe;
-      fe.gt_index = static_cast<int>(i + span_begin);  // index in the full ground truth
-      fe.estimate_index = j;
-      fe.timestamp = gt[i].timestamp;
-      fe.gt_position = gt[i].world_from_rig.translation;
-      fe.aligned_position = out.gt_from_est * run.trajectory[j].world_from_rig.translation;
-      fe.error_m = (fe.gt_position - fe.aligned_position).norm();
-      out.frame_errors.push_back(fe);
-    }
-    m.drift = RelativeDrift(gt, run.trajectory, association);
-  } else {
-    m.alignment_note = "no estimated pose matches a ground-truth timestamp";
-  }
-
-  int ok = 0;
-  double inlier_sum = 0.0, reproj_sum = 0.0, time_sum = 0.0;
-  for (const FrameRecord& f : run.frames) {
-    time_sum += f.time_ms;
-    if (f.status == FrameStatus::kLost) ++m.lost_frames;
-    if (f.status != FrameStatus::kOk) continue;
-    ++ok;
-    inlier_sum += f.inlier_ratio;
-    reproj_sum += f.mean_reproj_error_deg;
-  }
-  if (ok > 0) {
-    m.mean_inlier_ratio = inlier_sum / ok;
-    m.mean_reproj_error_deg = reproj_sum / ok;
-  }
-  if (!run.frames.empty()) m.mean_time_ms = time_sum / static_cast<double>(run.frames.size());
-
+  ScoreTrajectory(gt, run, span_begin, options, &out);
+  ScoreFrameRecords(run.frames, &m);
   out.extrinsic_errors = ExtrinsicErrors(run.extrinsics, gt_cam_from_rig);
-  const int num_cameras = static_cast<int>(gt_cam_from_rig.size());
-  if (num_cameras > 1) {
-    const size_t k = static_cast<size_t>(num_cameras - 1);
-    m.final_ext_rotation_deg.assign(k, 0.0);
-    m.final_ext_translation_m.assign(k, 0.0);
-    m.mean_ext_rotation_deg.assign(k, 0.0);
-    m.mean_ext_translation_m.assign(k, 0.0);
-    std::vector<int> count(k, 0), last_frame(k, -1);
-    for (const ExtrinsicError& e : out.extrinsic_errors) {
-      const size_t c = static_cast<size_t>(e.camera - 1);
-      m.mean_ext_rotation_deg[c] += e.rotation_error_deg;
-      m.mean_ext_translation_m[c] += e.translation_error_m;
-      ++count[c];
-      if (e.frame >= last_frame[c]) {
-        last_frame[c] = e.frame;
-        m.final_ext_rotation_deg[c] = e.rotation_error_deg;
-        m.final_ext_translation_m[c] = e.translation_error_m;
-      }
-    }
-    for (size_t c = 0; c < k; ++c) {
-      if (count[c] > 0) {
-        m.mean_ext_rotation_deg[c] /= count[c];
-        m.mean_ext_translation_m[c] /= count[c];
-      }
-      m.max_final_ext_rotation_deg = std::max(m.max_final_ext_rotation_deg, m.final_ext_rotation_deg[c]);
-      m.max_final_ext_translation_m = std::max(m.max_final_ext_translation_m, m.final_ext_translation_m[c]);
-    }
-  }
+  ScoreExtrinsics(out.extrinsic_errors, static_cast<int>(gt_cam_from_rig.size()), &m);
   return out;
 }
 

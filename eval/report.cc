@@ -159,98 +159,84 @@ static void WriteGroundTruthCsv(const std::string& path, const std::vector<Stamp
   WriteFileAtomic(path, csv);
 }
 
-std::vector<RunEvaluation> EvaluateAndReport(const std::string& dataset_dir, const std::vector<std::string>& run_dirs,
-                                             const std::string& out_dir, const EvalReportOptions& options) {
-  if (run_dirs.empty()) throw std::invalid_argument("rovo eval: no run folders given");
-  const DatasetInfo info = ReadDatasetInfo(dataset_dir);
-  if (!info.has_ground_truth) {
-    throw std::runtime_error(DatasetJsonPath(dataset_dir) +
-                             ": has_ground_truth is false: rovo eval scores runs "
-                             "against ground-truth poses, which this dataset (a capture) does not have; rovo vo runs "
-                             "on it, and rovo study calibration --shot-only measures against its own calibration");
+// Folder name of a run in the report: the run folder's name, made unique with a suffix.
+static std::string UniqueRunLabel(const std::string& run_dir, std::map<std::string, int>* label_count) {
+  std::string label = fs::path(run_dir).lexically_normal().filename().string();
+  if (label.empty() || label == ".") label = fs::path(run_dir).lexically_normal().parent_path().filename().string();
+  if (label.empty()) label = "run";
+  const int seen = (*label_count)[label]++;
+  if (seen > 0) label += "_" + std::to_string(seen + 1);
+  return label;
+}
+
+// errors.csv, frames.csv, extrinsic_errors.csv and (with --kitti) the KITTI pair of one run.
+static void WriteRunFiles(const std::string& run_out, const RunEvaluation& evaluation, const RunData& run,
+                          const Trajectory& gt, bool kitti) {
+  std::string errors = Csv({"gt_index", "timestamp", "gt_x", "gt_y", "gt_z", "est_x", "est_y", "est_z", "error_m"});
+  for (const FrameError& e : evaluation.frame_errors) {
+    errors += Csv({std::to_string(e.gt_index), Num(e.timestamp), Num(e.gt_position.x()), Num(e.gt_position.y()),
+                   Num(e.gt_position.z()), Num(e.aligned_position.x()), Num(e.aligned_position.y()),
+                   Num(e.aligned_position.z()), Num(e.error_m)});
   }
-  const Trajectory gt = ReadTum(GroundTruthPath(dataset_dir));
-  if (gt.empty()) throw std::runtime_error(GroundTruthPath(dataset_dir) + ": no poses");
-  const std::vector<Rigid3> gt_cam_from_rig = info.rig.Extrinsics();
-  EnsureWritableDir(out_dir);
+  WriteFileAtomic((fs::path(run_out) / "errors.csv").string(), errors);
+  WriteFramesCsv((fs::path(run_out) / "frames.csv").string(), run.frames);
+  std::string ext = Csv({"frame", "timestamp", "camera", "rotation_error_deg", "translation_error_m", "roll_est_deg",
+                         "pitch_est_deg", "yaw_est_deg", "roll_gt_deg", "pitch_gt_deg", "yaw_gt_deg"});
+  for (const ExtrinsicError& e : evaluation.extrinsic_errors) {
+    ext += Csv({std::to_string(e.frame), Num(e.timestamp), std::to_string(e.camera), Num(e.rotation_error_deg),
+                Num(e.translation_error_m), Num(e.rpy_est_deg.x()), Num(e.rpy_est_deg.y()), Num(e.rpy_est_deg.z()),
+                Num(e.rpy_gt_deg.x()), Num(e.rpy_gt_deg.y()), Num(e.rpy_gt_deg.z())});
+  }
+  WriteFileAtomic((fs::path(run_out) / "extrinsic_errors.csv").string(), ext);
 
-  std::vector<RunEvaluation> evaluations;
-  std::map<std::string, int> label_count;
-  nlohmann::json runs_json = nlohmann::json::array();
-  std::string summary =
-      Csv({"label", "mode", "noise_set", "run_seed", "gt_frames", "associated_frames", "missing_frames", "lost_frames",
-           "path_length_m", "rmse_se3_m", "relative_rmse_pct", "rmse_origin_m", "drift_translation_pct",
-           "drift_rotation_deg_per_100m", "mean_inlier_ratio", "mean_reproj_error_deg", "max_final_ext_rotation_deg",
-           "max_final_ext_translation_m", "mean_time_ms"});
-  for (const std::string& run_dir : run_dirs) {
-    std::string note;
-    const RunData run = ReadRunOrTrajectory(run_dir, gt, options.trajectory_format, &note);
-    if (!note.empty() && !options.quiet) std::printf("%s\n", note.c_str());
-    std::string label = fs::path(run_dir).lexically_normal().filename().string();
-    if (label.empty() || label == ".") label = fs::path(run_dir).lexically_normal().parent_path().filename().string();
-    if (label.empty()) label = "run";
-    const int seen = label_count[label]++;
-    if (seen > 0) label += "_" + std::to_string(seen + 1);
-
-    RunEvaluation evaluation = EvaluateRun(gt, gt_cam_from_rig, run, label, options.eval);
-    const RunMetrics& m = evaluation.metrics;
-    const std::string run_out = (fs::path(out_dir) / label).string();
-    EnsureWritableDir(run_out);
-
-    std::string errors = Csv({"gt_index", "timestamp", "gt_x", "gt_y", "gt_z", "est_x", "est_y", "est_z", "error_m"});
+  if (kitti) {
+    // Line k of both files is the k-th associated frame; the estimate is mapped into the gt world.
+    Trajectory est_aligned, gt_associated;
     for (const FrameError& e : evaluation.frame_errors) {
-      errors += Csv({std::to_string(e.gt_index), Num(e.timestamp), Num(e.gt_position.x()), Num(e.gt_position.y()),
-                     Num(e.gt_position.z()), Num(e.aligned_position.x()), Num(e.aligned_position.y()),
-                     Num(e.aligned_position.z()), Num(e.error_m)});
+      gt_associated.push_back(gt[static_cast<size_t>(e.gt_index)]);
+      const StampedPose& est = run.trajectory[static_cast<size_t>(e.estimate_index)];
+      est_aligned.push_back({est.timestamp, evaluation.gt_from_est * est.world_from_rig});
     }
-    WriteFileAtomic((fs::path(run_out) / "errors.csv").string(), errors);
-    WriteFramesCsv((fs::path(run_out) / "frames.csv").string(), run.frames);
-    std::string ext = Csv({"frame", "timestamp", "camera", "rotation_error_deg", "translation_error_m", "roll_est_deg",
-                           "pitch_est_deg", "yaw_est_deg", "roll_gt_deg", "pitch_gt_deg", "yaw_gt_deg"});
-    for (const ExtrinsicError& e : evaluation.extrinsic_errors) {
-      ext += Csv({std::to_string(e.frame), Num(e.timestamp), std::to_string(e.camera), Num(e.rotation_error_deg),
-                  Num(e.translation_error_m), Num(e.rpy_est_deg.x()), Num(e.rpy_est_deg.y()), Num(e.rpy_est_deg.z()),
-                  Num(e.rpy_gt_deg.x()), Num(e.rpy_gt_deg.y()), Num(e.rpy_gt_deg.z())});
-    }
-    WriteFileAtomic((fs::path(run_out) / "extrinsic_errors.csv").string(), ext);
-
-    if (options.kitti) {
-      // Line k of both files is the k-th associated frame; the estimate is mapped into the gt world.
-      Trajectory est_aligned, gt_associated;
-      for (const FrameError& e : evaluation.frame_errors) {
-        gt_associated.push_back(gt[static_cast<size_t>(e.gt_index)]);
-        const StampedPose& est = run.trajectory[static_cast<size_t>(e.estimate_index)];
-        est_aligned.push_back({est.timestamp, evaluation.gt_from_est * est.world_from_rig});
-      }
-      WriteKitti((fs::path(run_out) / "kitti_estimate.txt").string(), est_aligned);
-      WriteKitti((fs::path(run_out) / "kitti_groundtruth.txt").string(), gt_associated);
-    }
-
-    nlohmann::json rj = MetricsToJson(m);
-    rj["run_dir"] = fs::absolute(run_dir).lexically_normal().string();
-    rj["run_seed"] = run.info.value("seed", nlohmann::json(nullptr));
-    rj["gt_from_est"] = {{"qx", evaluation.gt_from_est.rotation.x()},    {"qy", evaluation.gt_from_est.rotation.y()},
-                         {"qz", evaluation.gt_from_est.rotation.z()},    {"qw", evaluation.gt_from_est.rotation.w()},
-                         {"tx", evaluation.gt_from_est.translation.x()}, {"ty", evaluation.gt_from_est.translation.y()},
-                         {"tz", evaluation.gt_from_est.translation.z()}};
-    runs_json.push_back(rj);
-    summary += Csv({m.label, m.mode, std::to_string(m.noise_set), rj["run_seed"].dump(), std::to_string(m.gt_frames),
-                    std::to_string(m.associated_frames), std::to_string(m.missing_frames),
-                    std::to_string(m.lost_frames), Num(m.path_length_m), m.rmse_se3_m ? Num(*m.rmse_se3_m) : "",
-                    m.relative_rmse_pct ? Num(*m.relative_rmse_pct) : "", m.rmse_origin_m ? Num(*m.rmse_origin_m) : "",
-                    Num(m.drift.translation_pct), Num(m.drift.rotation_deg_per_100m), Num(m.mean_inlier_ratio),
-                    Num(m.mean_reproj_error_deg), Num(m.max_final_ext_rotation_deg), Num(m.max_final_ext_translation_m),
-                    Num(m.mean_time_ms)});
-    if (!options.quiet && m.missing_frames > 0) {
-      std::fprintf(stderr, "rovo eval: %s: %d of %d ground-truth frames have no estimate\n", label.c_str(),
-                   m.missing_frames, m.gt_frames);
-    }
-    if (!options.quiet && !m.alignment_note.empty()) {
-      std::fprintf(stderr, "rovo eval: %s: %s\n", label.c_str(), m.alignment_note.c_str());
-    }
-    evaluations.push_back(std::move(evaluation));
+    WriteKitti((fs::path(run_out) / "kitti_estimate.txt").string(), est_aligned);
+    WriteKitti((fs::path(run_out) / "kitti_groundtruth.txt").string(), gt_associated);
   }
+}
 
+// The run's object in metrics.json: its metrics, folder, seed and the gt_from_est alignment.
+static nlohmann::json RunJson(const RunEvaluation& evaluation, const RunData& run, const std::string& run_dir) {
+  nlohmann::json rj = MetricsToJson(evaluation.metrics);
+  rj["run_dir"] = fs::absolute(run_dir).lexically_normal().string();
+  rj["run_seed"] = run.info.value("seed", nlohmann::json(nullptr));
+  rj["gt_from_est"] = {{"qx", evaluation.gt_from_est.rotation.x()},    {"qy", evaluation.gt_from_est.rotation.y()},
+                       {"qz", evaluation.gt_from_est.rotation.z()},    {"qw", evaluation.gt_from_est.rotation.w()},
+                       {"tx", evaluation.gt_from_est.translation.x()}, {"ty", evaluation.gt_from_est.translation.y()},
+                       {"tz", evaluation.gt_from_est.translation.z()}};
+  return rj;
+}
+
+static std::string SummaryHeader() {
+  return Csv({"label", "mode", "noise_set", "run_seed", "gt_frames", "associated_frames", "missing_frames",
+              "lost_frames", "path_length_m", "rmse_se3_m", "relative_rmse_pct", "rmse_origin_m",
+              "drift_translation_pct", "drift_rotation_deg_per_100m", "mean_inlier_ratio", "mean_reproj_error_deg",
+              "max_final_ext_rotation_deg", "max_final_ext_translation_m", "mean_time_ms"});
+}
+
+// One summary.csv row; `run_seed` is the run's metrics.json seed as JSON text.
+static std::string SummaryRow(const RunMetrics& m, const nlohmann::json& run_seed) {
+  return Csv({m.label, m.mode, std::to_string(m.noise_set), run_seed.dump(), std::to_string(m.gt_frames),
+              std::to_string(m.associated_frames), std::to_string(m.missing_frames), std::to_string(m.lost_frames),
+              Num(m.path_length_m), m.rmse_se3_m ? Num(*m.rmse_se3_m) : "",
+              m.relative_rmse_pct ? Num(*m.relative_rmse_pct) : "", m.rmse_origin_m ? Num(*m.rmse_origin_m) : "",
+              Num(m.drift.translation_pct), Num(m.drift.rotation_deg_per_100m), Num(m.mean_inlier_ratio),
+              Num(m.mean_reproj_error_deg), Num(m.max_final_ext_rotation_deg), Num(m.max_final_ext_translation_m),
+              Num(m.mean_time_ms)});
+}
+
+// The dataset-wide files: groundtruth.csv, summary.csv, table.md, metrics.json and (with plots) report.html.
+static void WriteReportFiles(const std::string& dataset_dir, const DatasetInfo& info, const Trajectory& gt,
+                             const std::string& out_dir, const EvalReportOptions& options,
+                             const std::vector<RunEvaluation>& evaluations, const std::string& summary,
+                             const nlohmann::json& runs_json) {
   WriteGroundTruthCsv((fs::path(out_dir) / "groundtruth.csv").string(), gt);
   WriteFileAtomic((fs::path(out_dir) / "summary.csv").string(), summary);
 
@@ -277,6 +263,53 @@ std::vector<RunEvaluation> EvaluateAndReport(const std::string& dataset_dir, con
     const std::vector<std::string> pngs = RunReportPlots(out_dir, options.quiet);
     WriteHtmlReport((fs::path(out_dir) / "report.html").string(), title, table + "\n" + MetricsLegendMarkdown(), pngs);
   }
+}
+
+std::vector<RunEvaluation> EvaluateAndReport(const std::string& dataset_dir, const std::vector<std::string>& run_dirs,
+                                             const std::string& out_dir, const EvalReportOptions& options) {
+  if (run_dirs.empty()) throw std::invalid_argument("rovo eval: no run folders given");
+  const DatasetInfo info = ReadDatasetInfo(dataset_dir);
+  if (!info.has_ground_truth) {
+    throw std::runtime_error(DatasetJsonPath(dataset_dir) +
+                             ": has_ground_truth is false: rovo eval scores runs "
+                             "against ground-truth poses, which this dataset (a capture) does not have; rovo vo runs "
+                             "on it, and rovo study calibration --shot-only measures against its own calibration");
+  }
+  const Trajectory gt = ReadTum(GroundTruthPath(dataset_dir));
+  if (gt.empty()) throw std::runtime_error(GroundTruthPath(dataset_dir) + ": no poses");
+  const std::vector<Rigid3> gt_cam_from_rig = info.rig.Extrinsics();
+  EnsureWritableDir(out_dir);
+
+  std::vector<RunEvaluation> evaluations;
+  std::map<std::string, int> label_count;
+  nlohmann::json runs_json = nlohmann::json::array();
+  std::string summary = SummaryHeader();
+  for (const std::string& run_dir : run_dirs) {
+    std::string note;
+    const RunData run = ReadRunOrTrajectory(run_dir, gt, options.trajectory_format, &note);
+    if (!note.empty() && !options.quiet) std::printf("%s\n", note.c_str());
+    const std::string label = UniqueRunLabel(run_dir, &label_count);
+
+    RunEvaluation evaluation = EvaluateRun(gt, gt_cam_from_rig, run, label, options.eval);
+    const RunMetrics& m = evaluation.metrics;
+    const std::string run_out = (fs::path(out_dir) / label).string();
+    EnsureWritableDir(run_out);
+    WriteRunFiles(run_out, evaluation, run, gt, options.kitti);
+
+    const nlohmann::json rj = RunJson(evaluation, run, run_dir);
+    runs_json.push_back(rj);
+    summary += SummaryRow(m, rj["run_seed"]);
+    if (!options.quiet && m.missing_frames > 0) {
+      std::fprintf(stderr, "rovo eval: %s: %d of %d ground-truth frames have no estimate\n", label.c_str(),
+                   m.missing_frames, m.gt_frames);
+    }
+    if (!options.quiet && !m.alignment_note.empty()) {
+      std::fprintf(stderr, "rovo eval: %s: %s\n", label.c_str(), m.alignment_note.c_str());
+    }
+    evaluations.push_back(std::move(evaluation));
+  }
+
+  WriteReportFiles(dataset_dir, info, gt, out_dir, options, evaluations, summary, runs_json);
   return evaluations;
 }
 

@@ -254,6 +254,28 @@ __attribute__((always_inline)) inline __m128 MipTexture::Filter(const Footprint4
   return _mm_mul_ps(_mm_add_ps(top, _mm_mul_ps(vay, _mm_sub_ps(bottom, top))), _mm_set1_ps(1.0f / 65535.0f));
 }
 
+namespace {
+
+// As Sample4: level 0 for lod <= 0 or NaN, the last level from lod >= last on, else the two
+// levels around lod with weight lod - floor(lod) on the coarser one: the finer level l0, the weight a.
+inline void SelectLevels4(__m128 l, __m128i last, bool trilinear, __m128i* l0, __m128* a) {
+  if (trilinear) {
+    const __m128 positive = _mm_cmpgt_ps(l, _mm_setzero_ps());
+    const __m128 inside = _mm_and_ps(positive, _mm_cmplt_ps(l, _mm_cvtepi32_ps(last)));
+    const __m128i floor_l = _mm_cvttps_epi32(l);
+    *l0 = Select(_mm_castps_si128(inside), floor_l, _mm_and_si128(_mm_castps_si128(positive), last));
+    *a = _mm_and_ps(inside, _mm_sub_ps(l, _mm_cvtepi32_ps(floor_l)));
+  } else {
+    // The nearest level, clamp(int(lod + 1/2), 0, last) (a NaN converts to INT_MIN: level 0).
+    *l0 = _mm_cvttps_epi32(_mm_add_ps(l, _mm_set1_ps(0.5f)));
+    *l0 = _mm_andnot_si128(_mm_cmplt_epi32(*l0, _mm_setzero_si128()), *l0);
+    *l0 = Select(_mm_cmpgt_epi32(*l0, last), last, *l0);
+    *a = _mm_setzero_ps();
+  }
+}
+
+}  // namespace
+
 void MipTexture::SampleBatch(const MipTexture* const* textures, const float* u, const float* v, const float* lod, int n,
                              __m128* out, bool trilinear) {
   // Chunks of up to kChunk lookups: first every address (four lanes at a time) with a prefetch of
@@ -287,25 +309,11 @@ void MipTexture::SampleBatch(const MipTexture* const* textures, const float* u, 
         lv = _mm_load_ps(tv);
         l = _mm_load_ps(tl);
       }
-      // As Sample4: level 0 for lod <= 0 or NaN, the last level from lod >= last on, else the two
-      // levels around lod with weight lod - floor(lod) on the coarser one.
       const __m128i last =
           _mm_setr_epi32(tex[0]->last_level_, tex[1]->last_level_, tex[2]->last_level_, tex[3]->last_level_);
       __m128i l0;
       __m128 a;
-      if (trilinear) {
-        const __m128 positive = _mm_cmpgt_ps(l, _mm_setzero_ps());
-        const __m128 inside = _mm_and_ps(positive, _mm_cmplt_ps(l, _mm_cvtepi32_ps(last)));
-        const __m128i floor_l = _mm_cvttps_epi32(l);
-        l0 = Select(_mm_castps_si128(inside), floor_l, _mm_and_si128(_mm_castps_si128(positive), last));
-        a = _mm_and_ps(inside, _mm_sub_ps(l, _mm_cvtepi32_ps(floor_l)));
-      } else {
-        // The nearest level, clamp(int(lod + 1/2), 0, last) (a NaN converts to INT_MIN: level 0).
-        l0 = _mm_cvttps_epi32(_mm_add_ps(l, _mm_set1_ps(0.5f)));
-        l0 = _mm_andnot_si128(_mm_cmplt_epi32(l0, _mm_setzero_si128()), l0);
-        l0 = Select(_mm_cmpgt_epi32(l0, last), last, l0);
-        a = _mm_setzero_ps();
-      }
+      SelectLevels4(l, last, trilinear, &l0, &a);
       __m128i l1 = _mm_add_epi32(l0, _mm_set1_epi32(1));
       l1 = Select(_mm_cmpgt_epi32(l1, last), last, l1);
       _mm_store_ps(blend + g * 4, a);

@@ -3,7 +3,7 @@
 // perturbation draws (the paper's protocol, datasets/rig.h PerturbExtrinsics), not the dataset's
 // stored noise sets.
 //
-// Per draw (seed = first_seed + index): the extrinsic error (../shared/DESIGN.md: the largest over
+// Per draw (seed = first_seed + index): the extrinsic error (the largest over
 // cameras i >= 1 of the angle of est(cam_i_from_cam0) true(cam_i_from_cam0)^-1, against the
 // dataset's rig) of the draw itself, after the start-up calibration, at frames 50 and 100 of the
 // OnlineExt run and at its end. `shot_only` runs the start-up calibration alone on one synchronous

@@ -485,19 +485,23 @@ void SummarizeArms(const Arm& fisheye_arm, const Arm& hybrid_arm, ProjectionStud
   result->inliers_hybrid = hybrid_arm.inliers;
 }
 
-// table.md: the Table II rows, ratios, track counts, error bins and the method.
-void WriteStudyTable(const StudySetup& setup, const DatasetInfo& info, const FrontendOptions& frontend_options,
-                     const StudyTally& tally, const ProjectionStudyResult& result) {
-  const ProjectionStudyOptions& options = setup.options;
-  const Rig& rig = setup.rig;
-  const int frames = result.frames;
+// "ratio % (correct / all)" of a match count.
+std::string RatioCell(int64_t inliers, int64_t matches) {
+  char text[96];
+  std::snprintf(text, sizeof(text), "%.2f (%lld / %lld)", matches ? 100.0 * double(inliers) / double(matches) : 0.0,
+                static_cast<long long>(inliers), static_cast<long long>(matches));
+  return std::string(text);
+}
+
+std::string BinsRow(const char* name, const std::vector<int64_t>& bins) {
+  std::string row = std::string("| ") + name;
+  for (int64_t count : bins) row += " | " + std::to_string(count);
+  return row + " |\n";
+}
+
+// The Table II rows of table.md, then the ratios and track counts under it.
+void WriteTableRows(const ProjectionStudyResult& result, std::ostringstream& md) {
   char line[1024];
-  std::ostringstream md;
-  md << "# Hybrid projection vs raw fisheye (paper Table II)\n\n";
-  md << "Dataset: `" << options.dataset_dir << "` (preset " << (info.preset.empty() ? "custom" : info.preset)
-     << ", seed " << info.seed << "), frames 0-" << frames - 1 << ", " << setup.n << " cameras of "
-     << rig.cameras[0].camera.width << "x" << rig.cameras[0].camera.height << ", " << options.features_per_view
-     << " features per view. rovo " << ROVO_VERSION << ".\n\n";
   md << "| | Original fisheye | Hybrid projection (ours) | Paper: fisheye / hybrid |\n|---|---|---|---|\n";
   std::snprintf(line, sizeof(line),
                 "| Descriptor distance (mean Hamming, track's first frame vs each later frame) | %.2f | %.2f | 124.85 "
@@ -507,24 +511,17 @@ void WriteStudyTable(const StudySetup& setup, const DatasetInfo& info, const Fro
   std::snprintf(line, sizeof(line), "| Descriptor distance (mean Hamming, frame t vs t+1) | %.2f | %.2f | - |\n",
                 result.hamming_step_fisheye, result.hamming_step_hybrid);
   md << line;
-  // "ratio % (correct / all)" of a match count.
-  const auto cell = [](int64_t inliers, int64_t matches) {
-    char text[96];
-    std::snprintf(text, sizeof(text), "%.2f (%lld / %lld)", matches ? 100.0 * double(inliers) / double(matches) : 0.0,
-                  static_cast<long long>(inliers), static_cast<long long>(matches));
-    return std::string(text);
-  };
   md << "| Inter-view inlier ratio %, mutual-NN ORB matches in the overlaps, descriptors only (correct / all) | "
-     << cell(result.raw_inliers_fisheye, result.raw_matches_fisheye) << " | "
-     << cell(result.raw_inliers_hybrid, result.raw_matches_hybrid) << " | - |\n";
+     << RatioCell(result.raw_inliers_fisheye, result.raw_matches_fisheye) << " | "
+     << RatioCell(result.raw_inliers_hybrid, result.raw_matches_hybrid) << " | - |\n";
   md << "| Inter-view inlier ratio %, the same matches kept when epipolar-consistent | "
-     << cell(result.inliers_fisheye, result.matches_fisheye) << " | "
-     << cell(result.inliers_hybrid, result.matches_hybrid) << " | 21.53 / 73.16 |\n";
+     << RatioCell(result.inliers_fisheye, result.matches_fisheye) << " | "
+     << RatioCell(result.inliers_hybrid, result.matches_hybrid) << " | 21.53 / 73.16 |\n";
   md << "| Inter-view inlier ratio %, the front-end's filter chain on the same overlap features | "
-     << cell(result.chain_inliers_fisheye, result.chain_matches_fisheye) << " | "
-     << cell(result.chain_inliers_hybrid, result.chain_matches_hybrid) << " | - |\n";
+     << RatioCell(result.chain_inliers_fisheye, result.chain_matches_fisheye) << " | "
+     << RatioCell(result.chain_inliers_hybrid, result.chain_matches_hybrid) << " | - |\n";
   md << "| Inter-view inlier ratio %, the front-end itself | - | "
-     << cell(result.inliers_frontend, result.matches_frontend) << " | - |\n\n";
+     << RatioCell(result.inliers_frontend, result.matches_frontend) << " | - |\n\n";
   std::snprintf(line, sizeof(line),
                 "Ratios: descriptor distance hybrid/fisheye = %.3f (target <= 0.35); inlier ratio hybrid/fisheye = "
                 "%.2f (target >= 3, hybrid >= 80%%); correct matches of the filter chain hybrid/fisheye = %.2f.\n\n",
@@ -541,15 +538,16 @@ void WriteStudyTable(const StudySetup& setup, const DatasetInfo& info, const Fro
                 result.mean_age_fisheye, static_cast<long long>(result.tracked_pairs_hybrid),
                 static_cast<long long>(result.features_hybrid), result.mean_age_hybrid);
   md << line;
-  const auto bins_row = [](const char* name, const std::vector<int64_t>& bins) {
-    std::string row = std::string("| ") + name;
-    for (int64_t count : bins) row += " | " + std::to_string(count);
-    return row + " |\n";
-  };
+}
+
+// The error bins and the method of table.md.
+void WriteTableMethod(const StudySetup& setup, const FrontendOptions& frontend_options, const StudyTally& tally,
+                      std::ostringstream& md) {
+  const ProjectionStudyOptions& options = setup.options;
   md << "Ground-truth reprojection distance of the counted matches (fisheye px):\n\n"
      << "| | < 0.5 | 0.5-1 | 1-2 | 2-4 | 4-8 | >= 8 |\n|---|---|---|---|---|---|---|\n"
-     << bins_row("fisheye, NN", tally.fisheye.error_bins) << bins_row("hybrid, NN", tally.hybrid.error_bins)
-     << bins_row("hybrid, front-end", tally.frontend_error_bins) << "\n";
+     << BinsRow("fisheye, NN", tally.fisheye.error_bins) << BinsRow("hybrid, NN", tally.hybrid.error_bins)
+     << BinsRow("hybrid, front-end", tally.frontend_error_bins) << "\n";
   md << "Method: the same tracker (FAST + " << frontend_options.min_feature_distance_px
      << " px minimum distance, pyramidal KLT with forward-backward check, re-detection to the target, ORB "
         "descriptors recomputed every frame, "
@@ -567,6 +565,22 @@ void WriteStudyTable(const StudySetup& setup, const DatasetInfo& info, const Fro
      << "back-projection of the first feature (any of its 3x3 depth pixels) reprojects within " << options.inlier_px
      << " fisheye px of the second and is not occluded (depth agrees). Matches without depth (sky) are not "
         "counted.\n";
+}
+
+// table.md: the Table II rows, ratios, track counts, error bins and the method.
+void WriteStudyTable(const StudySetup& setup, const DatasetInfo& info, const FrontendOptions& frontend_options,
+                     const StudyTally& tally, const ProjectionStudyResult& result) {
+  const ProjectionStudyOptions& options = setup.options;
+  const Rig& rig = setup.rig;
+  const int frames = result.frames;
+  std::ostringstream md;
+  md << "# Hybrid projection vs raw fisheye (paper Table II)\n\n";
+  md << "Dataset: `" << options.dataset_dir << "` (preset " << (info.preset.empty() ? "custom" : info.preset)
+     << ", seed " << info.seed << "), frames 0-" << frames - 1 << ", " << setup.n << " cameras of "
+     << rig.cameras[0].camera.width << "x" << rig.cameras[0].camera.height << ", " << options.features_per_view
+     << " features per view. rovo " << ROVO_VERSION << ".\n\n";
+  WriteTableRows(result, md);
+  WriteTableMethod(setup, frontend_options, tally, md);
   WriteFileAtomic(options.out_dir + "/table.md", md.str());
 }
 
