@@ -5,14 +5,18 @@
 #include <exception>
 
 #include "eval/app/commands.h"
+#include "eval/app/progress_printer.h"
 #include "rovo/version.h"
 
-int main(int argc, char** argv) {
+// Building the command tree throws only on a programming error (a flag named twice), which should abort.
+int main(int argc, char** argv) {  // NOLINT(bugprone-exception-escape)
   CLI::App app{"rovo " ROVO_VERSION
                ": synthetic multi-fisheye datasets with exact ground truth, the ROVO visual odometry pipeline, "
                "and its evaluation suites."};
   app.set_version_flag("--version", "rovo " ROVO_VERSION);
   app.require_subcommand(1);
+  rovo::ProgressPrinter progress_printer;  // the libraries' progress, shown on stderr
+  rovo::SetProgressSink(&progress_printer);
 
   rovo::CommandTree tree;
   tree.root = &app;
