@@ -174,7 +174,7 @@ Scene ProceduralSceneHeader(const ScenePreset& preset, uint64_t seed, bool quick
 
 Scene GenerateScene(const std::string& preset_name, uint64_t seed, bool quick) {
   const ScenePreset& preset = FindScenePreset(preset_name);
-  if (preset.world == "indoor") return GenerateIndoorScene(preset, seed, quick);
+  if (preset.world == SceneWorld::kIndoor) return GenerateIndoorScene(preset, seed, quick);
   const CityLayout L = MakeCityLayout(preset, seed, quick);
   const CityStyle& st = L.style;
   const uint64_t layout_seed = LayoutSeed(preset.name, seed);
@@ -182,7 +182,8 @@ Scene GenerateScene(const std::string& preset_name, uint64_t seed, bool quick) {
   SceneRng rng(SubSeed(layout_seed, "props"));
 
   Scene scene = ProceduralSceneHeader(preset, seed, quick, L.trajectory);
-  scene.lighting = MakeLighting(preset.lighting, SubSeed(seed, preset.lighting.c_str()), st.high_sun_along_streets);
+  const std::string lighting = SceneLightingName(preset.lighting);
+  scene.lighting = MakeLighting(lighting, SubSeed(seed, lighting.c_str()), st.high_sun_along_streets);
 
   const CityTextures textures = GenerateTextures(scene, st, texture_seed, quick);
   const CityMaterials materials = AddSharedMaterials(scene, textures);
@@ -201,7 +202,7 @@ Scene GenerateScene(const std::string& preset_name, uint64_t seed, bool quick) {
   CarFactory cars(scene, textures.car);
   FurnishStreets(scene, L, mesh_light, mesh_tree, cars, rng);
 
-  const bool night = preset.lighting == "night";
+  const bool night = preset.lighting == SceneLighting::kNight;
   if (preset.traffic) AddTraffic(scene, L, layout_seed ^ seed, preset.frame_rate, cars, night);
   if (night) LightStreetLamps(scene, mesh_light, materials.lamp);
   if (st.houses) AddLawns(scene, L, materials.lawn);

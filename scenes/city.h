@@ -11,18 +11,24 @@
 
 namespace rovo {
 
+// The procedural lighting of a preset; its name goes into the scene (Lighting::preset).
+enum class SceneLighting { kSunny, kCloudy, kSunset, kNight, kIndoor };
+std::string SceneLightingName(SceneLighting lighting);  // "sunny" | "cloudy" | "sunset" | "night" | "indoor"
+// What a preset is built from: the street grid (city_layout.h) or a hall and corridor (indoor.h).
+enum class SceneWorld { kCity, kIndoor };
+
 struct ScenePreset {
   std::string name;  // e.g. "static_urban"
   std::string description;
   double path_length_m = 0;  // full form
   int frames = 0;            // full form, at 10 Hz
-  std::string lighting;      // "sunny" | "cloudy" | "sunset" | "night" | "indoor"
-  bool traffic = false;      // moving objects (vehicles; people in indoor_hall)
+  SceneLighting lighting = SceneLighting::kSunny;
+  bool traffic = false;  // moving objects (vehicles; people in indoor_hall)
   std::string rig_preset = "rovo4";
-  int quick_frames = 0;        // --quick form
-  double quick_scale = 0.5;    // image scale for the --quick form
-  double frame_rate = 10.0;    // Hz
-  std::string world = "city";  // "city" (street grid, city_layout.h) or "indoor" (hall and corridor, indoor.h)
+  int quick_frames = 0;      // --quick form
+  double quick_scale = 0.5;  // image scale for the --quick form
+  double frame_rate = 10.0;  // Hz
+  SceneWorld world = SceneWorld::kCity;
 };
 
 // The Table I presets, in Table I order (what `rovo suite` runs by default).

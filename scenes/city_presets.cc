@@ -17,7 +17,7 @@ ScenePreset StaticUrban() {
   p.description = "Static Urban: ~2 km city drive, no moving objects, sunny";
   p.path_length_m = 2000;
   p.frames = 3000;
-  p.lighting = "sunny";
+  p.lighting = SceneLighting::kSunny;
   p.traffic = false;
   p.quick_frames = 60;
   return p;
@@ -29,7 +29,7 @@ ScenePreset DynamicUrban() {
   p.description = "Dynamic Urban: ~1.3 km fast drive on long blocks, heavy traffic";
   p.path_length_m = 1320;
   p.frames = 1000;
-  p.lighting = "sunny";
+  p.lighting = SceneLighting::kSunny;
   p.traffic = true;
   p.quick_frames = 60;
   return p;
@@ -41,7 +41,7 @@ ScenePreset CloudyUrban() {
   p.description = "Cloudy Urban: ~350 m in a small town, overcast";
   p.path_length_m = 350;
   p.frames = 300;
-  p.lighting = "cloudy";
+  p.lighting = SceneLighting::kCloudy;
   p.traffic = false;
   p.quick_frames = 60;
   return p;
@@ -53,7 +53,7 @@ ScenePreset SunsetUrban() {
   p.description = "Sunset Urban: the cloudy_urban streets at sunset (low warm sun)";
   p.path_length_m = 350;
   p.frames = 300;
-  p.lighting = "sunset";
+  p.lighting = SceneLighting::kSunset;
   p.traffic = false;
   p.quick_frames = 60;
   return p;
@@ -65,7 +65,7 @@ ScenePreset CanyonMultiFov() {
   p.description = "4view-MultiFOV-like: ~440 m slow drive in a narrow urban canyon";
   p.path_length_m = 440;
   p.frames = 2200;
-  p.lighting = "sunny";
+  p.lighting = SceneLighting::kSunny;
   p.traffic = false;
   p.rig_preset = "omnimvs4";
   p.quick_frames = 80;
@@ -80,10 +80,10 @@ ScenePreset IndoorHall() {
   p.description = "Indoor hall and corridor: plain walls, polished floor, ceiling lights, people near the rig";
   p.path_length_m = 128;
   p.frames = 1000;
-  p.lighting = "indoor";
+  p.lighting = SceneLighting::kIndoor;
   p.traffic = true;
   p.quick_frames = 80;
-  p.world = "indoor";
+  p.world = SceneWorld::kIndoor;
   return p;
 }
 
@@ -93,7 +93,7 @@ ScenePreset SuburbanRoad() {
   p.description = "Suburban road: plain houses behind lawns, wide spacing, open sky, sparse features";
   p.path_length_m = 600;
   p.frames = 600;
-  p.lighting = "sunny";
+  p.lighting = SceneLighting::kSunny;
   p.traffic = false;
   p.quick_frames = 60;
   return p;
@@ -105,13 +105,29 @@ ScenePreset NightStreet() {
   p.description = "The cloudy_urban streets at night: street lamps, headlights, dark sky (high gain)";
   p.path_length_m = 350;
   p.frames = 300;
-  p.lighting = "night";
+  p.lighting = SceneLighting::kNight;
   p.traffic = true;
   p.quick_frames = 60;
   return p;
 }
 
 }  // namespace
+
+std::string SceneLightingName(SceneLighting lighting) {
+  switch (lighting) {
+    case SceneLighting::kSunny:
+      return "sunny";
+    case SceneLighting::kCloudy:
+      return "cloudy";
+    case SceneLighting::kSunset:
+      return "sunset";
+    case SceneLighting::kNight:
+      return "night";
+    case SceneLighting::kIndoor:
+      return "indoor";
+  }
+  throw std::logic_error("SceneLightingName: unknown lighting");
+}
 
 const std::vector<ScenePreset>& ScenePresets() {
   static const std::vector<ScenePreset> presets = {StaticUrban(), DynamicUrban(), CloudyUrban(), SunsetUrban(),

@@ -101,7 +101,7 @@ void RunList() {
               "lighting", "description");
   for (const ScenePreset& p : AllScenePresets()) {
     std::printf("%-16s %7d %9.0f %7d %8.2f %7s %-9s  %s\n", p.name.c_str(), p.frames, p.path_length_m, p.quick_frames,
-                p.quick_scale, p.traffic ? "yes" : "no", p.lighting.c_str(), p.description.c_str());
+                p.quick_scale, p.traffic ? "yes" : "no", SceneLightingName(p.lighting).c_str(), p.description.c_str());
   }
 }
 

@@ -31,8 +31,8 @@ TEST(ScenePresets, TableOneOrderAndLookup) {
   EXPECT_EQ(presets[0].frames, 3000);
   EXPECT_EQ(presets[1].name, "dynamic_urban");
   EXPECT_TRUE(presets[1].traffic);
-  EXPECT_EQ(FindScenePreset("sunset_urban").lighting, "sunset");
-  EXPECT_EQ(FindScenePreset("cloudy_urban").lighting, "cloudy");
+  EXPECT_EQ(FindScenePreset("sunset_urban").lighting, SceneLighting::kSunset);
+  EXPECT_EQ(FindScenePreset("cloudy_urban").lighting, SceneLighting::kCloudy);
   try {
     FindScenePreset("nope");
     FAIL() << "expected an exception";

@@ -34,8 +34,8 @@ TEST(HarderWorlds, ListedAfterTableOneAndFound) {
     EXPECT_EQ(FindScenePreset(names[i]).name, names[i]);
     EXPECT_GT(FindScenePreset(names[i]).quick_frames, 0);
   }
-  EXPECT_EQ(FindScenePreset("indoor_hall").world, "indoor");
-  EXPECT_EQ(FindScenePreset("night_street").lighting, "night");
+  EXPECT_EQ(FindScenePreset("indoor_hall").world, SceneWorld::kIndoor);
+  EXPECT_EQ(FindScenePreset("night_street").lighting, SceneLighting::kNight);
 }
 
 // Quick forms: frame count and path length as the preset says, the same bytes for the same seed,
