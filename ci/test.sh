@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# The test command: installs dependencies, builds, runs every ctest test (unit + integration),
+# The test command: installs dependencies, builds, checks formatting and lint (ci/lint.sh), runs every ctest
+# test (unit + integration),
 # then rebuilds the unit tests with AddressSanitizer + UndefinedBehaviorSanitizer and runs them.
 # Set ROVO_SKIP_SANITIZERS=1 to skip the sanitizer pass locally.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash ci/install-deps.sh
 bash ci/build.sh
+bash ci/lint.sh     # clang-format and clang-tidy (bugprone-*, performance-*): any finding fails
 ctest --test-dir build --output-on-failure -j2 --timeout 1500
 
 if [ "${ROVO_SKIP_SANITIZERS:-0}" != "1" ]; then

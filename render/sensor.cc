@@ -323,7 +323,7 @@ int SensorPipeline::Digitize(double mean_e, double gain, uint16_t shot_word, uin
   const double dn = gain * e * full_scale_ / settings_.full_well_e;
   if (!(dn > 0.0)) return 0;
   if (dn >= full_scale_) return full_scale_;
-  return static_cast<int>(dn + 0.5);
+  return static_cast<int>(dn + 0.5);  // NOLINT(bugprone-incorrect-roundings): dn > 0, so this rounds half up
 }
 
 void SensorPipeline::Apply(const std::vector<float>& linear, const std::vector<uint8_t>& valid,

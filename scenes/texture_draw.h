@@ -47,7 +47,7 @@ class NoiseField {
       lattice.resize(static_cast<size_t>(period_x) * period_y);
       for (int y = 0; y < period_y; ++y)
         for (int x = 0; x < period_x; ++x)
-          lattice[static_cast<size_t>(y) * period_x + x] = Hash01(x, y, seed + 7919u * o);
+          lattice[static_cast<size_t>(y) * period_x + x] = Hash01(x, y, seed + static_cast<uint64_t>(7919u * o));
       for (int py = 0; py < h; ++py) {
         const float fy = (py + 0.5f) * period_y / h;
         const int y0 = static_cast<int>(fy);

@@ -278,7 +278,7 @@ void HybridProjection::BuildMaps() {
   // Exact fisheye pixel of a warped pixel, or nullopt when outside the FOV or (with one pixel of
   // margin for bilinear interpolation) outside the fisheye image.
   const auto exact = [&](int u, int v) -> std::optional<Eigen::Vector2d> {
-    const auto uv = FisheyeFromWarped(Eigen::Vector2d(u, v));
+    auto uv = FisheyeFromWarped(Eigen::Vector2d(u, v));
     if (!uv || uv->x() < 0 || uv->y() < 0 || uv->x() > camera_.width - 1 || uv->y() > camera_.height - 1) {
       return std::nullopt;
     }

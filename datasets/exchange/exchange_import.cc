@@ -70,6 +70,7 @@ std::vector<ExchangeCamera> ReadCalibration(ExchangeFormat format, const std::st
       return ReadBasaltCalibration(path);
     case ExchangeFormat::kEuroc: {
       std::vector<ExchangeCamera> cameras;
+      cameras.reserve(folders.size());
       for (const std::string& name : folders) {
         cameras.push_back(ReadEurocSensorYaml((fs::path(in_dir) / "mav0" / name / "sensor.yaml").string(), name));
       }
@@ -211,6 +212,7 @@ ImportReport ImportDataset(const std::string& in_dir, const ImportOptions& optio
 
   const auto frames = SynchronousFrames(in_dir, folders);
   std::vector<int64_t> stamps;
+  stamps.reserve(frames.size());
   for (const auto& frame : frames) stamps.push_back(frame.first);
   info.frame_rate = MedianRate(stamps);
   info.frame_count = static_cast<int>(frames.size());

@@ -67,6 +67,7 @@ OverlapFit FitOverlaps(const std::string& dataset_dir, const DatasetInfo& info, 
   OverlapFit fit;
   fit.results = static_cast<int>(results.size());
   std::vector<double> scales;
+  scales.reserve(results.size());
   for (const FitCalibration& r : results) scales.push_back(r.angle_scale);
   if (!scales.empty()) fit.angle_scale = Median(scales);
   for (int frame : frames) {
@@ -80,6 +81,7 @@ OverlapFit FitOverlaps(const std::string& dataset_dir, const DatasetInfo& info, 
     const std::vector<RingPairFit> given = ring.Fit(info.rig.Extrinsics(), 1.0);
     const std::vector<RingPairFit> given_scaled = ring.Fit(info.rig.Extrinsics(), fit.angle_scale);
     std::vector<std::vector<RingPairFit>> by_result;
+    by_result.reserve(results.size());
     for (const FitCalibration& r : results) {
       by_result.push_back(ring.Fit(r.cam_from_rig, r.angle_scale));
     }
