@@ -26,7 +26,7 @@ auto DispatchModel(CameraModelId id, F&& f) {
   switch (id) {
 #define ROVO_CAMERA_CASE(enum_id, Model, name) \
   case CameraModelId::enum_id:                 \
-    return f(Model{});
+    return f(Model{});  // NOLINT(bugprone-macro-parentheses): Model is a type name
     ROVO_CAMERA_MODELS(ROVO_CAMERA_CASE)
 #undef ROVO_CAMERA_CASE
   }
@@ -166,7 +166,7 @@ void CheckOcam(const Camera& camera, const std::string& what) {
 
 CameraModelId CameraModelFromName(const std::string& name) {
 #define ROVO_CAMERA_FROM_NAME(enum_id, Model, model_name) \
-  if (name == model_name) return CameraModelId::enum_id;
+  if (name == (model_name)) return CameraModelId::enum_id;
   ROVO_CAMERA_MODELS(ROVO_CAMERA_FROM_NAME)
 #undef ROVO_CAMERA_FROM_NAME
   throw std::invalid_argument("unknown camera model \"" + name +

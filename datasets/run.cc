@@ -159,7 +159,7 @@ std::vector<FrameRecord> ReadFramesCsv(const std::string& path) {
     f.mean_reproj_error_deg = csv.Double(r, 5);
     if (f.mean_reproj_error_deg < 0.0) csv.Fail(r, 5, "negative error");
     f.keyframe = csv.Bool(r, 6);
-    const std::string status = csv.Text(r, 7);
+    const std::string& status = csv.Text(r, 7);
     try {
       f.status = FrameStatusFromName(status);
     } catch (const std::invalid_argument&) {

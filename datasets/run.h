@@ -44,6 +44,7 @@ struct ExtrinsicsRecord {
   Rigid3 cam_from_rig;
 };
 
+// NOLINTNEXTLINE(bugprone-exception-escape): its implicit move moves nlohmann::json, which does not throw.
 struct RunData {
   Trajectory trajectory;
   std::vector<FrameRecord> frames;

@@ -42,7 +42,7 @@ UmeyamaResult AlignUmeyama(const std::vector<Eigen::Vector3d>& src, const std::v
 
   // Degeneracy: the spread of src must span at least a plane. Eigenvalues ascending.
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov_src);
-  const Eigen::Vector3d lambda = eig.eigenvalues();
+  const Eigen::Vector3d& lambda = eig.eigenvalues();
   const double largest = lambda(2);
   if (!(largest > 0.0) || lambda(1) <= 1e-12 * largest) {
     std::ostringstream msg;

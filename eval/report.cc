@@ -241,6 +241,7 @@ static void WriteReportFiles(const std::string& dataset_dir, const DatasetInfo& 
   WriteFileAtomic((fs::path(out_dir) / "summary.csv").string(), summary);
 
   std::vector<RunMetrics> metrics;
+  metrics.reserve(evaluations.size());
   for (const RunEvaluation& e : evaluations) metrics.push_back(e.metrics);
   const std::string title = "rovo eval: " + (info.preset.empty() ? dataset_dir : info.preset);
   const std::string table = RunTableMarkdown(metrics);

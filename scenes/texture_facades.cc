@@ -217,9 +217,10 @@ Texture MakeStorefrontTexture(uint64_t seed, int index) {
         c.Rect(lx, by0 + 8, lx + lw, by0 + 12, ink);
         c.Rect(lx + lw / 2 - 2, by0 + 8, lx + lw / 2 + 2, by0 + 8 + lh, ink);
       } else {
-        c.Line(static_cast<float>(lx), static_cast<float>(by0 + 8 + lh), static_cast<float>(lx + lw / 2),
+        const int mid_x = lx + lw / 2;  // whole pixels
+        c.Line(static_cast<float>(lx), static_cast<float>(by0 + 8 + lh), static_cast<float>(mid_x),
                static_cast<float>(by0 + 8), 2.0f, ink, 1.0f);
-        c.Line(static_cast<float>(lx + lw / 2), static_cast<float>(by0 + 8), static_cast<float>(lx + lw),
+        c.Line(static_cast<float>(mid_x), static_cast<float>(by0 + 8), static_cast<float>(lx + lw),
                static_cast<float>(by0 + 8 + lh), 2.0f, ink, 1.0f);
       }
       lx += lw + rng.UniformInt(4, 9);

@@ -129,7 +129,7 @@ std::vector<Eigen::Vector3d> DepthSolutions(const P3PEquations& e, const Eigen::
                                             const Eigen::Matrix3d& other) {
   std::vector<Eigen::Vector3d> lambdas;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(d0);
-  const Eigen::Vector3d sig = eig.eigenvalues();
+  const Eigen::Vector3d& sig = eig.eigenvalues();
   int k0 = 0;  // the (numerically) zero eigenvalue
   for (int k = 1; k < 3; ++k) {
     if (std::abs(sig(k)) < std::abs(sig(k0))) k0 = k;

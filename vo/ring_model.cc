@@ -463,6 +463,7 @@ double MedianResidualDeg(const OverlapPair& p, const std::vector<int>& indices, 
   if (indices.empty()) return -1.0;
   const Eigen::Vector3d baseline_in_rig = PairBaselineInRig(p, rig);
   std::vector<double> residuals;
+  residuals.reserve(indices.size());
   for (int i : indices) residuals.push_back(RingResidual(p, i, baseline_in_rig, model));
   std::nth_element(residuals.begin(), residuals.begin() + residuals.size() / 2, residuals.end());
   return std::asin(std::min(1.0, residuals[residuals.size() / 2])) / kDeg;

@@ -110,14 +110,14 @@ float IntensityCentroidAngleDeg(const cv::Mat& image, cv::Point2f px) {
     if (inside) {
       for (int dx = -half; dx <= half; ++dx) {
         row_sum += row[cx + dx];
-        row_moment += dx * row[cx + dx];
+        row_moment += static_cast<int64_t>(dx) * row[cx + dx];
       }
     } else {
       for (int dx = -half; dx <= half; ++dx) {
         const int x = cx + dx;
         if (x < 0 || x >= image.cols) continue;
         row_sum += row[x];
-        row_moment += dx * row[x];
+        row_moment += static_cast<int64_t>(dx) * row[x];
       }
     }
     m10 += row_moment;

@@ -52,6 +52,7 @@ void AddEvalCommand(CLI::App& root) {
     options.trajectory_format = args->format;
     const std::vector<RunEvaluation> evaluations = EvaluateAndReport(args->dataset, args->runs, args->out, options);
     std::vector<RunMetrics> metrics;
+    metrics.reserve(evaluations.size());
     for (const RunEvaluation& e : evaluations) metrics.push_back(e.metrics);
     std::printf("%s\n%s\nReport: %s\n", RunTableMarkdown(metrics).c_str(), MetricsLegendMarkdown().c_str(),
                 args->out.c_str());

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -18,7 +19,7 @@ void ProgressPrinter::Report(const ProgressUpdate& u) {
   char line[256];
   if (tty_) {
     const int width = 28;
-    const int filled = static_cast<int>(frac * width + 0.5);
+    const int filled = static_cast<int>(std::lround(frac * width));
     std::string bar(static_cast<size_t>(filled), '#');
     bar.resize(width, '.');
     std::snprintf(line, sizeof(line), "\r%s [%s] %lld/%lld %s  %.2f %s/s  ETA %.0fs   ", u.label.c_str(), bar.c_str(),

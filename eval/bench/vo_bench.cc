@@ -33,6 +33,7 @@ double MachineReferenceWarpMs(int cores) {
   for (int k = 0; k < 40; ++k) {
     const auto start = std::chrono::steady_clock::now();
     std::vector<std::thread> workers;
+    workers.reserve(static_cast<size_t>(cores));
     for (int c = 0; c < cores; ++c) workers.emplace_back([&, c] { projection.Warp(image, &warped[c]); });
     for (std::thread& w : workers) w.join();
     const double round_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

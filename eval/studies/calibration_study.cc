@@ -347,6 +347,7 @@ CalibrationStudyResult RunCalibrationStudy(const CalibrationStudyOptions& option
   }
   if (!o.fit_frames.empty()) {
     std::vector<FitCalibration> converged;
+    converged.reserve(agreeing.size());
     for (const CalibrationDraw* d : agreeing) converged.push_back({d->startup_cam_from_rig, d->lens_angle_scale});
     result.overlap_fit = FitOverlaps(o.dataset_dir, info, o.fit_frames, converged);
   }
