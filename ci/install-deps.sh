@@ -4,7 +4,7 @@
 set -euo pipefail
 
 PACKAGES=(
-  build-essential cmake ninja-build pkg-config git ccache
+  build-essential cmake ninja-build pkg-config git ccache clang-format clang-tidy
   libembree-dev libtbb-dev
   libopenimageio-dev openimageio-tools
   libopencv-dev
