@@ -49,7 +49,8 @@ void AddBenchCommands(CommandTree& tree) {
       "with a machine reference taken before and after the run (full-size hybrid warps, one per core at once); "
       "compare speeds only between runs whose references agree");
   AddVoRunOptions(bench, bench_args.get());
-  bench->add_option("--out", bench_args->options.io.out_dir, "Run folder to write (default: DATASET/../bench_vo_run)");
+  bench->add_option("--out", bench_args->options.io.out_dir,
+                    "Run folder to write (default: DATASET_bench_vo_run, beside the dataset)");
   bench->add_flag("--preload", bench_args->options.io.preload,
                   "Decode every frame's images before timing (a live rig delivers decoded images; PNG decoding costs "
                   "about 30 CPU-ms per full-size view). Keeps all frames in memory: use --frames");
