@@ -69,11 +69,12 @@ StreetFacade MakeStreetFacade(const BuildingPlan& p, const FacadeLayout& fl) {
   auto d_of_px = [&](double x) { return x * f.texel - p.u_offset; };
   const int tile_first = static_cast<int>(std::floor(p.u_offset / kFacadeTileMetres)) - 1;
   const int tile_last = static_cast<int>(std::ceil((p.u_offset + f.length) / kFacadeTileMetres)) + 1;
+  const int window_margin_px = (f.bay_px - f.win_w_px) / 2;  // whole pixels, as the texture draws it
   for (int t = tile_first; t <= tile_last; ++t)
     for (int k = 0; k < fl.bays; ++k) {
       const double x0 = 1024.0 * t + k * f.bay_px;
       f.bay_edges.push_back(d_of_px(x0));
-      f.window_centres.push_back(d_of_px(x0 + (f.bay_px - f.win_w_px) / 2 + 0.5 * f.win_w_px));
+      f.window_centres.push_back(d_of_px(x0 + window_margin_px + 0.5 * f.win_w_px));
     }
   f.top = p.height;
   return f;

@@ -388,6 +388,7 @@ std::vector<InterviewMatch> MatchViews(const PairGeometry& pair, const MatchView
     std::sort(b_order.begin(), b_order.end(), [&](int x, int y) { return yb[x] < yb[y]; });
   }
   std::vector<double> b_sorted_y;
+  b_sorted_y.reserve(b_order.size());
   for (int j : b_order) b_sorted_y.push_back(options.use_y_distance ? yb[j] : 0.0);
 
   std::vector<Best> best_a(na), best_b(nb);
