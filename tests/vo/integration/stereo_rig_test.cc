@@ -54,8 +54,7 @@ TEST(StereoRig, RendersRingAndForwardPairAndTheVoRunsOnTheRing) {
   for (size_t i = 0; i < run.trajectory.size(); ++i) {
     EXPECT_LT((run.trajectory[i].world_from_rig.translation - gt[i].world_from_rig.translation).norm(), 0.1) << i;
   }
-  // Explicitly with every camera the ring's VO would need the narrow lenses too: refused clearly or run;
-  // a camera list without camera 0 is refused before any frame.
+  // A camera list without camera 0 (the gauge) is refused before any frame, naming the flag.
   EXPECT_NE(RunCommand(std::string(ROVO_BINARY) + " vo " + dataset + " --extrinsics gt --cameras 1,2 --quiet --out " +
                        (root / "bad").string() + " 2> " + (root / "bad.log").string()),
             0);
