@@ -85,11 +85,11 @@ OpticsSettings OpticsProfile(const std::string& name) {
   // A 220-degree M12 fisheye on a ~3 um-pixel sensor; render/README.md ("Optics") gives the sources and
   // which values are fitted to the real frames of ../shared/data/itbt_real.
   s.enabled = true;
-  s.mtf50_centre = 0.25;
-  s.mtf50_rim = 0.15;
+  s.mtf50_centre = 0.35;
+  s.mtf50_rim = 0.20;
   s.mtf50_spread = 0.05;
   s.falloff_angle_scale = 0.30;
-  s.rim_illumination = 0.60;
+  s.rim_illumination = 0.40;
   s.lateral_ca_red = 0.002;
   s.lateral_ca_blue = -0.002;
   s.veiling_glare = 0.02;

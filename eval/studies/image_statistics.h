@@ -24,7 +24,7 @@
 namespace rovo {
 
 struct ImageStatisticsOptions {
-  int crop = 512;                 // side of the central crop of the spectrum, pixels (even, <= the short side)
+  int crop = 256;                 // side of the central crop of the spectrum, pixels (even, <= the short side)
   double circle_fraction = 0.47;  // valid circle of the noise estimate, fraction of the short side
   double ring_inner = 0.40;       // rim ring, fraction of the short side
   double ring_outer = 0.47;
