@@ -168,6 +168,8 @@ DatasetInfo ParseDatasetJson(JsonChecker& check, const json& root) {
     info.sensor = ParseSensor(check, root["sensor"], "/sensor", info.rig.NumCameras());
   if (root.is_object() && root.contains("timing"))
     info.timing = ParseTiming(check, root["timing"], "/timing", info.rig.NumCameras(), info.sensor.has_value());
+  if (root.is_object() && root.contains("optics"))
+    info.optics = ParseOpticsRecord(check, root["optics"], "/optics", info.rig.NumCameras());
   if (const json* perturbed = check.Member(root, "", "perturbed")) {
     if (!perturbed->is_array()) {
       check.Issue("/perturbed", "expected an array of perturbed extrinsic sets, found " + TypeName(*perturbed));
@@ -248,6 +250,7 @@ void WriteDatasetInfo(const std::string& dir, const DatasetInfo& info) {
   root["perturbed"] = perturbed;
   if (info.sensor) root["sensor"] = SensorJson(*info.sensor);
   if (info.timing) root["timing"] = TimingJson(*info.timing);
+  if (info.optics) root["optics"] = OpticsRecordJson(*info.optics);
   EnsureWritableDir(dir);
   WriteJsonFileAtomic(DatasetJsonPath(dir), root);
 }

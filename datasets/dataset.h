@@ -9,6 +9,7 @@
 
 #include "datasets/dataset_validate.h"
 #include "datasets/exposure_csv.h"
+#include "datasets/optics_record.h"
 #include "datasets/rig.h"
 #include "datasets/rig_json.h"
 #include "datasets/trajectory.h"
@@ -80,6 +81,8 @@ struct DatasetInfo {
   std::optional<SensorRecord> sensor;
   // Rendered with exposure timing effects (trigger offsets, motion blur, rolling shutter).
   std::optional<TimingRecord> timing;
+  // Rendered with the lens model of image quality (blur, vignetting, colour fringes, glare).
+  std::optional<OpticsRecord> optics;
 };
 
 // Paths inside a dataset folder.

@@ -160,6 +160,8 @@ void CheckExistingDataset(const std::string& out_dir, const DatasetInfo& info) {
     differ("sensor");
   if (old.timing.has_value() != info.timing.has_value() || (old.timing && *old.timing != *info.timing))
     differ("timing");
+  if (old.optics.has_value() != info.optics.has_value() || (old.optics && *old.optics != *info.optics))
+    differ("optics");
   if (old.rig.NumCameras() != info.rig.NumCameras()) differ("rig/cameras");
   for (int c = 0; c < info.rig.NumCameras(); ++c) {
     const Camera& a = old.rig.cameras[c].camera;
@@ -245,6 +247,11 @@ void CheckRenderOptions(const RenderOptions& options) {
   if (!(options.vignetting >= 0.0f && options.vignetting <= 1.0f))
     throw std::invalid_argument("--vignetting must be in [0, 1]");
   options.sensor.Check();
+  options.optics.Check();
+  if (options.optics.enabled && !options.sensor.enabled)
+    throw std::invalid_argument(
+        "--optics " + options.optics.profile +
+        ": the lens model works on the sensor model's linear image; add --sensor (or --realistic)");
 }
 
 // The scene has a trajectory and every dynamic object has one pose per trajectory frame.
@@ -266,8 +273,21 @@ struct SensorPlan {
   std::vector<std::vector<double>> meter;
   std::vector<std::vector<CameraExposure>> exposure;
   std::vector<double> trigger_offset_ms;  // per camera (timing; empty when timing is off)
+  std::vector<double> mtf50_factor;       // per camera (optics; empty when the lens is ideal)
   Trajectory groundtruth;                 // the dataset's rig poses, which timing interpolates
 };
+
+// The lens's relative illumination (render/optics.h) on a linear render of `rays`' camera.
+void ApplyIllumination(const OpticsSettings& optics, const CameraRays& rays, std::vector<float>* linear) {
+  const double theta_max = rays.camera.max_fov_deg * M_PI / 360.0;
+  for (size_t i = 0; i < rays.valid.size(); ++i) {
+    if (!rays.valid[i]) continue;
+    const Eigen::Vector3f& b = rays.bearing[i];
+    const auto e = static_cast<float>(
+        RelativeIllumination(optics, std::atan2(std::hypot(b.x(), b.y()), static_cast<double>(b.z())), theta_max));
+    for (int k = 0; k < 3; ++k) (*linear)[i * 3 + k] *= e;
+  }
+}
 
 // The auto-exposure meter of dataset frames [0, count) (trajectory frames begin + f): per camera a
 // 1-spp linear render with the sun, sensor.meter_width pixels wide (at most the image width), and
@@ -300,6 +320,7 @@ std::vector<std::vector<double>> MeterFrames(const RenderOptions& options, const
       tracer.SetFrame(begin + f);
       for (int c = 0; c < rig.NumCameras(); ++c) {
         tracer.Render(rays[c], world_from_rig * rig.cameras[c].cam_from_rig.Inverse(), settings, &image);
+        if (options.optics.enabled) ApplyIllumination(options.optics, rays[c], &image.linear);
         meter[f][c] = MeterLuminance(image.linear, rays[c].bearing, rays[c].valid, options.sensor.ae_target);
       }
     });
@@ -309,11 +330,13 @@ std::vector<std::vector<double>> MeterFrames(const RenderOptions& options, const
   return meter;
 }
 
-// Sensitivities, meter and exposure schedule of a render with the sensor model (else empty).
+// Sensitivities, meter and exposure schedule of a render with the sensor model (else empty), and the
+// cameras' MTF50 factors with the lens model.
 SensorPlan PlanSensor(const RenderOptions& options, const Scene& scene, const Rig& rig, int begin, int count,
                       tbb::task_arena& arena, Tracer& tracer) {
   SensorPlan plan;
   if (!options.sensor.enabled) return plan;
+  if (options.optics.enabled) plan.mtf50_factor = CameraMtf50Factors(options.optics, rig.NumCameras(), options.seed);
   plan.sensitivity = CameraSensitivities(options.sensor, rig.NumCameras(), options.seed);
   plan.meter = MeterFrames(options, scene, rig, begin, count, arena, tracer);
   plan.exposure = ExposureSchedule(options.sensor, plan.meter, scene.frame_rate);
@@ -339,6 +362,7 @@ DatasetInfo MakeDatasetInfo(const RenderOptions& options, const Scene& scene, co
   info.has_masks = options.masks;
   if (options.sensor.enabled) info.sensor = MakeSensorRecord(options.sensor, plan.sensitivity);
   if (options.timing.Enabled()) info.timing = MakeTimingRecord(options.timing, plan.trigger_offset_ms);
+  if (options.optics.enabled) info.optics = MakeOpticsRecord(options.optics, plan.mtf50_factor);
   return info;
 }
 
@@ -417,7 +441,8 @@ void CheckTimingWindows(const RenderOptions& options, const Scene& scene, int be
 // window (the scene's motion), each camera at its own times (the rig from the dataset's poses).
 void RenderTimedFrame(const RenderOptions& options, const Rig& rig, int traj_frame, int f, const SensorPlan& plan,
                       const std::vector<CameraRays>& rays, const ShadeSettings& settings, Tracer& tracer,
-                      std::vector<float>* linear, const SensorPipeline* pipeline, FrameJob* job) {
+                      std::vector<float>* linear, const SensorPipeline* pipeline, const std::vector<LensOptics>& lenses,
+                      FrameJob* job) {
   const std::vector<double> shutter = ShutterMs(options.timing, plan, f, rig.NumCameras());
   const double h = HalfWindowSeconds(plan.trigger_offset_ms, options.timing.rolling_shutter_ms, shutter);
   tracer.SetFrameWindow(traj_frame, h);
@@ -430,6 +455,7 @@ void RenderTimedFrame(const RenderOptions& options, const Rig& rig, int traj_fra
     if (pipeline) image.linear.swap(*linear);
     tracer.Render(rays[c], world_from_cam, settings, &image, &motion);
     if (!pipeline) continue;
+    if (!lenses.empty()) lenses[c].Apply(&image.linear);
     pipeline->Apply(image.linear, rays[c].valid, plan.exposure[f][c], plan.sensitivity[c],
                     SensorNoiseSeed(options.seed, f, c), options.sensor.grayscale ? &image.gray : &image.rgb);
     image.linear.swap(*linear);
@@ -459,6 +485,14 @@ void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& r
   settings.sun_aureole = sensor;
   std::optional<SensorPipeline> pipeline;
   if (sensor) pipeline.emplace(options.sensor);
+  std::vector<LensOptics> lenses;
+  if (options.optics.enabled) {
+    arena.execute([&] {
+      for (int c = 0; c < rig.NumCameras(); ++c)
+        lenses.emplace_back(options.optics, rig.cameras[c].camera, rays[c].bearing, rays[c].valid,
+                            plan.mtf50_factor[c]);
+    });
+  }
   std::vector<float> linear;  // reused between images
 
   Progress progress("render " + options.out_dir, static_cast<int64_t>(todo.size()), "frames", options.quiet);
@@ -473,7 +507,7 @@ void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& r
       arena.execute([&] {
         if (options.timing.Enabled()) {
           RenderTimedFrame(options, rig, traj_frame, f, plan, rays, settings, tracer, &linear,
-                           pipeline ? &*pipeline : nullptr, &job);
+                           pipeline ? &*pipeline : nullptr, lenses, &job);
           return;
         }
         tracer.SetFrame(traj_frame);
@@ -483,6 +517,7 @@ void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& r
           if (sensor) image.linear.swap(linear);
           tracer.Render(rays[c], world_from_cam, settings, &image);
           if (!sensor) continue;
+          if (!lenses.empty()) lenses[c].Apply(&image.linear);
           pipeline->Apply(image.linear, rays[c].valid, plan.exposure[f][c], plan.sensitivity[c],
                           SensorNoiseSeed(options.seed, f, c), options.sensor.grayscale ? &image.gray : &image.rgb);
           image.linear.swap(linear);

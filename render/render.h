@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "datasets/rig.h"
+#include "render/optics.h"
 #include "render/sensor.h"
 #include "render/timing.h"
 #include "scenes/scene.h"
@@ -32,6 +33,8 @@ struct RenderOptions {
   float vignetting = 0.0f;  // optional vignetting: gain 1 - v * (theta / theta_max)^2 (0 = off)
   // The physical sensor model (render/sensor.h); off by default (the scene's exposure and sRGB).
   SensorSettings sensor;
+  // The lens model of image quality (render/optics.h); off by default (an ideal lens). Needs the sensor model.
+  OpticsSettings optics;
   // Exposure timing (render/timing.h): trigger offsets, motion blur, rolling shutter; off by default.
   TimingSettings timing;
 };

@@ -105,11 +105,55 @@ struct SensorArgs {
   }
 };
 
+// The lens options of `rovo render` (render/optics.h); applied by Resolve() on top of --optics.
+struct OpticsArgs {
+  std::string profile = "off";
+  OpticsOverrides overrides;
+  std::vector<double> lateral_ca;
+  CLI::Option* o_profile = nullptr;
+
+  void Add(CLI::App* cmd) {
+    const std::string g = "Lens optics (render/optics.h, datasets/FORMAT.md section Optics; off by default)";
+    const OpticsSettings r = OpticsProfile("realistic");
+    char d[512];
+    std::snprintf(d, sizeof(d),
+                  "off | realistic (a 220-degree fisheye: Gaussian PSF of MTF50 %g cycles/px on the axis, %g at the "
+                  "rim; cos^4(%g theta) fall-off times %g relative illumination at the rim; lateral colour %+g/%+g; "
+                  "%g veiling glare); needs the sensor model",
+                  r.mtf50_centre, r.mtf50_rim, r.falloff_angle_scale, r.rim_illumination, r.lateral_ca_red,
+                  r.lateral_ca_blue, r.veiling_glare);
+    o_profile = cmd->add_option("--optics", profile, d)->check(CLI::IsMember({"off", "realistic"}))->group(g);
+    OpticsOverrides& o = overrides;
+    cmd->add_option("--mtf50-centre", o.mtf50_centre, "MTF50 on the optical axis, cycles/pixel (0: no blur)")->group(g);
+    cmd->add_option("--mtf50-rim", o.mtf50_rim, "MTF50 at the edge of the field of view, cycles/pixel")->group(g);
+    cmd->add_option("--mtf50-spread", o.mtf50_spread, "Std. dev. of ln(per-camera MTF50 factor), seeded")->group(g);
+    cmd->add_option("--falloff-angle-scale", o.falloff_angle_scale, "k of the natural fall-off cos^4(k theta)")
+        ->group(g);
+    cmd->add_option("--rim-illumination", o.rim_illumination,
+                    "Relative illumination at the edge of the field of view besides cos^4, (0, 1]")
+        ->group(g);
+    cmd->add_option("--lateral-ca", lateral_ca, "Red,blue magnification minus 1 relative to green, e.g. 0.002,-0.002")
+        ->delimiter(',')
+        ->expected(2)
+        ->group(g);
+    cmd->add_option("--veiling-glare", o.veiling_glare, "Fraction of the mean image irradiance added to every pixel")
+        ->group(g);
+  }
+  OpticsSettings Resolve() {
+    if (lateral_ca.size() == 2) {
+      overrides.lateral_ca_red = lateral_ca[0];
+      overrides.lateral_ca_blue = lateral_ca[1];
+    }
+    return MakeOpticsSettings(profile, overrides);
+  }
+};
+
 // `--realistic`: the realistic sensor and timing (RealisticTiming) where no option of the command
 // line sets them.
-void ApplyRealisticProfile(const CLI::App& cmd, SensorArgs* sensor, TimingSettings* timing) {
+void ApplyRealisticProfile(const CLI::App& cmd, SensorArgs* sensor, OpticsArgs* optics, TimingSettings* timing) {
   const TimingSettings realistic = RealisticTiming();
   if (sensor->o_profile->count() == 0) sensor->profile = "realistic";
+  if (optics->o_profile->count() == 0) optics->profile = "realistic";
   if (cmd.count("--shutter-ms") == 0 && cmd.count("--motion-blur") == 0)
     timing->shutter_from_sensor = realistic.shutter_from_sensor;
   if (cmd.count("--rolling-shutter-ms") == 0) timing->rolling_shutter_ms = realistic.rolling_shutter_ms;
@@ -150,6 +194,7 @@ void AddRenderCommand(CLI::App& root) {
     RenderOptions options;
     std::string frames, shard;
     SensorArgs sensor;
+    OpticsArgs optics;
     bool realistic = false;
   };
   auto args = std::make_shared<Args>();
@@ -184,6 +229,7 @@ void AddRenderCommand(CLI::App& root) {
                   "Image size relative to the rig (same lens); default 1, or the preset's quick scale with --quick");
   cmd->add_option("--vignetting", args->options.vignetting, "Vignetting strength in [0, 1] (default 0)");
   args->sensor.Add(cmd);
+  args->optics.Add(cmd);
   AddTimingOptions(cmd, &args->options.timing);
   {
     const TimingSettings realistic = RealisticTiming();
@@ -192,7 +238,7 @@ void AddRenderCommand(CLI::App& root) {
                   realistic.rolling_shutter_ms, realistic.trigger_offset_std_ms);
     cmd->add_flag("--realistic", args->realistic,
                   std::string("The realistic profile of an automotive fisheye camera (render/README.md): --sensor "
-                              "realistic --motion-blur ") +
+                              "realistic --optics realistic --motion-blur ") +
                       values + "; options given beside it override these");
   }
   cmd->add_flag("--quiet", args->options.quiet, "No progress output");
@@ -200,8 +246,9 @@ void AddRenderCommand(CLI::App& root) {
     RenderOptions options = args->options;
     if (!args->frames.empty()) ParseFrameRange(args->frames, &options.frame_begin, &options.frame_end);
     if (!args->shard.empty()) ParseShard(args->shard, &options.shard_index, &options.shard_count);
-    if (args->realistic) ApplyRealisticProfile(*cmd, &args->sensor, &options.timing);
+    if (args->realistic) ApplyRealisticProfile(*cmd, &args->sensor, &args->optics, &options.timing);
     options.sensor = args->sensor.Resolve();
+    options.optics = args->optics.Resolve();
     const RenderSummary s = RenderDataset(options);
     std::printf("rendered %d frames, skipped %d complete, %d in this shard, %.1f s\n%s\n", s.frames_rendered,
                 s.frames_skipped, s.frames_total, s.seconds, s.rig.c_str());

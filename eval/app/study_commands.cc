@@ -5,6 +5,7 @@
 
 #include "eval/app/commands.h"
 #include "eval/studies/calibration_study.h"
+#include "eval/studies/image_statistics.h"
 #include "eval/studies/projection_study.h"
 
 namespace rovo {
@@ -108,11 +109,41 @@ void AddCalibrationStudyCommand(CLI::App* study) {
   });
 }
 
+void AddImageStatisticsCommand(CLI::App* study) {
+  auto options = std::make_shared<ImageStatisticsOptions>();
+  auto inputs = std::make_shared<std::vector<std::string>>();
+  CLI::App* cmd = study->add_subcommand(
+      "images",
+      "Image-quality statistics of fisheye frames (eval/studies/image_statistics.h): share of spectral power above "
+      "1/4 Nyquist and spectrum slope of a Hann-windowed central crop, Immerkaer's noise sigma over the valid "
+      "circle, rim/centre brightness; a Markdown table, one row per image and the mean, min and max");
+  cmd->add_option("inputs", *inputs, "Image files or folders (searched recursively for .png/.jpg)")->required();
+  cmd->add_option("--crop", options->crop, "Side of the central crop of the spectrum, pixels")->capture_default_str();
+  cmd->add_option("--circle", options->circle_fraction,
+                  "Valid circle of the noise estimate, fraction of the short side")
+      ->capture_default_str();
+  cmd->add_option("--ring-inner", options->ring_inner, "Rim ring, inner radius, fraction of the short side")
+      ->capture_default_str();
+  cmd->add_option("--ring-outer", options->ring_outer, "Rim ring, outer radius, fraction of the short side")
+      ->capture_default_str();
+  cmd->add_option("--centre", options->centre_fraction, "Central disc radius, fraction of the short side")
+      ->capture_default_str();
+  cmd->callback([options, inputs] {
+    std::vector<std::string> files;
+    for (const std::string& in : *inputs) {
+      const std::vector<std::string> found = ListImageFiles(in);
+      files.insert(files.end(), found.begin(), found.end());
+    }
+    std::printf("%s", ImageStatisticsTable(files, ComputeImageFileStatistics(files, *options)).c_str());
+  });
+}
+
 }  // namespace
 
 void AddStudyCommands(CommandTree& tree) {
   AddProjectionStudyCommand(tree.study);
   AddCalibrationStudyCommand(tree.study);
+  AddImageStatisticsCommand(tree.study);
 }
 
 }  // namespace rovo

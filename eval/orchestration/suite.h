@@ -38,11 +38,13 @@ namespace rovo {
 //   ideal      --sensor ideal (HDR sun, auto-exposure and gain, no noise)
 //   sensor     --sensor realistic (noise, 12-bit ADC, BT.709 response, per-camera sensitivity spread)
 //   gray       the realistic sensor, grayscale
+//   optics     the realistic sensor behind the realistic lens (render/optics.h: blur widening towards
+//              the rim, vignetting, lateral colour, veiling glare)
 //   blur       motion blur over a fixed 10 ms shutter (8 samples per pixel)
 //   rolling    rolling shutter, 30 ms readout
 //   trigger    per-camera trigger offsets, standard deviation 1 ms
-//   realistic  the realistic profile, `rovo render --realistic`: the realistic sensor, motion blur over
-//              its exposure, 20 ms rolling shutter, trigger offsets of 0.5 ms standard deviation
+//   realistic  the realistic profile, `rovo render --realistic`: the realistic sensor and lens, motion
+//              blur over its exposure, 20 ms rolling shutter, trigger offsets of 0.5 ms standard deviation
 struct SuiteEntry {
   std::string preset;   // a scene preset (scenes/city.h)
   std::string variant;  // "" or one of SuiteVariantNames()

@@ -96,7 +96,8 @@ SuiteOptions SuiteOptionsFromJson(const nlohmann::json& j, const std::string& so
 }
 
 const std::vector<std::string>& SuiteVariantNames() {
-  static const std::vector<std::string> names = {"ideal", "sensor", "gray", "blur", "rolling", "trigger", "realistic"};
+  static const std::vector<std::string> names = {"ideal", "sensor",  "gray",    "optics",
+                                                 "blur",  "rolling", "trigger", "realistic"};
   return names;
 }
 

@@ -106,13 +106,14 @@ bool DatasetComplete(const std::string& dataset_dir, int max_frames, const Rende
 // The render settings of a variant (ParseSuiteEntry), on top of the preset's.
 void ApplySuiteVariant(const std::string& variant, RenderOptions* render) {
   if (variant.empty()) return;
-  const bool sensor = variant == "sensor" || variant == "gray" || variant == "realistic";
+  const bool sensor = variant == "sensor" || variant == "gray" || variant == "optics" || variant == "realistic";
   if (variant == "ideal") render->sensor = MakeSensorSettings("ideal", {});
   if (sensor) {
     SensorOverrides overrides;
     if (variant == "gray") overrides.grayscale = true;
     render->sensor = MakeSensorSettings("realistic", overrides);
   }
+  if (variant == "optics" || variant == "realistic") render->optics = OpticsProfile("realistic");
   if (variant == "realistic") render->timing = RealisticTiming();
   if (variant == "blur") render->timing.shutter_ms = 10.0;
   if (variant == "rolling") render->timing.rolling_shutter_ms = 30.0;
