@@ -248,3 +248,46 @@ TEST_F(RenderDatasetTest, SceneFolderRigJsonIsTheDefaultRig) {
 
 }  // namespace
 }  // namespace rovo
+
+namespace rovo {
+namespace {
+
+// --imu adds the IMU streams and records and changes no image; the exact stream agrees with the
+// continuous-time ground truth the validator rebuilds; the rig carries the mount only with an IMU.
+TEST_F(RenderDatasetTest, ImuAddsItsStreamsAndChangesNoImage) {
+  RenderOptions plain = Options("plain");
+  RenderDataset(plain);
+  RenderOptions with_imu = Options("imu");
+  with_imu.imu = true;
+  with_imu.imu_settings.noise_profile = "none";
+  with_imu.imu_settings.time_offset_s = 0.002;
+  RenderDataset(with_imu);
+  const auto a = Files(plain.out_dir), b = Files(with_imu.out_dir);
+  for (const auto& [path, content] : a) {
+    if (path == "dataset.json") continue;
+    ASSERT_TRUE(b.count(path)) << path;
+    EXPECT_EQ(content, b.at(path)) << path;
+  }
+  EXPECT_FALSE(ReadDatasetInfo(plain.out_dir).rig.imu_from_rig);
+  EXPECT_FALSE(fs::exists(ImuDataPath(plain.out_dir)));
+  const DatasetInfo info = ReadDatasetInfo(with_imu.out_dir);
+  ASSERT_TRUE(info.imu);
+  ASSERT_TRUE(info.rig.imu_from_rig);
+  EXPECT_EQ(info.imu->rate_hz, 200.0);
+  EXPECT_EQ(info.imu->noise_profile, "none");
+  const ImuStreams streams = ReadImuStreams(with_imu.out_dir);
+  EXPECT_EQ(static_cast<int>(streams.measured.size()), info.imu->sample_count);
+  EXPECT_DOUBLE_EQ(streams.measured.front().timestamp,
+                   ReadTum(GroundTruthPath(with_imu.out_dir)).front().timestamp + 0.002);
+  for (const ValidationIssue& issue : ValidateDataset(with_imu.out_dir))
+    ADD_FAILURE() << issue.file << " " << issue.field << ": " << issue.message;
+  // Bad settings fail before any output, naming the option.
+  RenderOptions bad = Options("bad");
+  bad.imu = true;
+  bad.imu_settings.rate_hz = -1.0;
+  ExpectFailsNaming(bad, "--imu-rate");
+  EXPECT_FALSE(fs::exists(bad.out_dir + "/dataset.json"));
+}
+
+}  // namespace
+}  // namespace rovo
