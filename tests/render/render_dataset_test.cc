@@ -1,8 +1,10 @@
 // RenderDataset on a small saved box scene: outputs, resume, shards, threads, bad input.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <utility>
 
 #include "datasets/dataset.h"
 #include "datasets/io.h"
@@ -287,6 +289,43 @@ TEST_F(RenderDatasetTest, ImuAddsItsStreamsAndChangesNoImage) {
   bad.imu_settings.rate_hz = -1.0;
   ExpectFailsNaming(bad, "--imu-rate");
   EXPECT_FALSE(fs::exists(bad.out_dir + "/dataset.json"));
+}
+
+// The command line: bad IMU settings fail naming the option and write nothing; the IMU options
+// set the record.
+TEST_F(RenderDatasetTest, CommandLineImuOptions) {
+  const std::string log = (root_ / "log.txt").string();
+  auto run = [&](const std::string& out, const std::string& args) {
+    const int status =
+        std::system((std::string(ROVO_BINARY) + " render --scene " + scene_dir_ + " --out " + (root_ / out).string() +
+                     " --rig omnimvs4 --scale 0.1 --spp 1 --frames 0:3 --quiet " + args + " > " + log + " 2>&1")
+                        .c_str());
+    return std::make_pair(status, ReadFile(log));
+  };
+  const std::pair<std::string, std::string> bad[] = {
+      {"--imu --imu-rate -200", "--imu-rate -200"},
+      {"--imu --imu-gyro-noise-density nan", "--imu-gyro-noise-density nan"},
+      {"--imu --imu-accel-random-walk -1", "--imu-accel-random-walk"},
+      {"--imu --imu-noise tactical", "--imu-noise `tactical`"},
+      {"--imu-rate 100", "--imu-rate: needs --imu"}};
+  for (const auto& [args, needle] : bad) {
+    const auto [status, text] = run("bad", args);
+    EXPECT_NE(status, 0) << args;
+    EXPECT_NE(text.find(needle), std::string::npos) << args << ": " << text;
+    EXPECT_FALSE(fs::exists(root_ / "bad")) << args;
+  }
+  const auto [status, text] = run(
+      "good", "--imu --imu-rate 400 --imu-gyro-noise-density 1e-3 --imu-accel-bias 0.1,0.2,0.3 --imu-time-offset-ms 5");
+  ASSERT_EQ(status, 0) << text;
+  const DatasetInfo info = ReadDatasetInfo((root_ / "good").string());
+  ASSERT_TRUE(info.imu);
+  EXPECT_EQ(info.imu->rate_hz, 400.0);
+  EXPECT_EQ(info.imu->noise_profile, "custom");
+  EXPECT_EQ(info.imu->noise.gyroscope_noise_density, 1e-3);
+  EXPECT_EQ(info.imu->noise.accelerometer_noise_density, 2e-3);  // the profile's
+  EXPECT_EQ(info.imu->noise.accelerometer_initial_bias, Eigen::Vector3d(0.1, 0.2, 0.3));
+  EXPECT_DOUBLE_EQ(info.imu->time_offset_s, 0.005);
+  EXPECT_EQ(info.imu->sample_count, 81);  // 0.2 s at 400 Hz
 }
 
 }  // namespace
