@@ -370,7 +370,16 @@ void PrepareOutput(const RenderOptions& options, const DatasetInfo& info, const 
     WriteExposureCsv(ExposurePath(options.out_dir),
                      MakeExposureRows(options.sensor, plan.exposure, plan.meter, plan.sensitivity, names));
   }
-  if (plan.imu) WriteImuStreams(options.out_dir, *plan.imu);
+  if (plan.imu) {
+    WriteImuStreams(options.out_dir, *plan.imu);
+  } else {
+    // A render without --imu into a folder rendered with it (resume): the IMU files go with the record.
+    std::error_code ec;
+    for (const std::string& path :
+         {ImuDataPath(options.out_dir), ImuExactPath(options.out_dir), ImuBiasPath(options.out_dir)})
+      fs::remove(path, ec);
+    fs::remove(fs::path(ImuDataPath(options.out_dir)).parent_path(), ec);  // only when empty
+  }
   WriteDatasetInfo(options.out_dir, info);
   for (const RigCamera& cam : info.rig.cameras) {
     PrepareDir(ImagePath(options.out_dir, cam.name, 0));

@@ -283,6 +283,15 @@ TEST_F(RenderDatasetTest, ImuAddsItsStreamsAndChangesNoImage) {
                    ReadTum(GroundTruthPath(with_imu.out_dir)).front().timestamp + 0.002);
   for (const ValidationIssue& issue : ValidateDataset(with_imu.out_dir))
     ADD_FAILURE() << issue.file << " " << issue.field << ": " << issue.message;
+  // Resuming the folder without --imu takes the IMU away with its files; with it again, brings it back.
+  RenderOptions resumed = with_imu;
+  resumed.imu = false;
+  RenderDataset(resumed);
+  EXPECT_FALSE(ReadDatasetInfo(with_imu.out_dir).imu);
+  EXPECT_FALSE(fs::exists(fs::path(ImuDataPath(with_imu.out_dir)).parent_path()));
+  EXPECT_TRUE(ValidateDataset(with_imu.out_dir).empty());
+  RenderDataset(with_imu);
+  EXPECT_EQ(ReadImuStreams(with_imu.out_dir).exact.size(), streams.exact.size());
   // Bad settings fail before any output, naming the option.
   RenderOptions bad = Options("bad");
   bad.imu = true;
