@@ -252,6 +252,7 @@ void CheckRenderOptions(const RenderOptions& options) {
     throw std::invalid_argument(
         "--optics " + options.optics.profile +
         ": the lens model works on the sensor model's linear image; add --sensor (or --realistic)");
+  if (options.imu) options.imu_settings.Check();
 }
 
 // The scene has a trajectory and every dynamic object has one pose per trajectory frame.
@@ -274,7 +275,10 @@ struct SensorPlan {
   std::vector<std::vector<CameraExposure>> exposure;
   std::vector<double> trigger_offset_ms;  // per camera (timing; empty when timing is off)
   std::vector<double> mtf50_factor;       // per camera (optics; empty when the lens is ideal)
-  Trajectory groundtruth;                 // the dataset's rig poses, which timing interpolates
+  // The dataset's continuous-time ground truth, which timing and the IMU sample (timing or IMU on).
+  std::optional<ContinuousTrajectory> rig_motion;
+  std::optional<ImuStreams> imu;  // the IMU's streams and record (--imu)
+  ImuRecord imu_record;
 };
 
 // The lens's relative illumination (render/optics.h) on a linear render of `rays`' camera.
@@ -363,6 +367,12 @@ DatasetInfo MakeDatasetInfo(const RenderOptions& options, const Scene& scene, co
   if (options.sensor.enabled) info.sensor = MakeSensorRecord(options.sensor, plan.sensitivity);
   if (options.timing.Enabled()) info.timing = MakeTimingRecord(options.timing, plan.trigger_offset_ms);
   if (options.optics.enabled) info.optics = MakeOpticsRecord(options.optics, plan.mtf50_factor);
+  // A dataset's rig carries the IMU mount exactly when the dataset has an IMU.
+  info.rig.imu_from_rig.reset();
+  if (plan.imu) {
+    info.rig.imu_from_rig = rig.imu_from_rig.value_or(PresetImuFromRig());
+    info.imu = plan.imu_record;
+  }
   return info;
 }
 
@@ -383,6 +393,16 @@ void PrepareOutput(const RenderOptions& options, const DatasetInfo& info, const 
     for (const RigCamera& cam : info.rig.cameras) names.push_back(cam.name);
     WriteExposureCsv(ExposurePath(options.out_dir),
                      MakeExposureRows(options.sensor, plan.exposure, plan.meter, plan.sensitivity, names));
+  }
+  if (plan.imu) {
+    WriteImuStreams(options.out_dir, *plan.imu);
+  } else {
+    // A render without --imu into a folder rendered with it (resume): the IMU files go with the record.
+    std::error_code ec;
+    for (const std::string& path :
+         {ImuDataPath(options.out_dir), ImuExactPath(options.out_dir), ImuBiasPath(options.out_dir)})
+      fs::remove(path, ec);
+    fs::remove(fs::path(ImuDataPath(options.out_dir)).parent_path(), ec);  // only when empty
   }
   WriteDatasetInfo(options.out_dir, info);
   for (const RigCamera& cam : info.rig.cameras) {
@@ -437,6 +457,27 @@ void CheckTimingWindows(const RenderOptions& options, const Scene& scene, int be
   }
 }
 
+// The continuous-time ground truth of the dataset's poses, the trigger offsets and the IMU streams
+// (timing or IMU on); throws naming the options when the poses cannot make one.
+void PlanMotion(const RenderOptions& options, const Scene& scene, const Rig& rig, const Trajectory& groundtruth,
+                int begin, SensorPlan* plan) {
+  if (!options.timing.Enabled() && !options.imu) return;
+  try {
+    plan->rig_motion.emplace(groundtruth);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(
+        std::string(options.imu ? "--imu" : "--shutter-ms/--rolling-shutter-ms/--trigger-offset") + ": " + e.what());
+  }
+  if (options.timing.Enabled()) {
+    plan->trigger_offset_ms = TriggerOffsetsMs(options.timing, rig.NumCameras(), options.seed);
+    CheckTimingWindows(options, scene, begin, static_cast<int>(groundtruth.size()), *plan, rig.NumCameras());
+  }
+  if (options.imu) {
+    plan->imu = SimulateImu(*plan->rig_motion, rig.imu_from_rig.value_or(PresetImuFromRig()), options.imu_settings,
+                            options.seed, &plan->imu_record);
+  }
+}
+
 // The images of one frame with timing (render/timing.h): the dynamic objects over the frame's
 // window (the scene's motion), each camera at its own times (the rig from the dataset's poses).
 void RenderTimedFrame(const RenderOptions& options, const Rig& rig, int traj_frame, int f, const SensorPlan& plan,
@@ -449,7 +490,7 @@ void RenderTimedFrame(const RenderOptions& options, const Rig& rig, int traj_fra
   for (int c = 0; c < rig.NumCameras(); ++c) {
     Rigid3 world_from_cam;
     const CameraMotion motion =
-        MakeCameraMotion(plan.groundtruth, f, rig.cameras[c].cam_from_rig, h > 0.0 ? h : 1.0, plan.trigger_offset_ms[c],
+        MakeCameraMotion(*plan.rig_motion, f, rig.cameras[c].cam_from_rig, h > 0.0 ? h : 1.0, plan.trigger_offset_ms[c],
                          shutter[c], options.timing.rolling_shutter_ms, rays[c].height, &world_from_cam);
     CameraImage& image = job->images[c];
     if (pipeline) image.linear.swap(*linear);
@@ -584,11 +625,7 @@ RenderSummary RenderDataset(const RenderOptions& options) {
   arena.execute([&] { tracer = std::make_unique<Tracer>(scene); });
   // The sensor model's exposure schedule covers every frame of the range (before any output).
   SensorPlan plan = PlanSensor(options, scene, rig, begin, count, arena, *tracer);
-  if (options.timing.Enabled()) {
-    plan.trigger_offset_ms = TriggerOffsetsMs(options.timing, rig.NumCameras(), options.seed);
-    plan.groundtruth = groundtruth;
-    CheckTimingWindows(options, scene, begin, count, plan, rig.NumCameras());
-  }
+  PlanMotion(options, scene, rig, groundtruth, begin, &plan);
   const int spp = options.spp > 0 ? options.spp : DefaultSpp(options.timing, plan.exposure);
   const DatasetInfo info = MakeDatasetInfo(options, scene, rig, count, plan);
 
