@@ -107,6 +107,10 @@ struct ImportReport {
 // calibration-perturbed-N.json beside the calibration.
 ImportReport ImportDataset(const std::string& in_dir, const ImportOptions& options);
 
+// Full FOV cone of an imported lens that does not state it: twice the widest angle from the axis of
+// any border pixel's bearing (within the model's valid set), so the whole image is usable.
+double ImageFovDeg(const Camera& lens);
+
 // Numbers for the YAML files of the exchange formats: full precision (%.17g), lists as [a, b, c].
 std::string YamlNumber(double value);
 std::string YamlList(const std::vector<double>& values);
