@@ -193,6 +193,16 @@ Rig RigFromBag(const BagContents& bag, const std::map<std::string, Rigid3>& root
       throw std::runtime_error(where + ": distortion_model: '" + ci.distortion_model + "' with " +
                                std::to_string(ci.d.size()) + " coefficients (rovo reads equidistant with 4)");
     }
+    if (ci.width < 1 || ci.width > 65536 || ci.height < 1 || ci.height > 65536) {
+      throw std::runtime_error(where + ": width, height: " + std::to_string(ci.width) + " x " +
+                               std::to_string(ci.height) + " is not an image size in [1, 65536]");
+    }
+    for (double v : ci.k) {
+      if (!std::isfinite(v)) throw std::runtime_error(where + ": k: not finite");
+    }
+    for (double v : ci.d) {
+      if (!std::isfinite(v)) throw std::runtime_error(where + ": d: not finite");
+    }
     RigCamera rc;
     rc.name = "cam" + std::to_string(k);
     const std::vector<double> params = {ci.k[0], ci.k[4], ci.k[2], ci.k[5], ci.d[0], ci.d[1], ci.d[2], ci.d[3]};
@@ -209,6 +219,20 @@ Rig RigFromBag(const BagContents& bag, const std::map<std::string, Rigid3>& root
   }
   rig.Check(what);
   return rig;
+}
+
+// world_from_rig at each odometry stamp (strictly increasing, unit-normable orientations).
+Trajectory GroundTruth(const std::vector<RosOdometry>& odometry, const std::string& what) {
+  Trajectory gt;
+  for (size_t i = 0; i < odometry.size(); ++i) {
+    const RosOdometry& o = odometry[i];
+    const std::string where = what + ": nav_msgs/msg/Odometry " + std::to_string(i) + ": ";
+    const double t = static_cast<double>(RosTimeToNs(o.header.stamp)) * 1e-9;
+    if (!gt.empty() && !(t > gt.back().timestamp)) throw std::runtime_error(where + "header.stamp: not increasing");
+    if (o.orientation.norm() < 1e-9) throw std::runtime_error(where + "pose.pose.orientation: zero quaternion");
+    gt.push_back({t, Rigid3(o.orientation, o.position)});
+  }
+  return gt;
 }
 
 }  // namespace
@@ -232,10 +256,7 @@ Ros2ImportReport ImportRos2Bag(const std::string& bag_path, const std::string& o
   if (frames == 0) throw std::runtime_error(path + ": " + bag.image_topics[0] + ": no images");
   info.frame_count = static_cast<int>(frames);
 
-  Trajectory gt;
-  for (const RosOdometry& o : bag.odometry) {
-    gt.push_back({static_cast<double>(RosTimeToNs(o.header.stamp)) * 1e-9, Rigid3(o.orientation, o.position)});
-  }
+  Trajectory gt = GroundTruth(bag.odometry, path);
   const bool gt_per_frame = gt.size() == frames;
   std::vector<double> times;
   for (size_t f = 0; f < frames; ++f) {
