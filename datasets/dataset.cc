@@ -168,6 +168,10 @@ DatasetInfo ParseDatasetJson(JsonChecker& check, const json& root) {
     info.sensor = ParseSensor(check, root["sensor"], "/sensor", info.rig.NumCameras());
   if (root.is_object() && root.contains("timing"))
     info.timing = ParseTiming(check, root["timing"], "/timing", info.rig.NumCameras(), info.sensor.has_value());
+  if (root.is_object() && root.contains("imu")) {
+    info.imu = ParseImuRecord(check, root["imu"], "/imu");
+    if (!info.rig.imu_from_rig) check.Issue("/rig/imu_from_rig", "missing field (dataset.json has /imu)");
+  }
   if (const json* perturbed = check.Member(root, "", "perturbed")) {
     if (!perturbed->is_array()) {
       check.Issue("/perturbed", "expected an array of perturbed extrinsic sets, found " + TypeName(*perturbed));
@@ -248,6 +252,11 @@ void WriteDatasetInfo(const std::string& dir, const DatasetInfo& info) {
   root["perturbed"] = perturbed;
   if (info.sensor) root["sensor"] = SensorJson(*info.sensor);
   if (info.timing) root["timing"] = TimingJson(*info.timing);
+  if (info.imu) {
+    if (!info.rig.imu_from_rig)
+      throw std::invalid_argument(DatasetJsonPath(dir) + ": /rig/imu_from_rig: missing (the dataset has an IMU)");
+    root["imu"] = ImuRecordToJson(*info.imu);
+  }
   EnsureWritableDir(dir);
   WriteJsonFileAtomic(DatasetJsonPath(dir), root);
 }

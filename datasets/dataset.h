@@ -1,6 +1,6 @@
 #pragma once
 // The on-disk dataset (datasets/FORMAT.md): dataset.json, camN/NNNNNN.png, groundtruth.tum,
-// optional depth/ and masks/.
+// optional depth/, masks/ and imu/.
 
 #include <cstdint>
 #include <optional>
@@ -9,6 +9,7 @@
 
 #include "datasets/dataset_validate.h"
 #include "datasets/exposure_csv.h"
+#include "datasets/imu.h"
 #include "datasets/rig.h"
 #include "datasets/rig_json.h"
 #include "datasets/trajectory.h"
@@ -80,6 +81,8 @@ struct DatasetInfo {
   std::optional<SensorRecord> sensor;
   // Rendered with exposure timing effects (trigger offsets, motion blur, rolling shutter).
   std::optional<TimingRecord> timing;
+  // Rendered with an IMU (datasets/imu.h): how its streams under imu/ were made.
+  std::optional<ImuRecord> imu;
 };
 
 // Paths inside a dataset folder.

@@ -199,6 +199,18 @@ void Rig::Check(const std::string& what) const {
     }
     if (std::abs(q.norm() - 1.0) > 1e-6) throw std::invalid_argument(where + ".cam_from_rig: non-unit quaternion");
   }
+  if (imu_from_rig) {
+    const Eigen::Quaterniond& q = imu_from_rig->rotation;
+    if (!q.coeffs().allFinite() || !imu_from_rig->translation.allFinite())
+      throw std::invalid_argument(what + ": imu_from_rig: NaN or Inf");
+    if (std::abs(q.norm() - 1.0) > 1e-6) throw std::invalid_argument(what + ": imu_from_rig: non-unit quaternion");
+  }
+}
+
+Rigid3 PresetImuFromRig() {
+  const Eigen::Quaterniond imu_from_rig_rotation(Eigen::AngleAxisd(-M_PI / 2.0, Eigen::Vector3d::UnitZ()));
+  const Eigen::Vector3d imu_in_rig(0.03, -0.02, -0.05);
+  return Rigid3(imu_from_rig_rotation, -(imu_from_rig_rotation * imu_in_rig));
 }
 
 std::vector<std::string> RigPresetNames() { return {"rovo4", "omnimvs4", "rovo4_real"}; }

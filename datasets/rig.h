@@ -4,6 +4,7 @@
 // other cameras are estimated relative to it (the paper's Fig. 8).
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,9 @@ struct RigCamera {
 
 struct Rig {
   std::vector<RigCamera> cameras;
+  // The IMU's mount (datasets/imu.h), present when the rig carries an IMU: x_in_imu = imu_from_rig *
+  // x_in_rig. The rig presets' IMU sits at PresetImuFromRig().
+  std::optional<Rigid3> imu_from_rig;
 
   int NumCameras() const { return static_cast<int>(cameras.size()); }
   // Rig with `scale` times the image size (intrinsics scaled accordingly), same lenses.
@@ -34,6 +38,12 @@ struct Rig {
 // "rovo4_real" (the paper lab's calibrated rig, imported from OmniMVS config.yaml).
 std::vector<std::string> RigPresetNames();
 Rig MakeRigPreset(const std::string& name);  // throws std::invalid_argument for an unknown name
+
+// The IMU mount of the rig presets (datasets/FORMAT.md, "IMU"): the IMU 3 cm forward, 2 cm right
+// and 5 cm below the rig origin, its x axis along the rig's y (left), y along the rig's -x
+// (backward), z up (a -90 deg yaw): neither the identity nor at a camera, so that a frame mix-up
+// shows in the data.
+Rigid3 PresetImuFromRig();
 
 // Mounting helpers (rig frame REP-103: x forward, y left, z up; camera frame OpenCV).
 // CamFromRigFromMount: a camera whose optical axis (+z) points at yaw (about rig +z, 0 = forward,

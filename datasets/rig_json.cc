@@ -149,6 +149,11 @@ Rig ParseRig(JsonChecker& check, const json& rig_json, const std::string& pointe
     }
     rig.cameras.push_back(rc);
   }
+  if (rig_json.contains("imu_from_rig")) {
+    bool ok = false;
+    const Rigid3 imu_from_rig = check.Transform(rig_json, pointer, "imu_from_rig", &ok);
+    if (ok) rig.imu_from_rig = imu_from_rig;
+  }
   return rig;
 }
 
@@ -161,7 +166,9 @@ json Rigid3ToJson(const Rigid3& b_from_a) {
 json RigToJson(const Rig& rig) {
   json cameras = json::array();
   for (const RigCamera& rc : rig.cameras) cameras.push_back(CameraJson(rc));
-  return json{{"cameras", cameras}};
+  json j{{"cameras", cameras}};
+  if (rig.imu_from_rig) j["imu_from_rig"] = Rigid3ToJson(*rig.imu_from_rig);
+  return j;
 }
 
 Rig RigFromJson(const json& rig_json, const std::string& file, const std::string& pointer) {
@@ -184,7 +191,9 @@ void WriteRigJson(const std::string& path, const Rig& rig, const std::string& so
   json root;
   root["schema_version"] = kRigSchemaVersion;
   root["source"] = source;
-  root["cameras"] = RigToJson(rig)["cameras"];
+  const json rig_json = RigToJson(rig);
+  root["cameras"] = rig_json["cameras"];
+  if (rig_json.contains("imu_from_rig")) root["imu_from_rig"] = rig_json["imu_from_rig"];
   WriteJsonFileAtomic(path, root);
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // Rig JSON (datasets/FORMAT.md), the same camera objects as dataset.json's /rig:
 //   {"cameras": [{"name", "model", "width", "height", "params", "max_fov_deg",
-//                 "cam_from_rig": {"rotation_xyzw": [x, y, z, w], "translation": [x, y, z]}}]}
+//                 "cam_from_rig": {"rotation_xyzw": [x, y, z, w], "translation": [x, y, z]}}],
+//    "imu_from_rig": {...}}   (optional: the rig's IMU mount, the same transform object)
 // A rig.json file adds "schema_version" and "source" at the top level.
 
 #include <nlohmann/json_fwd.hpp>
