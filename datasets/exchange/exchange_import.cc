@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "datasets/exchange/exchange.h"
+#include "datasets/exchange/exchange_imu.h"
 #include "datasets/io.h"
 
 namespace rovo {
@@ -229,7 +230,8 @@ ImportReport ImportDataset(const std::string& in_dir, const ImportOptions& optio
       CommitTempFile(tmp, to);
     }
   }
-  const Trajectory gt = GroundTruthAt(in_dir, stamps);
+  Trajectory gt = GroundTruthAt(in_dir, stamps);
+  ApplyExchangeImu(in_dir, options.out_dir, &info, &gt);  // the body is the IMU when mav0/imu0 exists
   ImportReport report;
   if (!gt.empty()) WriteTum(GroundTruthPath(options.out_dir), gt);
   info.has_ground_truth = !gt.empty();

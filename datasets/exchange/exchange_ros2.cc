@@ -229,15 +229,16 @@ struct Event {
 
 struct TopicIds {
   std::vector<std::pair<size_t, size_t>> cameras;  // image, camera_info
-  size_t tf = 0, gt = 0, imu = 0;
+  size_t tf = 0, gt = 0, imu = 0, imu_exact = 0, imu_bias = 0;
 };
 
 void WriteMessages(const std::string& dataset_dir, const DatasetInfo& info, const Trajectory& gt,
-                   const std::vector<LensFit>& fits, const std::vector<RosImu>& imu, const TopicIds& topics,
-                   BagWriter* bag) {
+                   const std::vector<LensFit>& fits, const Ros2ImuExport& imu, const TopicIds& topics, BagWriter* bag) {
   std::vector<Event> events;
   for (size_t i = 0; i < gt.size(); ++i) events.push_back({SecondsToNs(gt[i].timestamp), 0, i, 0});
-  for (size_t i = 0; i < imu.size(); ++i) events.push_back({RosTimeToNs(imu[i].header.stamp), 1, i, 0});
+  for (size_t i = 0; i < imu.samples.size(); ++i) {
+    events.push_back({RosTimeToNs(imu.samples[i].header.stamp), 1, i, 0});
+  }
   for (int f = 0; f < info.frame_count; ++f) {
     for (size_t k = 0; k < info.rig.cameras.size(); ++k) {
       events.push_back({ImageStampNs(info, gt, f, k), 2, static_cast<size_t>(f), k});
@@ -248,7 +249,9 @@ void WriteMessages(const std::string& dataset_dir, const DatasetInfo& info, cons
     if (e.kind == 0) {
       bag->Write(topics.gt, e.stamp_ns, EncodeRosOdometry(Odometry(gt, e.index)));
     } else if (e.kind == 1) {
-      bag->Write(topics.imu, e.stamp_ns, EncodeRosImu(imu[e.index]));
+      bag->Write(topics.imu, e.stamp_ns, EncodeRosImu(imu.samples[e.index]));
+      bag->Write(topics.imu_exact, e.stamp_ns, EncodeRosImu(imu.exact[e.index]));
+      bag->Write(topics.imu_bias, e.stamp_ns, EncodeRosImu(imu.bias[e.index]));
     } else {
       const RigCamera& rc = info.rig.cameras[e.camera];
       RosImage image = ReadRosImage(ImagePath(dataset_dir, rc.name, static_cast<int>(e.index)));
@@ -299,7 +302,11 @@ Ros2ExportReport ExportRos2Bag(const std::string& dataset_dir, const Ros2ExportO
   }
   topics.tf = bag.AddTopic(kRos2TfStaticTopic, kRosTfMessageType, true);
   if (!gt.empty()) topics.gt = bag.AddTopic(kRos2GroundTruthTopic, kRosOdometryType);
-  if (!imu.samples.empty()) topics.imu = bag.AddTopic(kRos2ImuTopic, kRosImuType);
+  if (!imu.samples.empty()) {
+    topics.imu = bag.AddTopic(kRos2ImuTopic, kRosImuType);
+    topics.imu_exact = bag.AddTopic(kRos2ImuExactTopic, kRosImuType);
+    topics.imu_bias = bag.AddTopic(kRos2ImuBiasTopic, kRosImuType);
+  }
   McapStringMap custom = CustomData(info, dataset_dir, report.fits);
   custom.insert(custom.end(), imu.metadata.begin(), imu.metadata.end());
   bag.AddMetadata(custom);
@@ -310,7 +317,7 @@ Ros2ExportReport ExportRos2Bag(const std::string& dataset_dir, const Ros2ExportO
     first_ns = std::min(first_ns, ImageStampNs(info, gt, 0, k));
   }
   bag.Write(topics.tf, first_ns, EncodeRosTfMessage(StaticTransforms(info, report.fits, imu, first_ns)));
-  WriteMessages(dataset_dir, info, gt, report.fits, imu.samples, topics, &bag);
+  WriteMessages(dataset_dir, info, gt, report.fits, imu, topics, &bag);
   bag.Close();
   WriteFileAtomic((fs::path(options.out_dir) / "metadata.yaml").string(), MetadataYaml(bag, file, custom));
 

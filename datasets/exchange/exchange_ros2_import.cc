@@ -50,7 +50,7 @@ struct BagContents {
   std::vector<std::vector<int64_t>> image_stamps;    // per camera
   std::vector<RosTransform> transforms;              // /tf_static
   std::vector<RosOdometry> odometry;                 // /ground_truth/odometry (or the only Odometry topic)
-  std::vector<RosImu> imu;
+  Ros2ImuImport imu;
   McapStringMap metadata;  // the "rovo" Metadata record
 };
 
@@ -108,7 +108,7 @@ BagContents Decode(std::string_view bytes, const std::string& what, const McapCo
   bag.image_topics = ImageTopics(index, what);
   bag.image_stamps.resize(bag.image_topics.size());
   for (const McapMetadata& m : index.metadata) {
-    if (m.name == "rovo") bag.metadata = m.metadata;
+    if (m.name == "rovo") bag.metadata = bag.imu.metadata = m.metadata;
   }
   std::map<std::string, size_t> camera_of;
   for (size_t k = 0; k < bag.image_topics.size(); ++k) camera_of[bag.image_topics[k]] = k;
@@ -130,8 +130,12 @@ BagContents Decode(std::string_view bytes, const std::string& what, const McapCo
       for (RosTransform& t : DecodeRosTfMessage(m.data, m.where)) bag.transforms.push_back(std::move(t));
     } else if (type == kRosOdometryType) {
       bag.odometry.push_back(DecodeRosOdometry(m.data, m.where));
-    } else if (type == kRosImuType) {
-      bag.imu.push_back(DecodeRosImu(m.data, m.where));
+    } else if (type == kRosImuType && channel.topic == kRos2ImuTopic) {
+      bag.imu.samples.push_back(DecodeRosImu(m.data, m.where));
+    } else if (type == kRosImuType && channel.topic == kRos2ImuExactTopic) {
+      bag.imu.exact.push_back(DecodeRosImu(m.data, m.where));
+    } else if (type == kRosImuType && channel.topic == kRos2ImuBiasTopic) {
+      bag.imu.bias.push_back(DecodeRosImu(m.data, m.where));
     }
   });
   return bag;
@@ -243,7 +247,7 @@ Ros2ImportReport ImportRos2Bag(const std::string& bag_path, const std::string& o
   const McapContents index = ReadMcap(bytes, path, nullptr);
   if (index.profile != "ros2") throw std::runtime_error(path + ": Header: profile: '" + index.profile + "', not ros2");
   EnsureWritableDir(out_dir);
-  const BagContents bag = Decode(bytes, path, index, out_dir);
+  BagContents bag = Decode(bytes, path, index, out_dir);
 
   DatasetInfo info;
   info.generator = "rovo dataset import";
@@ -272,10 +276,10 @@ Ros2ImportReport ImportRos2Bag(const std::string& bag_path, const std::string& o
                     : frames > 1 && times.back() > times.front()
                         ? (static_cast<double>(frames) - 1) / (times.back() - times.front())
                         : 10.0;
-  Rigid3 imu_from_rig;
-  if (root_from.count("imu") != 0)
-    imu_from_rig = root_from.at("imu").Inverse() * root_from.at(RigFrame(bag, root_from));
-  ImportRos2Imu(bag.imu, bag.metadata, imu_from_rig, path, out_dir, &info);
+  if (root_from.count("imu") != 0) {
+    bag.imu.imu_from_rig = root_from.at("imu").Inverse() * root_from.at(RigFrame(bag, root_from));
+  }
+  const bool imu = ImportRos2Imu(bag.imu, path, out_dir, &info);
   info.has_ground_truth = !gt.empty();
   if (!gt.empty()) WriteTum(GroundTruthPath(out_dir), gt);
   WriteDatasetInfo(out_dir, info);
@@ -284,7 +288,7 @@ Ros2ImportReport ImportRos2Bag(const std::string& bag_path, const std::string& o
   report.frames = info.frame_count;
   report.cameras = info.rig.NumCameras();
   report.ground_truth = !gt.empty();
-  report.imu = !bag.imu.empty();
+  report.imu = imu;
   report.issues = ValidateDataset(out_dir);
   return report;
 }
