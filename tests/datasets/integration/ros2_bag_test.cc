@@ -12,6 +12,7 @@
 #include "datasets/exchange/lens_fit.h"
 #include "datasets/io.h"
 #include "datasets/trajectory.h"
+#include "tests/datasets/integration/imu_fixture.h"
 
 namespace rovo {
 namespace {
@@ -42,6 +43,7 @@ class Ros2BagTest : public ::testing::Test {
                                " render --preset cloudy_urban --quick --frames 0:3 --spp 1 --scale 0.5 --quiet --out " +
                                Dataset();
     ASSERT_EQ(RunShell(render, root_ + "/render.log"), 0) << ReadFile(root_ + "/render.log");
+    test::AddImu(Dataset());
     const std::string export_command =
         std::string(ROVO_BINARY) + " dataset export " + Dataset() + " --format ros2 --out " + Bag();
     ASSERT_EQ(RunShell(export_command, root_ + "/export.log"), 0) << ReadFile(root_ + "/export.log");
@@ -78,7 +80,13 @@ TEST_F(Ros2BagTest, FoxgloveReadersDecodeTheBagAsTheDatasetHoldsIt) {
   EXPECT_TRUE(check["in_order"].get<bool>());
 
   // Message counts per topic: by the index, by the statistics record and by a linear scan.
-  std::map<std::string, int> expected = {{"/tf_static", 1}, {"/ground_truth/odometry", info.frame_count}};
+  const ImuStreams imu = ReadImuStreams(Dataset());
+  const int samples = static_cast<int>(imu.measured.size());
+  std::map<std::string, int> expected = {{"/tf_static", 1},
+                                         {"/ground_truth/odometry", info.frame_count},
+                                         {"/imu0", samples},
+                                         {"/ground_truth/imu0/exact", samples},
+                                         {"/ground_truth/imu0/bias", samples}};
   for (const RigCamera& rc : info.rig.cameras) {
     expected["/" + rc.name + "/image_raw"] = info.frame_count;
     expected["/" + rc.name + "/camera_info"] = info.frame_count;
@@ -125,6 +133,29 @@ TEST_F(Ros2BagTest, FoxgloveReadersDecodeTheBagAsTheDatasetHoldsIt) {
     const nlohmann::json& p = t["transform"]["translation"];
     EXPECT_LT((Eigen::Vector3d(p["x"], p["y"], p["z"]) - centre).norm(), 1e-12);
   }
+  const nlohmann::json& imu_tf = transforms[info.rig.cameras.size()];
+  EXPECT_EQ(imu_tf["child_frame_id"], "imu");
+  const Eigen::Vector3d imu_centre = info.rig.imu_from_rig->Inverse().translation;
+  const nlohmann::json& q = imu_tf["transform"]["translation"];
+  EXPECT_LT((Eigen::Vector3d(q["x"], q["y"], q["z"]) - imu_centre).norm(), 1e-12);
+
+  // One Imu: the first measured sample, every digit, on the IMU clock.
+  const nlohmann::json& first_imu = check["first"]["/imu0"];
+  EXPECT_EQ(first_imu["header"]["frame_id"], "imu");
+  EXPECT_EQ(first_imu["header"]["stamp"]["sec"].get<int64_t>() * 1000000000 +
+                first_imu["header"]["stamp"]["nanosec"].get<int64_t>(),
+            std::llround(imu.measured[0].timestamp * 1e9));
+  const char* axes[3] = {"x", "y", "z"};
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(first_imu["angular_velocity"][axes[i]].get<double>(), imu.measured[0].angular_velocity[i]);
+    EXPECT_EQ(first_imu["linear_acceleration"][axes[i]].get<double>(), imu.measured[0].linear_acceleration[i]);
+  }
+  EXPECT_EQ(first_imu["orientation_covariance"][0].get<double>(), -1.0);
+  const double density = info.imu->noise.gyroscope_noise_density;
+  EXPECT_DOUBLE_EQ(first_imu["angular_velocity_covariance"][0].get<double>(), density * density * info.imu->rate_hz);
+  const nlohmann::json& bias = check["first"]["/ground_truth/imu0/bias"];
+  EXPECT_EQ(bias["angular_velocity"]["x"].get<double>(), imu.bias[0].gyroscope_bias.x());
+
   const nlohmann::json& pose = check["first"]["/ground_truth/odometry"]["pose"]["pose"];
   EXPECT_EQ(pose["position"]["x"].get<double>(), gt[0].world_from_rig.translation.x());
   EXPECT_EQ(pose["orientation"]["w"].get<double>(), gt[0].world_from_rig.rotation.w());
@@ -147,6 +178,24 @@ TEST_F(Ros2BagTest, ImportGivesTheDatasetBack) {
     EXPECT_NEAR(gt_a[i].timestamp, gt_b[i].timestamp, 1e-9);
     EXPECT_LT((gt_a[i].world_from_rig.translation - gt_b[i].world_from_rig.translation).norm(), 1e-12);
     EXPECT_LT(gt_a[i].world_from_rig.rotation.angularDistance(gt_b[i].world_from_rig.rotation), 1e-12);
+  }
+  // The IMU: record, mount and the three streams (stamps to the nanosecond the bag carries).
+  ASSERT_TRUE(b.imu.has_value());
+  EXPECT_EQ(b.imu->noise, a.imu->noise);
+  EXPECT_EQ(b.imu->rate_hz, a.imu->rate_hz);
+  EXPECT_EQ(b.imu->seed, a.imu->seed);
+  EXPECT_EQ(b.imu->time_offset_s, a.imu->time_offset_s);
+  EXPECT_EQ(b.imu->noise_profile, a.imu->noise_profile);
+  EXPECT_LT((a.rig.imu_from_rig->translation - b.rig.imu_from_rig->translation).norm(), 1e-15);
+  EXPECT_LT(a.rig.imu_from_rig->rotation.angularDistance(b.rig.imu_from_rig->rotation), 1e-15);
+  const ImuStreams imu_a = ReadImuStreams(Dataset()), imu_b = ReadImuStreams(imported);
+  ASSERT_EQ(imu_a.measured.size(), imu_b.measured.size());
+  for (size_t k = 0; k < imu_a.measured.size(); ++k) {
+    EXPECT_NEAR(imu_a.measured[k].timestamp, imu_b.measured[k].timestamp, 0.5e-9);
+    EXPECT_EQ(imu_a.measured[k].angular_velocity, imu_b.measured[k].angular_velocity);
+    EXPECT_EQ(imu_a.measured[k].linear_acceleration, imu_b.measured[k].linear_acceleration);
+    EXPECT_EQ(imu_a.exact[k].linear_acceleration, imu_b.exact[k].linear_acceleration);
+    EXPECT_EQ(imu_a.bias[k].accelerometer_bias, imu_b.bias[k].accelerometer_bias);
   }
   for (int k = 0; k < a.rig.NumCameras(); ++k) {
     const RigCamera &ca = a.rig.cameras[static_cast<size_t>(k)], &cb = b.rig.cameras[static_cast<size_t>(k)];
