@@ -194,16 +194,13 @@ void WriteCalibrations(const ExportOptions& options, const DatasetInfo& info, co
     sets.emplace_back("-perturbed-" + std::to_string(k), &info.perturbed[k]);
   }
   for (const auto& [suffix, set] : sets) {
-    std::vector<ExchangeCamera> cameras =
+    const std::vector<ExchangeCamera> cameras =
         ExchangeCameras(info.rig, report.model, report.fits,
                         ExchangeCamFromBody(info, set ? set->cam_from_rig : info.rig.Extrinsics()));
-    if (info.imu) {
-      for (ExchangeCamera& c : cameras) c.timeshift_cam_imu_s = info.imu->time_offset_s;
-    }
     if (options.format == ExchangeFormat::kKalibr) {
       const std::string header = set ? PerturbationHeader(*set) : "rovo ground-truth extrinsics";
       WriteFileAtomic((fs::path(options.out_dir) / ("camchain" + suffix + ".yaml")).string(),
-                      KalibrCamchainYaml(cameras, header));
+                      WithKalibrTimeshift(KalibrCamchainYaml(cameras, header), info));
     } else {
       nlohmann::json json = BasaltCalibrationJson(cameras);
       if (info.imu) SetBasaltImu(*info.imu, &json);

@@ -37,7 +37,6 @@ struct ExchangeCamera {
   int height = 0;
   double max_fov_deg = 0.0;  // 0 when the file does not say
   Rigid3 cam_from_rig;       // cam_from_body: the rig, or the IMU when the dataset has one (exchange_imu.h)
-  std::optional<double> timeshift_cam_imu_s;  // Kalibr's timeshift_cam_imu (t_imu = t_cam + shift), with an IMU
 };
 
 // Kalibr's field values of a lens: camera_model, intrinsics, distortion_model, distortion_coeffs.

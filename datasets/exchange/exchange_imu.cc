@@ -247,6 +247,19 @@ std::string KalibrImuYaml(const ImuRecord& imu) {
          "  # rad/s^2/sqrt(Hz)\nrostopic: /imu0\nupdate_rate: " + YamlNumber(imu.rate_hz) + "  # Hz\n";
 }
 
+std::string WithKalibrTimeshift(const std::string& camchain, const DatasetInfo& info) {
+  if (!info.imu) return camchain;
+  // Every camera block has one `  cam_overlaps:` line (KalibrCamchainYaml); the shift follows it.
+  std::istringstream in(camchain);
+  std::string out;
+  for (std::string line; std::getline(in, line);) {
+    out += line + "\n";
+    if (line.rfind("  cam_overlaps:", 0) == 0)
+      out += "  timeshift_cam_imu: " + YamlNumber(info.imu->time_offset_s) + "\n";
+  }
+  return out;
+}
+
 void SetBasaltImu(const ImuRecord& imu, nlohmann::json* calibration) {
   nlohmann::json& value = (*calibration)["value0"];
   const ImuNoise& n = imu.noise;

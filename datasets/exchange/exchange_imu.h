@@ -35,6 +35,10 @@ std::vector<Rigid3> ExchangeCamFromBody(const DatasetInfo& info, const std::vect
 // Nothing without an IMU. Throws naming the dataset's files when they cannot be read.
 void WriteExchangeImu(const std::string& dataset_dir, const DatasetInfo& info, bool kalibr, const std::string& out_dir);
 
+// A Kalibr camchain with `timeshift_cam_imu` (the IMU's time offset) added to every camera when the
+// dataset has an IMU; unchanged without one.
+std::string WithKalibrTimeshift(const std::string& camchain, const DatasetInfo& info);
+
 // Basalt's IMU fields of calibration.json's value0 (noise, rate, time offset).
 void SetBasaltImu(const ImuRecord& imu, nlohmann::json* calibration);
 

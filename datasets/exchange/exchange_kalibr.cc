@@ -96,7 +96,6 @@ std::string KalibrCamchainYaml(const std::vector<ExchangeCamera>& cameras, const
     out << "cam" << i << ":\n";
     if (i > 0) WriteMatrix(out, "T_cn_cnm1", camera.cam_from_rig * cameras[i - 1].cam_from_rig.Inverse());
     WriteMatrix(out, "T_cam_imu", camera.cam_from_rig);
-    if (camera.timeshift_cam_imu_s) out << "  timeshift_cam_imu: " << YamlNumber(*camera.timeshift_cam_imu_s) << "\n";
     std::string overlaps;
     for (int j : Overlaps(cameras, i)) overlaps += (overlaps.empty() ? "" : ", ") + std::to_string(j);
     out << "  cam_overlaps: [" << overlaps << "]\n"
