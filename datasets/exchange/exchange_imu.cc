@@ -195,7 +195,9 @@ void ReadImuSensorYaml(const std::string& path, ExchangeImu* imu) {
   if (root["rovo_imu_from_rig"]) {
     const std::vector<double> m = YamlDoubles(root, "rovo_imu_from_rig", path, 16);
     Eigen::Matrix3d rotation;
-    for (int i = 0; i < 9; ++i) rotation(i / 3, i % 3) = m[static_cast<size_t>(4 * (i / 3) + i % 3)];
+    for (size_t i = 0; i < 9; ++i) {
+      rotation(static_cast<Eigen::Index>(i / 3), static_cast<Eigen::Index>(i % 3)) = m[4 * (i / 3) + i % 3];
+    }
     if ((rotation * rotation.transpose() - Eigen::Matrix3d::Identity()).norm() > 1e-6 || rotation.determinant() < 0) {
       throw std::runtime_error(path + ": rovo_imu_from_rig: the 3x3 block is not a rotation");
     }

@@ -20,9 +20,9 @@ RosImu ImuMessage(double timestamp, const Eigen::Vector3d& angular_velocity, con
   m.orientation_covariance[0] = -1;  // no orientation estimate
   m.angular_velocity = angular_velocity;
   m.linear_acceleration = acceleration;
-  for (int i = 0; i < 3; ++i) {
-    m.angular_velocity_covariance[static_cast<size_t>(4 * i)] = gyro_variance;
-    m.linear_acceleration_covariance[static_cast<size_t>(4 * i)] = accel_variance;
+  for (size_t i = 0; i < 3; ++i) {  // the diagonal of the row-major 3x3
+    m.angular_velocity_covariance[4 * i] = gyro_variance;
+    m.linear_acceleration_covariance[4 * i] = accel_variance;
   }
   return m;
 }
