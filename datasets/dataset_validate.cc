@@ -222,6 +222,7 @@ std::vector<ValidationIssue> ValidateDataset(const std::string& dir) {
 
   if (json_ok && info.has_static_masks) CheckStaticMasks(dir, info, &issues);
   if (json_ok && info.sensor) CheckExposureRecord(dir, info, &issues);
+  CheckImuStreams(dir, info, &issues);
 
   CheckImageLayers(dir, info, &issues);
   return issues;

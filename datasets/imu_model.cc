@@ -140,6 +140,29 @@ ImuSample ExactImuSample(const RigMotionState& state, const Rigid3& imu_from_rig
   return s;
 }
 
+ImuGroundTruthState ImuStateAt(const ContinuousTrajectory& trajectory, const Rigid3& imu_from_rig, double t) {
+  const RigMotionState s = trajectory.State(t);
+  const Eigen::Vector3d imu_in_rig = imu_from_rig.Inverse().translation;
+  ImuGroundTruthState out;
+  out.timestamp = t;
+  out.world_from_imu = s.world_from_rig * imu_from_rig.Inverse();
+  out.velocity = s.linear_velocity + s.world_from_rig.rotation * s.angular_velocity.cross(imu_in_rig);
+  return out;
+}
+
+std::vector<ImuGroundTruthState> ImuGroundTruthStream(const ContinuousTrajectory& trajectory,
+                                                      const Rigid3& imu_from_rig, const ImuRecord& record) {
+  std::vector<ImuGroundTruthState> out;
+  out.reserve(record.sample_count);
+  for (int k = 0; k < record.sample_count; ++k) {
+    const double stamp = record.first_timestamp + k / record.rate_hz;
+    ImuGroundTruthState s = ImuStateAt(trajectory, imu_from_rig, stamp - record.time_offset_s);
+    s.timestamp = stamp;
+    out.push_back(s);
+  }
+  return out;
+}
+
 std::vector<ImuSample> ExactImuStream(const ContinuousTrajectory& trajectory, const Rigid3& imu_from_rig,
                                       const ImuRecord& record) {
   std::vector<ImuSample> out;

@@ -54,6 +54,20 @@ ImuSample ExactImuSample(const RigMotionState& state, const Rigid3& imu_from_rig
 ImuStreams SimulateImu(const ContinuousTrajectory& trajectory, const Rigid3& imu_from_rig, const ImuSettings& settings,
                        uint64_t seed, ImuRecord* record);
 
+// The IMU's true state (EuRoC's state_groundtruth_estimate0 with the body frame at the IMU): the
+// pose world_from_imu = world_from_rig * imu_from_rig^-1 and the velocity of the IMU origin in the
+// world frame, v_rig + R (omega x r).
+struct ImuGroundTruthState {
+  double timestamp = 0.0;  // seconds; ImuGroundTruthStream: IMU clock
+  Rigid3 world_from_imu;
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // m/s, world frame
+};
+// At dataset time t (timestamp t).
+ImuGroundTruthState ImuStateAt(const ContinuousTrajectory& trajectory, const Rigid3& imu_from_rig, double t);
+// At every sample of a record: stamp s on the IMU clock, the state at dataset time s - time_offset_s.
+std::vector<ImuGroundTruthState> ImuGroundTruthStream(const ContinuousTrajectory& trajectory,
+                                                      const Rigid3& imu_from_rig, const ImuRecord& record);
+
 // The exact stream of a record (the stamps and values SimulateImu gives imu/exact.csv).
 std::vector<ImuSample> ExactImuStream(const ContinuousTrajectory& trajectory, const Rigid3& imu_from_rig,
                                       const ImuRecord& record);

@@ -245,6 +245,7 @@ void CheckRenderOptions(const RenderOptions& options) {
   if (!(options.vignetting >= 0.0f && options.vignetting <= 1.0f))
     throw std::invalid_argument("--vignetting must be in [0, 1]");
   options.sensor.Check();
+  if (options.imu) options.imu_settings.Check();
 }
 
 // The scene has a trajectory and every dynamic object has one pose per trajectory frame.
@@ -266,7 +267,10 @@ struct SensorPlan {
   std::vector<std::vector<double>> meter;
   std::vector<std::vector<CameraExposure>> exposure;
   std::vector<double> trigger_offset_ms;  // per camera (timing; empty when timing is off)
-  Trajectory groundtruth;                 // the dataset's rig poses, which timing interpolates
+  // The dataset's continuous-time ground truth, which timing and the IMU sample (timing or IMU on).
+  std::optional<ContinuousTrajectory> rig_motion;
+  std::optional<ImuStreams> imu;  // the IMU's streams and record (--imu)
+  ImuRecord imu_record;
 };
 
 // The auto-exposure meter of dataset frames [0, count) (trajectory frames begin + f): per camera a
@@ -339,6 +343,12 @@ DatasetInfo MakeDatasetInfo(const RenderOptions& options, const Scene& scene, co
   info.has_masks = options.masks;
   if (options.sensor.enabled) info.sensor = MakeSensorRecord(options.sensor, plan.sensitivity);
   if (options.timing.Enabled()) info.timing = MakeTimingRecord(options.timing, plan.trigger_offset_ms);
+  // A dataset's rig carries the IMU mount exactly when the dataset has an IMU.
+  info.rig.imu_from_rig.reset();
+  if (plan.imu) {
+    info.rig.imu_from_rig = rig.imu_from_rig.value_or(PresetImuFromRig());
+    info.imu = plan.imu_record;
+  }
   return info;
 }
 
@@ -360,6 +370,7 @@ void PrepareOutput(const RenderOptions& options, const DatasetInfo& info, const 
     WriteExposureCsv(ExposurePath(options.out_dir),
                      MakeExposureRows(options.sensor, plan.exposure, plan.meter, plan.sensitivity, names));
   }
+  if (plan.imu) WriteImuStreams(options.out_dir, *plan.imu);
   WriteDatasetInfo(options.out_dir, info);
   for (const RigCamera& cam : info.rig.cameras) {
     PrepareDir(ImagePath(options.out_dir, cam.name, 0));
@@ -413,6 +424,27 @@ void CheckTimingWindows(const RenderOptions& options, const Scene& scene, int be
   }
 }
 
+// The continuous-time ground truth of the dataset's poses, the trigger offsets and the IMU streams
+// (timing or IMU on); throws naming the options when the poses cannot make one.
+void PlanMotion(const RenderOptions& options, const Scene& scene, const Rig& rig, const Trajectory& groundtruth,
+                int begin, SensorPlan* plan) {
+  if (!options.timing.Enabled() && !options.imu) return;
+  try {
+    plan->rig_motion.emplace(groundtruth);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(
+        std::string(options.imu ? "--imu" : "--shutter-ms/--rolling-shutter-ms/--trigger-offset") + ": " + e.what());
+  }
+  if (options.timing.Enabled()) {
+    plan->trigger_offset_ms = TriggerOffsetsMs(options.timing, rig.NumCameras(), options.seed);
+    CheckTimingWindows(options, scene, begin, static_cast<int>(groundtruth.size()), *plan, rig.NumCameras());
+  }
+  if (options.imu) {
+    plan->imu = SimulateImu(*plan->rig_motion, rig.imu_from_rig.value_or(PresetImuFromRig()), options.imu_settings,
+                            options.seed, &plan->imu_record);
+  }
+}
+
 // The images of one frame with timing (render/timing.h): the dynamic objects over the frame's
 // window (the scene's motion), each camera at its own times (the rig from the dataset's poses).
 void RenderTimedFrame(const RenderOptions& options, const Rig& rig, int traj_frame, int f, const SensorPlan& plan,
@@ -424,7 +456,7 @@ void RenderTimedFrame(const RenderOptions& options, const Rig& rig, int traj_fra
   for (int c = 0; c < rig.NumCameras(); ++c) {
     Rigid3 world_from_cam;
     const CameraMotion motion =
-        MakeCameraMotion(plan.groundtruth, f, rig.cameras[c].cam_from_rig, h > 0.0 ? h : 1.0, plan.trigger_offset_ms[c],
+        MakeCameraMotion(*plan.rig_motion, f, rig.cameras[c].cam_from_rig, h > 0.0 ? h : 1.0, plan.trigger_offset_ms[c],
                          shutter[c], options.timing.rolling_shutter_ms, rays[c].height, &world_from_cam);
     CameraImage& image = job->images[c];
     if (pipeline) image.linear.swap(*linear);
@@ -549,11 +581,7 @@ RenderSummary RenderDataset(const RenderOptions& options) {
   arena.execute([&] { tracer = std::make_unique<Tracer>(scene); });
   // The sensor model's exposure schedule covers every frame of the range (before any output).
   SensorPlan plan = PlanSensor(options, scene, rig, begin, count, arena, *tracer);
-  if (options.timing.Enabled()) {
-    plan.trigger_offset_ms = TriggerOffsetsMs(options.timing, rig.NumCameras(), options.seed);
-    plan.groundtruth = groundtruth;
-    CheckTimingWindows(options, scene, begin, count, plan, rig.NumCameras());
-  }
+  PlanMotion(options, scene, rig, groundtruth, begin, &plan);
   const int spp = options.spp > 0 ? options.spp : DefaultSpp(options.timing, plan.exposure);
   const DatasetInfo info = MakeDatasetInfo(options, scene, rig, count, plan);
 

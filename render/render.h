@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "datasets/imu_model.h"
 #include "datasets/rig.h"
 #include "render/sensor.h"
 #include "render/timing.h"
@@ -34,6 +35,9 @@ struct RenderOptions {
   SensorSettings sensor;
   // Exposure timing (render/timing.h): trigger offsets, motion blur, rolling shutter; off by default.
   TimingSettings timing;
+  // An IMU on the rig (datasets/imu_model.h), sampled from the continuous-time ground truth; off by default.
+  bool imu = false;
+  ImuSettings imu_settings;
 };
 
 struct RenderSummary {
@@ -47,10 +51,10 @@ struct RenderSummary {
 // Renders the frames of `options` (see RenderOptions) into options.out_dir. Throws
 // std::invalid_argument / std::runtime_error naming the file or option for bad input, before any
 // output is written. Resumable: frames whose files all exist are skipped (files appear only by
-// atomic rename). groundtruth.tum, dataset.json and, with the sensor model, exposure.csv cover the
-// whole frame range and are identical from every shard. Images are identical for any thread count.
-// Unless quiet, prints the rig line (DescribeRigChoice) to stderr before rendering. With the sensor
-// model, a small meter render of every frame of the range comes first (the auto-exposure schedule).
+// atomic rename). groundtruth.tum, dataset.json and, with the sensor model, exposure.csv (with the
+// IMU, imu/*.csv) cover the whole frame range and are identical from every shard. Images are identical for any thread
+// count. Unless quiet, prints the rig line (DescribeRigChoice) to stderr before rendering. With the sensor model, a
+// small meter render of every frame of the range comes first (the auto-exposure schedule).
 RenderSummary RenderDataset(const RenderOptions& options);
 
 // Samples per pixel when RenderOptions::spp is 0: the cheapest setting whose mean error against a

@@ -83,10 +83,10 @@ double HalfWindowSeconds(const std::vector<double>& offsets_ms, double readout_m
   return (offset + 0.5 * readout_ms + 0.5 * shutter) / 1000.0;
 }
 
-CameraMotion MakeCameraMotion(const Trajectory& trajectory, int frame, const Rigid3& cam_from_rig, double half_window_s,
-                              double offset_ms, double shutter_ms, double readout_ms, int height,
+CameraMotion MakeCameraMotion(const ContinuousTrajectory& rig_motion, int frame, const Rigid3& cam_from_rig,
+                              double half_window_s, double offset_ms, double shutter_ms, double readout_ms, int height,
                               Rigid3* world_from_cam_at_trigger) {
-  const double t = trajectory.at(frame).timestamp;
+  const double t = rig_motion.frames().at(frame).timestamp;
   const double window = 2.0 * half_window_s;
   const Rigid3 rig_from_cam = cam_from_rig.Inverse();
   CameraMotion m;
@@ -94,13 +94,13 @@ CameraMotion MakeCameraMotion(const Trajectory& trajectory, int frame, const Rig
   m.readout = static_cast<float>(readout_ms / 1000.0 / window);
   m.shutter = static_cast<float>(shutter_ms / 1000.0 / window);
   if (height <= 1) m.readout = 0.0f;
-  *world_from_cam_at_trigger = PoseAtTime(trajectory, nullptr, t + offset_ms / 1000.0) * rig_from_cam;
+  *world_from_cam_at_trigger = rig_motion.Pose(t + offset_ms / 1000.0) * rig_from_cam;
   if (m.readout == 0.0f && m.shutter == 0.0f) return m;
   m.rotation.resize(kMotionPoses);
   m.origin.resize(kMotionPoses);
   for (int k = 0; k < kMotionPoses; ++k) {
     const double time = t - half_window_s + window * k / (kMotionPoses - 1);
-    const Rigid3 world_from_cam = PoseAtTime(trajectory, nullptr, time) * rig_from_cam;
+    const Rigid3 world_from_cam = rig_motion.Pose(time) * rig_from_cam;
     m.rotation[k] = world_from_cam.RotationMatrix().cast<float>();
     m.origin[k] = world_from_cam.translation.cast<float>();
   }

@@ -5,7 +5,10 @@
 // (0 = top) of its H rows is exposed over [t_v - T/2, t_v + T/2] with
 //   t_v = t_f + o_c + (v / (H - 1) - 1/2) * R,
 // T the exposure (shutter) time and R the rolling-shutter readout time of the whole image. The rig
-// and the dynamic objects at any time come from the scene's per-frame samples by PoseAtTime.
+// at any time comes from the dataset's continuous-time ground truth (ContinuousTrajectory,
+// datasets/continuous_trajectory.h: a C2 spline through the poses of groundtruth.tum, the same
+// curve the IMU samples); the dynamic objects keep their own motion, from the scene's per-frame
+// samples by PoseAtTime.
 //
 // Pure functions and plain structs; RenderDataset (render/render.cc) drives them, the tracer
 // (render/tracer.h, CameraMotion and Tracer::SetFrameWindow) samples the times.
@@ -13,6 +16,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "datasets/continuous_trajectory.h"
 #include "datasets/dataset.h"
 #include "datasets/rigid3.h"
 #include "datasets/trajectory.h"
@@ -57,11 +61,11 @@ double HalfWindowSeconds(const std::vector<double>& offsets_ms, double readout_m
 // Poses in a CameraMotion table (ray times k / (kMotionPoses - 1)).
 inline constexpr int kMotionPoses = 129;
 
-// The CameraMotion of a camera of trajectory frame `frame` over the window [t_f - h, t_f + h]
-// (h = half_window_s > 0), and world_from_cam at its trigger time t_f + o_c (the pose Render
-// takes). `height` is the image height in rows.
-CameraMotion MakeCameraMotion(const Trajectory& trajectory, int frame, const Rigid3& cam_from_rig, double half_window_s,
-                              double offset_ms, double shutter_ms, double readout_ms, int height,
+// The CameraMotion of a camera of trajectory frame `frame` (of rig_motion.frames()) over the window
+// [t_f - h, t_f + h] (h = half_window_s > 0), and world_from_cam at its trigger time t_f + o_c (the
+// pose Render takes), the rig from the continuous-time ground truth. `height` is the image height in rows.
+CameraMotion MakeCameraMotion(const ContinuousTrajectory& rig_motion, int frame, const Rigid3& cam_from_rig,
+                              double half_window_s, double offset_ms, double shutter_ms, double readout_ms, int height,
                               Rigid3* world_from_cam_at_trigger);
 
 // The dataset.json record of a render with these settings and offsets.

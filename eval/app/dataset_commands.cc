@@ -25,9 +25,41 @@ void RunValidate(const std::string& dir) {
     throw CLI::RuntimeError(1);
   }
   const DatasetInfo info = ReadDatasetInfo(dir);
-  std::printf("OK: %s: %d frames x %d cameras, %zu perturbed set%s%s%s\n", dir.c_str(), info.frame_count,
+  const std::string imu = info.imu ? ", IMU " + std::to_string(info.imu->sample_count) + " samples" : "";
+  std::printf("OK: %s: %d frames x %d cameras, %zu perturbed set%s%s%s%s\n", dir.c_str(), info.frame_count,
               info.rig.NumCameras(), info.perturbed.size(), info.perturbed.size() == 1 ? "" : "s",
-              info.has_depth ? ", depth" : "", info.has_masks ? ", masks" : "");
+              info.has_depth ? ", depth" : "", info.has_masks ? ", masks" : "", imu.c_str());
+}
+
+// The IMU of a dataset (dataset.json /imu and the rig's imu_from_rig).
+void PrintImu(const DatasetInfo& info) {
+  if (!info.imu) {
+    std::printf("\nimu        none\n");
+    return;
+  }
+  const ImuRecord& r = *info.imu;
+  const ImuNoise& n = r.noise;
+  std::printf(
+      "\nimu        %d samples at %.6g Hz from %.9g s (IMU clock), time offset %.6g ms (t_imu = t_cam + "
+      "offset), gravity %.6g m/s^2, seed %llu\n",
+      r.sample_count, r.rate_hz, r.first_timestamp, r.time_offset_s * 1000.0, r.gravity_m_s2,
+      static_cast<unsigned long long>(r.seed));
+  std::printf(
+      "  noise    %s: gyroscope %.5g rad/s/sqrt(Hz), walk %.5g rad/s^2/sqrt(Hz); accelerometer %.5g "
+      "m/s^2/sqrt(Hz), walk %.5g m/s^3/sqrt(Hz)\n",
+      r.noise_profile.c_str(), n.gyroscope_noise_density, n.gyroscope_random_walk, n.accelerometer_noise_density,
+      n.accelerometer_random_walk);
+  std::printf("  biases   initial gyroscope (%+.5f, %+.5f, %+.5f) rad/s, accelerometer (%+.5f, %+.5f, %+.5f) m/s^2\n",
+              n.gyroscope_initial_bias.x(), n.gyroscope_initial_bias.y(), n.gyroscope_initial_bias.z(),
+              n.accelerometer_initial_bias.x(), n.accelerometer_initial_bias.y(), n.accelerometer_initial_bias.z());
+  if (info.rig.imu_from_rig) {
+    const Rigid3 rig_from_imu = info.rig.imu_from_rig->Inverse();
+    const Eigen::Vector3d rpy = RollPitchYawDegFromQuaternion(rig_from_imu.rotation);
+    std::printf(
+        "  mount    at (%+.3f, %+.3f, %+.3f) m in the rig, roll/pitch/yaw (%.2f, %.2f, %.2f) deg (rig_from_imu)\n",
+        rig_from_imu.translation.x(), rig_from_imu.translation.y(), rig_from_imu.translation.z(), rpy.x(), rpy.y(),
+        rpy.z());
+  }
 }
 
 void RunInfo(const std::string& dir) {
@@ -64,6 +96,7 @@ void RunInfo(const std::string& dir) {
                 CameraModelName(rc.camera.model).c_str(), size, rc.camera.max_fov_deg, pos,
                 CameraYawDeg(rc.cam_from_rig), CameraPitchDeg(rc.cam_from_rig));
   }
+  PrintImu(info);
   std::printf("\nperturbed extrinsic sets: %zu\n", info.perturbed.size());
   for (size_t i = 0; i < info.perturbed.size(); ++i) {
     const PerturbedExtrinsics& set = info.perturbed[i];
@@ -93,7 +126,8 @@ void AddDatasetCommands(CommandTree& tree) {
   auto info_dir = std::make_shared<std::string>();
   CLI::App* info = dataset->add_subcommand(
       "info",
-      "Summary of a dataset: generator, seed, preset, frames, duration, path length, rig table, perturbed sets");
+      "Summary of a dataset: generator, seed, preset, frames, duration, path length, rig table, IMU, perturbed "
+      "sets");
   info->add_option("dir", *info_dir, "Dataset folder")->required();
   info->callback([info_dir] { RunInfo(*info_dir); });
 

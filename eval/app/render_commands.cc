@@ -145,11 +145,74 @@ void AddTimingOptions(CLI::App* cmd, TimingSettings* timing) {
       ->group(g);
 }
 
+// The IMU options of `rovo render` (datasets/imu_model.h); each needs --imu.
+struct ImuArgs {
+  bool on = false;
+  double rate_hz = 200.0;
+  std::string noise = "adis16448";
+  double gyro_density = 0, gyro_walk = 0, accel_density = 0, accel_walk = 0, offset_ms = 0;
+  std::vector<double> gyro_bias, accel_bias;
+  std::vector<CLI::Option*> options;  // every option but --imu
+
+  void Add(CLI::App* cmd) {
+    const std::string g = "IMU (datasets/FORMAT.md, section IMU; off by default)";
+    cmd->add_flag("--imu", on,
+                  "Also write an IMU on the rig (imu/data.csv, exact.csv, bias.csv), sampled from the continuous-time "
+                  "ground truth, mounted at the rig's imu_from_rig (the presets' mount when the rig has none)")
+        ->group(g);
+    auto add = [&](const std::string& name, auto* value, const std::string& help) {
+      options.push_back(cmd->add_option(name, *value, help)->group(g));
+      return options.back();
+    };
+    add("--imu-rate", &rate_hz, "IMU samples per second (default 200)");
+    add("--imu-noise", &noise,
+        "Noise profile: adis16448 (default; the EuRoC MAV ADIS16448 values) or none (exact measurements)");
+    add("--imu-gyro-noise-density", &gyro_density, "Gyroscope white noise density, rad/s/sqrt(Hz) (over the profile)");
+    add("--imu-gyro-random-walk", &gyro_walk, "Gyroscope bias random walk, rad/s^2/sqrt(Hz) (over the profile)");
+    add("--imu-accel-noise-density", &accel_density,
+        "Accelerometer white noise density, m/s^2/sqrt(Hz) (over the profile)");
+    add("--imu-accel-random-walk", &accel_walk, "Accelerometer bias random walk, m/s^3/sqrt(Hz) (over the profile)");
+    add("--imu-gyro-bias", &gyro_bias, "Initial gyroscope bias x,y,z in rad/s (default: drawn from --seed)")
+        ->delimiter(',')
+        ->expected(3);
+    add("--imu-accel-bias", &accel_bias, "Initial accelerometer bias x,y,z in m/s^2 (default: drawn from --seed)")
+        ->delimiter(',')
+        ->expected(3);
+    add("--imu-time-offset-ms", &offset_ms,
+        "IMU clock minus camera clock in ms: t_imu = t_cam + offset (Kalibr's timeshift_cam_imu; default 0)");
+  }
+
+  // The settings; throws std::invalid_argument for an IMU option without --imu or a bad value.
+  void Resolve(RenderOptions* options) const {
+    for (const CLI::Option* o : this->options) {
+      if (o->count() && !on) throw std::invalid_argument(o->get_name() + ": needs --imu");
+    }
+    options->imu = on;
+    ImuSettings& s = options->imu_settings;
+    s.rate_hz = rate_hz;
+    s.noise_profile = noise;
+    auto set = [&](const char* name, double value, std::optional<double>* field) {
+      for (const CLI::Option* o : this->options)
+        if (o->get_name() == name && o->count()) *field = value;
+    };
+    set("--imu-gyro-noise-density", gyro_density, &s.gyroscope_noise_density);
+    set("--imu-gyro-random-walk", gyro_walk, &s.gyroscope_random_walk);
+    set("--imu-accel-noise-density", accel_density, &s.accelerometer_noise_density);
+    set("--imu-accel-random-walk", accel_walk, &s.accelerometer_random_walk);
+    if (gyro_bias.size() == 3) s.gyroscope_initial_bias = Eigen::Vector3d(gyro_bias[0], gyro_bias[1], gyro_bias[2]);
+    if (accel_bias.size() == 3)
+      s.accelerometer_initial_bias = Eigen::Vector3d(accel_bias[0], accel_bias[1], accel_bias[2]);
+    s.time_offset_s = offset_ms / 1000.0;
+    if (on) s.Check();
+  }
+};
+
 void AddRenderCommand(CLI::App& root) {
   struct Args {
     RenderOptions options;
     std::string frames, shard;
     SensorArgs sensor;
+    ImuArgs imu;
     bool realistic = false;
   };
   auto args = std::make_shared<Args>();
@@ -157,7 +220,7 @@ void AddRenderCommand(CLI::App& root) {
       "render",
       "Render a dataset (datasets/FORMAT.md) of a scene seen by a fisheye rig with the Embree tracer: "
       "camN/NNNNNN.png, groundtruth.tum, dataset.json, optional depth/ and masks/ (and exposure.csv with "
-      "--sensor). Resumable: rerunning "
+      "--sensor, imu/ with --imu). Resumable: rerunning "
       "skips frames whose files all exist.");
   auto* preset =
       cmd->add_option("--preset", args->options.preset, "Scene preset to generate and render (e.g. static_urban)");
@@ -193,6 +256,7 @@ void AddRenderCommand(CLI::App& root) {
                               "realistic --motion-blur ") +
                       values + "; options given beside it override these");
   }
+  args->imu.Add(cmd);
   cmd->add_flag("--quiet", args->options.quiet, "No progress output");
   cmd->callback([args, cmd] {
     RenderOptions options = args->options;
@@ -200,6 +264,7 @@ void AddRenderCommand(CLI::App& root) {
     if (!args->shard.empty()) ParseShard(args->shard, &options.shard_index, &options.shard_count);
     if (args->realistic) ApplyRealisticProfile(*cmd, &args->sensor, &options.timing);
     options.sensor = args->sensor.Resolve();
+    args->imu.Resolve(&options);
     const RenderSummary s = RenderDataset(options);
     std::printf("rendered %d frames, skipped %d complete, %d in this shard, %.1f s\n%s\n", s.frames_rendered,
                 s.frames_skipped, s.frames_total, s.seconds, s.rig.c_str());

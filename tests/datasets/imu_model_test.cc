@@ -33,11 +33,8 @@ struct ImuState {
 };
 
 ImuState TrueImuState(const ContinuousTrajectory& curve, const Rigid3& imu_from_rig, double t) {
-  const RigMotionState s = curve.State(t);
-  const Rigid3 world_from_imu = s.world_from_rig * imu_from_rig.Inverse();
-  const Eigen::Vector3d imu_in_rig = imu_from_rig.Inverse().translation;
-  return {world_from_imu.rotation, s.linear_velocity + s.world_from_rig.rotation * s.angular_velocity.cross(imu_in_rig),
-          world_from_imu.translation};
+  const ImuGroundTruthState s = ImuStateAt(curve, imu_from_rig, t);
+  return {s.world_from_imu.rotation, s.velocity, s.world_from_imu.translation};
 }
 
 // Strapdown integration, classic Runge-Kutta 4 over two sample intervals (samples k, k+1, k+2
@@ -220,6 +217,25 @@ TEST(ImuModel, Adis16448WhiteNoiseMatchesItsDensity) {
   // The biases start at the drawn initial values and are stored per sample.
   EXPECT_EQ(streams.bias.front().gyroscope_bias, record.noise.gyroscope_initial_bias);
   EXPECT_GT(record.noise.gyroscope_initial_bias.norm(), 0.0);
+}
+
+TEST(ImuModel, GroundTruthStateVelocityIsThePositionsDerivative) {
+  const ContinuousTrajectory curve(Drive(3.0));
+  const Rigid3 imu_from_rig = PresetImuFromRig();
+  const double t = curve.start_time() + 1.2345, h = 1e-5;
+  const ImuGroundTruthState s = ImuStateAt(curve, imu_from_rig, t);
+  const Eigen::Vector3d fd = (ImuStateAt(curve, imu_from_rig, t + h).world_from_imu.translation -
+                              ImuStateAt(curve, imu_from_rig, t - h).world_from_imu.translation) /
+                             (2 * h);
+  EXPECT_LT((fd - s.velocity).norm(), 1e-7 * (1.0 + s.velocity.norm()));
+  ImuRecord record;
+  ImuSettings settings;
+  settings.time_offset_s = 0.004;
+  SimulateImu(curve, imu_from_rig, settings, 1, &record);
+  const std::vector<ImuGroundTruthState> stream = ImuGroundTruthStream(curve, imu_from_rig, record);
+  ASSERT_EQ(static_cast<int>(stream.size()), record.sample_count);
+  EXPECT_EQ(stream[7].world_from_imu.translation,
+            ImuStateAt(curve, imu_from_rig, stream[7].timestamp - 0.004).world_from_imu.translation);
 }
 
 TEST(ImuModel, SeededAndReproducible) {

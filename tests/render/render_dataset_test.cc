@@ -1,8 +1,10 @@
 // RenderDataset on a small saved box scene: outputs, resume, shards, threads, bad input.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <utility>
 
 #include "datasets/dataset.h"
 #include "datasets/io.h"
@@ -244,6 +246,86 @@ TEST_F(RenderDatasetTest, SceneFolderRigJsonIsTheDefaultRig) {
   const RigChoice fallback = ChooseRig("", unnamed, scene_dir_, 0.0);
   EXPECT_EQ(fallback.source, "preset rovo4 (the default: the scene names no rig)");
   EXPECT_EQ(fallback.rig.cameras[0].camera.width, MakeRigPreset("rovo4").cameras[0].camera.width);
+}
+
+}  // namespace
+}  // namespace rovo
+
+namespace rovo {
+namespace {
+
+// --imu adds the IMU streams and records and changes no image; the exact stream agrees with the
+// continuous-time ground truth the validator rebuilds; the rig carries the mount only with an IMU.
+TEST_F(RenderDatasetTest, ImuAddsItsStreamsAndChangesNoImage) {
+  RenderOptions plain = Options("plain");
+  RenderDataset(plain);
+  RenderOptions with_imu = Options("imu");
+  with_imu.imu = true;
+  with_imu.imu_settings.noise_profile = "none";
+  with_imu.imu_settings.time_offset_s = 0.002;
+  RenderDataset(with_imu);
+  const auto a = Files(plain.out_dir), b = Files(with_imu.out_dir);
+  for (const auto& [path, content] : a) {
+    if (path == "dataset.json") continue;
+    ASSERT_TRUE(b.count(path)) << path;
+    EXPECT_EQ(content, b.at(path)) << path;
+  }
+  EXPECT_FALSE(ReadDatasetInfo(plain.out_dir).rig.imu_from_rig);
+  EXPECT_FALSE(fs::exists(ImuDataPath(plain.out_dir)));
+  const DatasetInfo info = ReadDatasetInfo(with_imu.out_dir);
+  ASSERT_TRUE(info.imu);
+  ASSERT_TRUE(info.rig.imu_from_rig);
+  EXPECT_EQ(info.imu->rate_hz, 200.0);
+  EXPECT_EQ(info.imu->noise_profile, "none");
+  const ImuStreams streams = ReadImuStreams(with_imu.out_dir);
+  EXPECT_EQ(static_cast<int>(streams.measured.size()), info.imu->sample_count);
+  EXPECT_DOUBLE_EQ(streams.measured.front().timestamp,
+                   ReadTum(GroundTruthPath(with_imu.out_dir)).front().timestamp + 0.002);
+  for (const ValidationIssue& issue : ValidateDataset(with_imu.out_dir))
+    ADD_FAILURE() << issue.file << " " << issue.field << ": " << issue.message;
+  // Bad settings fail before any output, naming the option.
+  RenderOptions bad = Options("bad");
+  bad.imu = true;
+  bad.imu_settings.rate_hz = -1.0;
+  ExpectFailsNaming(bad, "--imu-rate");
+  EXPECT_FALSE(fs::exists(bad.out_dir + "/dataset.json"));
+}
+
+// The command line: bad IMU settings fail naming the option and write nothing; the IMU options
+// set the record.
+TEST_F(RenderDatasetTest, CommandLineImuOptions) {
+  const std::string log = (root_ / "log.txt").string();
+  auto run = [&](const std::string& out, const std::string& args) {
+    const int status =
+        std::system((std::string(ROVO_BINARY) + " render --scene " + scene_dir_ + " --out " + (root_ / out).string() +
+                     " --rig omnimvs4 --scale 0.1 --spp 1 --frames 0:3 --quiet " + args + " > " + log + " 2>&1")
+                        .c_str());
+    return std::make_pair(status, ReadFile(log));
+  };
+  const std::pair<std::string, std::string> bad[] = {
+      {"--imu --imu-rate -200", "--imu-rate -200"},
+      {"--imu --imu-gyro-noise-density nan", "--imu-gyro-noise-density nan"},
+      {"--imu --imu-accel-random-walk -1", "--imu-accel-random-walk"},
+      {"--imu --imu-noise tactical", "--imu-noise `tactical`"},
+      {"--imu-rate 100", "--imu-rate: needs --imu"}};
+  for (const auto& [args, needle] : bad) {
+    const auto [status, text] = run("bad", args);
+    EXPECT_NE(status, 0) << args;
+    EXPECT_NE(text.find(needle), std::string::npos) << args << ": " << text;
+    EXPECT_FALSE(fs::exists(root_ / "bad")) << args;
+  }
+  const auto [status, text] = run(
+      "good", "--imu --imu-rate 400 --imu-gyro-noise-density 1e-3 --imu-accel-bias 0.1,0.2,0.3 --imu-time-offset-ms 5");
+  ASSERT_EQ(status, 0) << text;
+  const DatasetInfo info = ReadDatasetInfo((root_ / "good").string());
+  ASSERT_TRUE(info.imu);
+  EXPECT_EQ(info.imu->rate_hz, 400.0);
+  EXPECT_EQ(info.imu->noise_profile, "custom");
+  EXPECT_EQ(info.imu->noise.gyroscope_noise_density, 1e-3);
+  EXPECT_EQ(info.imu->noise.accelerometer_noise_density, 2e-3);  // the profile's
+  EXPECT_EQ(info.imu->noise.accelerometer_initial_bias, Eigen::Vector3d(0.1, 0.2, 0.3));
+  EXPECT_DOUBLE_EQ(info.imu->time_offset_s, 0.005);
+  EXPECT_EQ(info.imu->sample_count, 81);  // 0.2 s at 400 Hz
 }
 
 }  // namespace

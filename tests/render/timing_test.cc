@@ -90,8 +90,9 @@ struct EdgeRender {
     const double h = HalfWindowSeconds({offset_ms}, readout_ms, {shutter_ms});
     tracer.SetFrameWindow(1, h);
     Rigid3 world_from_cam;
-    const CameraMotion motion = MakeCameraMotion(scene.rig_trajectory, 1, CamFromRig(), h > 0 ? h : 1.0, offset_ms,
-                                                 shutter_ms, readout_ms, kSize, &world_from_cam);
+    const CameraMotion motion =
+        MakeCameraMotion(ContinuousTrajectory(scene.rig_trajectory), 1, CamFromRig(), h > 0 ? h : 1.0, offset_ms,
+                         shutter_ms, readout_ms, kSize, &world_from_cam);
     CameraImage image;
     tracer.Render(rays, world_from_cam, settings, &image, &motion);
     return image;
@@ -181,7 +182,10 @@ TEST(Timing, TriggerOffsetEqualsRenderAtShiftedPose) {
   const CameraImage offset = r.Render(7.0, 0.0, 0.0);
   CameraImage shifted;
   r.tracer.SetFrame(1);
-  const Rigid3 world_from_cam = PoseAtTime(r.scene.rig_trajectory, nullptr, 0.107) * CamFromRig().Inverse();
+  // The rig between frames is the continuous-time ground truth (here a straight line at constant speed).
+  const ContinuousTrajectory rig_motion(r.scene.rig_trajectory);
+  const Rigid3 world_from_cam = rig_motion.Pose(0.107) * CamFromRig().Inverse();
+  EXPECT_NEAR(rig_motion.Pose(0.107).translation.y(), 1.07, 1e-12);
   r.tracer.Render(r.rays, world_from_cam, r.settings, &shifted);
   EXPECT_EQ(offset.linear, shifted.linear);
   // And the edge moved right by f * atan(speed * o / D) from the frame's time.
@@ -273,10 +277,11 @@ TEST(Timing, DynamicObjectBlursAlongItsMotion) {
   Rigid3 world_from_cam;
   const double h = 0.05;
   tracer.SetFrameWindow(1, h);
+  const ContinuousTrajectory rig_motion(scene.rig_trajectory);
   CameraMotion still =
-      MakeCameraMotion(scene.rig_trajectory, 1, rig.cameras[0].cam_from_rig, h, 0, 0, 0, rays.height, &world_from_cam);
-  CameraMotion blur = MakeCameraMotion(scene.rig_trajectory, 1, rig.cameras[0].cam_from_rig, h, 0, 100.0, 0,
-                                       rays.height, &world_from_cam);
+      MakeCameraMotion(rig_motion, 1, rig.cameras[0].cam_from_rig, h, 0, 0, 0, rays.height, &world_from_cam);
+  CameraMotion blur =
+      MakeCameraMotion(rig_motion, 1, rig.cameras[0].cam_from_rig, h, 0, 100.0, 0, rays.height, &world_from_cam);
   CameraImage sharp, blurred;
   tracer.Render(rays, world_from_cam, settings, &sharp, &still);
   tracer.Render(rays, world_from_cam, settings, &blurred, &blur);
