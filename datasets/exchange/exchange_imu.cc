@@ -10,6 +10,7 @@
 
 #include "datasets/continuous_trajectory.h"
 #include "datasets/exchange/exchange.h"
+#include "datasets/imu_model.h"
 #include "datasets/io.h"
 
 namespace rovo {
@@ -49,19 +50,20 @@ std::vector<double> Row(const Rigid3& b_from_a) {
 
 // EuRoC's ground-truth columns at every IMU sample, the body being the IMU (frame S).
 std::string ImuGroundTruthCsv(const Trajectory& frames, const DatasetInfo& info, const ImuStreams& streams) {
-  const ContinuousTrajectory trajectory(frames);
-  const Rigid3 rig_from_imu = info.rig.imu_from_rig->Inverse();
+  const std::vector<ImuGroundTruthState> states =
+      ImuGroundTruthStream(ContinuousTrajectory(frames), *info.rig.imu_from_rig, *info.imu);
+  if (states.size() != streams.bias.size()) {
+    throw std::runtime_error("imu/bias.csv: " + std::to_string(streams.bias.size()) + " samples, the IMU record " +
+                             std::to_string(states.size()));
+  }
   std::ostringstream out;
   out << "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], q_RS_z [], "
          "v_RS_R_x [m s^-1], v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], b_w_RS_S_x [rad s^-1], b_w_RS_S_y [rad s^-1], "
          "b_w_RS_S_z [rad s^-1], b_a_RS_S_x [m s^-2], b_a_RS_S_y [m s^-2], b_a_RS_S_z [m s^-2]\n";
-  for (size_t k = 0; k < streams.bias.size(); ++k) {
-    const double t = streams.bias[k].timestamp - info.imu->time_offset_s;  // the dataset's (camera) clock
-    const RigMotionState state = trajectory.State(t);
-    const Rigid3 world_from_imu = state.world_from_rig * rig_from_imu;
-    // Velocity of the IMU's origin: v_rig + R_wr (omega_rig x p_imu_in_rig).
-    const Eigen::Vector3d velocity =
-        state.linear_velocity + state.world_from_rig.rotation * state.angular_velocity.cross(rig_from_imu.translation);
+  for (size_t k = 0; k < states.size(); ++k) {
+    const double t = states[k].timestamp - info.imu->time_offset_s;  // the dataset's (camera) clock
+    const Rigid3& world_from_imu = states[k].world_from_imu;
+    const Eigen::Vector3d& velocity = states[k].velocity;
     const Eigen::Quaterniond& q = world_from_imu.rotation;
     out << SecondsToNs(t);
     for (double v : {world_from_imu.translation.x(), world_from_imu.translation.y(), world_from_imu.translation.z(),
