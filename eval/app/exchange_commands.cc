@@ -57,6 +57,11 @@ void RunExport(const ExportArgs& args) {
       "%.1f deg from the axis\n",
       report.frames, report.ground_truth ? "with" : "without", args.out.c_str(), args.format.c_str(),
       ExchangeLensModelName(report.model).c_str(), worst, half_px);
+  const DatasetInfo info = ReadDatasetInfo(args.dataset);
+  if (info.imu) {
+    std::printf("with the IMU: %d samples at %g Hz in mav0/imu0 (the body frame of every file is the IMU)\n",
+                info.imu->sample_count, info.imu->rate_hz);
+  }
 }
 
 void RunImportRos2(const std::string& bag, const std::string& out_dir) {
