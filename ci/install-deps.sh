@@ -1,10 +1,15 @@
 #!/usr/bin/env bash
-# Installs every Debian package rovo builds, tests and plots with. Idempotent: packages that are
-# already present are left alone, so a second run costs one dpkg query.
+# Installs the Debian packages rovo needs. Idempotent: packages that are already present are left
+# alone, so a second run costs one dpkg query.
+# Usage: ci/install-deps.sh [demo|all]   (default all)
+#   demo: what building rovo and running `rovo demo` need (ci/demo.sh);
+#   all:  also what the tests use: lint tools, Blender (exporter and Cycles cross-checks), Chromium
+#         (report screenshots), Slurm (batch tests).
 set -euo pipefail
+what=${1:-all}
 
 PACKAGES=(
-  build-essential cmake ninja-build pkg-config git ccache clang-format clang-tidy
+  build-essential cmake ninja-build pkg-config git ccache
   libembree-dev libtbb-dev
   libopenimageio-dev openimageio-tools
   libopencv-dev
@@ -12,10 +17,12 @@ PACKAGES=(
   nlohmann-json3-dev libyaml-cpp-dev libcli11-dev libfastcdr-dev zlib1g-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib python3-numpy python3-yaml
-  blender
-  chromium
-  slurm-wlm munge
 )
+case "$what" in
+  demo) ;;
+  all) PACKAGES+=(clang-format clang-tidy blender chromium slurm-wlm munge) ;;
+  *) echo "install-deps: unknown set '$what' (demo or all)" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -128,6 +128,37 @@ Rig MakeOmniMvs4() {
   return rig;
 }
 
+// A forward camera that stereo and monocular systems can model: an equidistant (Kannala-Brandt
+// with k1..k4 = 0) lens, 1024 x 768 px, 100 degrees across the width (f = 512 px / 50 deg), 75
+// degrees across the height, 125 degrees across the diagonal; max_fov_deg bounds the corners.
+Camera ForwardCamera() {
+  Camera camera;
+  camera.model = CameraModelId::kEquidistant;
+  camera.width = 1024;
+  camera.height = 768;
+  const double f = 512.0 / (50.0 * kDegToRad);
+  camera.params = {f, f, 511.5, 383.5, 0.0, 0.0, 0.0, 0.0};
+  camera.max_fov_deg = 2.0 * std::hypot(512.0, 384.0) / f / kDegToRad + 1.0;
+  return camera;
+}
+
+// rovo4 plus forward cameras looking along +x from the front edge of the roof (x = 0.5 m), 0.1 m
+// above the ring: at y = +-0.2 m (a 0.4 m stereo baseline, cam4 left, cam5 right) or one at y = 0.
+Rig MakeRovo4WithForward(bool stereo) {
+  Rig rig = MakeRovo4();
+  const std::vector<std::pair<std::string, double>> mounts =
+      stereo ? std::vector<std::pair<std::string, double>>{{"cam4", 0.2}, {"cam5", -0.2}}
+             : std::vector<std::pair<std::string, double>>{{"cam4", 0.0}};
+  for (const auto& [name, y] : mounts) {
+    RigCamera rc;
+    rc.name = name;
+    rc.camera = ForwardCamera();
+    rc.cam_from_rig = CamFromRigFromMount(0.0, 0.0, Eigen::Vector3d(0.5, y, 0.1));
+    rig.cameras.push_back(rc);
+  }
+  return rig;
+}
+
 }  // namespace
 
 Rigid3 CamFromRigFromMount(double yaw_deg, double pitch_deg, const Eigen::Vector3d& position_in_rig) {
@@ -213,10 +244,12 @@ Rigid3 PresetImuFromRig() {
   return Rigid3(imu_from_rig_rotation, -(imu_from_rig_rotation * imu_in_rig));
 }
 
-std::vector<std::string> RigPresetNames() { return {"rovo4", "omnimvs4", "rovo4_real"}; }
+std::vector<std::string> RigPresetNames() { return {"rovo4", "omnimvs4", "rovo4_real", "rovo4_stereo", "rovo4_mono"}; }
 
 Rig MakeRigPreset(const std::string& name) {
   if (name == "rovo4") return MakeRovo4();
+  if (name == "rovo4_stereo") return MakeRovo4WithForward(/*stereo=*/true);
+  if (name == "rovo4_mono") return MakeRovo4WithForward(/*stereo=*/false);
   if (name == "omnimvs4") return MakeOmniMvs4();
   if (name == "rovo4_real") return MakeRovo4RealRig();
   std::string known;

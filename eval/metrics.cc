@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "eval/body_offset.h"
+
 namespace rovo {
 
 UmeyamaResult AlignUmeyama(const std::vector<Eigen::Vector3d>& src, const std::vector<Eigen::Vector3d>& dst,
@@ -173,6 +175,51 @@ DriftResult RelativeDrift(const Trajectory& gt, const Trajectory& estimate, cons
   return result;
 }
 
+RelativePoseError ComputeRelativePoseError(const Trajectory& gt, const Trajectory& estimate,
+                                           const Association& association, double delta_s) {
+  RelativePoseError result;
+  result.delta_s = delta_s;
+  const size_t n = association.pairs.size();
+  if (n < 2 || !(delta_s > 0.0)) return result;
+  double sum_sq_translation = 0.0, sum_translation = 0.0, sum_distance = 0.0, sum_sq_rotation = 0.0;
+  size_t m = 0;
+  for (size_t k = 0; k < n; ++k) {
+    const double t_k = gt[association.pairs[k].first].timestamp;
+    m = std::max(m, k + 1);
+    while (m < n && gt[association.pairs[m].first].timestamp < t_k + delta_s - 1e-9) ++m;
+    if (m >= n) break;
+    if (gt[association.pairs[m].first].timestamp - t_k > 1.5 * delta_s) continue;
+    const auto [gi, ei] = association.pairs[k];
+    const auto [gj, ej] = association.pairs[m];
+    const Rigid3 gt_motion = gt[gi].world_from_rig.Inverse() * gt[gj].world_from_rig;
+    const Rigid3 est_motion = estimate[ei].world_from_rig.Inverse() * estimate[ej].world_from_rig;
+    const Rigid3 error = gt_motion.Inverse() * est_motion;
+    const double angle = RotationAngleDeg(error.rotation);
+    sum_sq_translation += error.translation.squaredNorm();
+    sum_translation += error.translation.norm();
+    sum_distance += gt_motion.translation.norm();
+    sum_sq_rotation += angle * angle;
+    ++result.num_pairs;
+  }
+  if (result.num_pairs > 0) {
+    result.translation_rmse_m = std::sqrt(sum_sq_translation / result.num_pairs);
+    result.translation_pct = sum_distance > 0.0 ? 100.0 * sum_translation / sum_distance : 0.0;
+    result.rotation_rmse_deg = std::sqrt(sum_sq_rotation / result.num_pairs);
+  }
+  return result;
+}
+
+void CheckEvalOptions(const EvalOptions& options) {
+  if (options.association != "auto" && options.association != "nearest" && options.association != "interpolate") {
+    throw std::invalid_argument("eval options: association `" + options.association +
+                                "` is not one of auto, nearest, interpolate");
+  }
+  if (options.align != "se3" && options.align != "sim3") {
+    throw std::invalid_argument("eval options: align `" + options.align + "` is not one of se3, sim3");
+  }
+  if (!(options.rpe_delta_s > 0.0)) throw std::invalid_argument("eval options: rpe_delta_s must be positive");
+}
+
 std::vector<ExtrinsicError> ExtrinsicErrors(const std::vector<ExtrinsicsRecord>& extrinsics,
                                             const std::vector<Rigid3>& gt_cam_from_rig) {
   std::vector<ExtrinsicError> errors;
@@ -250,46 +297,147 @@ std::pair<size_t, size_t> RunSpan(const RunData& run, size_t gt_size) {
   return {span_begin, span_end};
 }
 
+// The poses the metrics compare: the ground truth (at the estimate's times when interpolated), the
+// estimate (scaled with sim3) and their pairing.
+struct ScoredPoses {
+  Trajectory gt;
+  Trajectory estimate;
+  Association association;
+  std::vector<int> gt_index;  // per pose of `gt`: index of the (nearest) frame in the run's span
+};
+
+double AssociationTolerance(const Trajectory& gt, const EvalOptions& options) {
+  if (options.time_tolerance_s > 0.0) return options.time_tolerance_s;
+  const double interval = MedianInterval(gt);
+  return interval > 0.0 ? 0.25 * interval : 1e-3;
+}
+
+size_t NearestIndex(const Trajectory& trajectory, double t) {
+  const auto it = std::lower_bound(trajectory.begin(), trajectory.end(), t,
+                                   [](const StampedPose& p, double value) { return p.timestamp < value; });
+  if (it == trajectory.end()) return trajectory.size() - 1;
+  if (it == trajectory.begin()) return 0;
+  return (t - (it - 1)->timestamp <= it->timestamp - t) ? static_cast<size_t>(it - 1 - trajectory.begin())
+                                                        : static_cast<size_t>(it - trajectory.begin());
+}
+
+// Ground truth interpolated at every estimate inside its time range; missing = ground-truth frames
+// farther than max(tolerance, 0.75 x the estimate's median interval) from every estimate.
+ScoredPoses InterpolatedPoses(const Trajectory& gt, const Trajectory& estimate, double tolerance, int* missing) {
+  ScoredPoses out;
+  for (size_t j = 0; j < estimate.size(); ++j) {
+    const double t = estimate[j].timestamp;
+    if (t < gt.front().timestamp - 1e-9 || t > gt.back().timestamp + 1e-9) continue;
+    out.association.pairs.emplace_back(static_cast<int>(out.gt.size()), static_cast<int>(j));
+    out.gt.push_back({t, InterpolatePose(gt, t)});
+    out.gt_index.push_back(static_cast<int>(NearestIndex(gt, t)));
+  }
+  out.estimate = estimate;
+  const double reach = std::max(tolerance, 0.75 * MedianInterval(estimate));
+  *missing = 0;
+  for (const StampedPose& p : gt) {
+    if (estimate.empty() || std::abs(estimate[NearestIndex(estimate, p.timestamp)].timestamp - p.timestamp) > reach) {
+      ++*missing;
+    }
+  }
+  return out;
+}
+
+// Pairs the run's poses with the ground truth as options.association says (m: association, missing).
+ScoredPoses AssociatePoses(const Trajectory& gt, const Trajectory& estimate, const EvalOptions& options,
+                           RunMetrics* m) {
+  const double tolerance = AssociationTolerance(gt, options);
+  Association nearest = AssociateByTimestamp(gt, estimate, tolerance);
+  const bool interpolate =
+      options.association == "interpolate" ||
+      (options.association == "auto" && !estimate.empty() &&
+       static_cast<double>(nearest.estimate_without_gt.size()) > 0.1 * static_cast<double>(estimate.size()));
+  if (interpolate && !gt.empty()) {
+    m->association = "interpolate";
+    return InterpolatedPoses(gt, estimate, tolerance, &m->missing_frames);
+  }
+  m->association = "nearest";
+  m->missing_frames = static_cast<int>(nearest.gt_without_estimate.size());
+  ScoredPoses out{gt, estimate, std::move(nearest), {}};
+  for (const auto& pair : out.association.pairs) out.gt_index.push_back(pair.first);
+  return out;
+}
+
+// sim3: the Umeyama scale over the associated positions, applied to the estimate's positions.
+void ApplySim3Scale(ScoredPoses* poses, RunMetrics* m) {
+  std::vector<Eigen::Vector3d> src, dst;
+  for (const auto& [i, j] : poses->association.pairs) {
+    src.push_back(poses->estimate[j].world_from_rig.translation);
+    dst.push_back(poses->gt[i].world_from_rig.translation);
+  }
+  try {
+    m->scale = AlignUmeyama(src, dst, /*with_scale=*/true).scale;
+  } catch (const std::invalid_argument& e) {
+    m->alignment_note = std::string("Sim(3) scale impossible (kept 1): ") + e.what();
+    return;
+  }
+  for (StampedPose& p : poses->estimate) p.world_from_rig.translation *= m->scale;
+}
+
+// Drift, RPE and origin error of the estimate after the hand-eye body offset is removed.
+void ScoreBodyAligned(const ScoredPoses& poses, const EvalOptions& options, BodyAlignedMetrics* body) {
+  const BodyOffset offset = EstimateBodyOffset(poses.gt, poses.estimate, poses.association);
+  body->note = offset.note;
+  if (!offset.valid) return;
+  body->available = true;
+  body->offset_rotation_deg = RotationAngleDeg(offset.rig_from_body.rotation);
+  body->offset_translation_m = offset.rig_from_body.translation;
+  body->offset_translation_rank = offset.translation_rank;
+  body->offset_rotation_residual_deg = offset.rotation_residual_deg;
+  const Trajectory aligned = RemoveBodyOffset(poses.estimate, offset.rig_from_body);
+  body->rmse_origin_m =
+      TranslationRmse(poses.gt, aligned, poses.association, AlignOrigin(poses.gt, aligned, poses.association));
+  body->drift = RelativeDrift(poses.gt, aligned, poses.association);
+  body->rpe = ComputeRelativePoseError(poses.gt, aligned, poses.association, options.rpe_delta_s);
+}
+
 // Associates the run's poses with `gt` (the run's span, starting at `span_begin` of the full ground
 // truth), aligns them and fills the trajectory metrics, gt_from_est and the per-frame errors.
-void ScoreTrajectory(const Trajectory& gt, const RunData& run, size_t span_begin, const EvalOptions& options,
+void ScoreTrajectory(const Trajectory& span_gt, const RunData& run, size_t span_begin, const EvalOptions& options,
                      RunEvaluation* out) {
   RunMetrics& m = out->metrics;
-  double tolerance = options.time_tolerance_s;
-  if (tolerance <= 0.0) {
-    const double interval = MedianInterval(gt);
-    tolerance = interval > 0.0 ? 0.25 * interval : 1e-3;
-  }
-  const Association association = AssociateByTimestamp(gt, run.trajectory, tolerance);
+  m.align = options.align;
+  ScoredPoses poses = AssociatePoses(span_gt, run.trajectory, options, &m);
+  const Trajectory& gt = poses.gt;
+  const Association& association = poses.association;
   m.associated_frames = static_cast<int>(association.pairs.size());
-  m.missing_frames = static_cast<int>(association.gt_without_estimate.size());
-
   if (association.pairs.empty()) {
     m.alignment_note = "no estimated pose matches a ground-truth timestamp";
     return;
   }
-  const Rigid3 origin = AlignOrigin(gt, run.trajectory, association);
-  m.rmse_origin_m = TranslationRmse(gt, run.trajectory, association, origin);
+  if (options.align == "sim3") ApplySim3Scale(&poses, &m);
+  const Trajectory& estimate = poses.estimate;
+  const Rigid3 origin = AlignOrigin(gt, estimate, association);
+  m.rmse_origin_m = TranslationRmse(gt, estimate, association, origin);
   out->gt_from_est = origin;
   try {
-    out->gt_from_est = AlignSe3(gt, run.trajectory, association);
-    m.rmse_se3_m = TranslationRmse(gt, run.trajectory, association, out->gt_from_est);
+    out->gt_from_est = AlignSe3(gt, estimate, association);
+    m.rmse_se3_m = TranslationRmse(gt, estimate, association, out->gt_from_est);
     if (m.path_length_m > 0.0) m.relative_rmse_pct = 100.0 * *m.rmse_se3_m / m.path_length_m;
   } catch (const std::invalid_argument& e) {
-    m.alignment_note =
-        std::string("SE(3) alignment impossible: ") + e.what() + "; error along path uses origin alignment";
+    m.alignment_note += std::string(m.alignment_note.empty() ? "" : "; ") + "SE(3) alignment impossible: " + e.what() +
+                        "; error along path uses origin alignment";
   }
-  for (const auto& [i, j] : association.pairs) {
+  for (size_t k = 0; k < association.pairs.size(); ++k) {
+    const auto [i, j] = association.pairs[k];
     FrameError fe;
-    fe.gt_index = static_cast<int>(i + span_begin);  // index in the full ground truth
+    fe.gt_index = static_cast<int>(static_cast<size_t>(poses.gt_index[k]) + span_begin);  // in the full gt
     fe.estimate_index = j;
     fe.timestamp = gt[i].timestamp;
+    fe.gt_world_from_rig = gt[i].world_from_rig;
     fe.gt_position = gt[i].world_from_rig.translation;
-    fe.aligned_position = out->gt_from_est * run.trajectory[j].world_from_rig.translation;
+    fe.aligned_position = out->gt_from_est * estimate[j].world_from_rig.translation;
     fe.error_m = (fe.gt_position - fe.aligned_position).norm();
     out->frame_errors.push_back(fe);
   }
-  m.drift = RelativeDrift(gt, run.trajectory, association);
+  m.drift = RelativeDrift(gt, estimate, association);
+  m.rpe = ComputeRelativePoseError(gt, estimate, association, options.rpe_delta_s);
+  ScoreBodyAligned(poses, options, &m.body);
 }
 
 // Lost frames, mean inlier ratio and reprojection error over ok frames, mean time over all frames.
@@ -347,6 +495,7 @@ RunEvaluation EvaluateRun(const Trajectory& full_gt, const std::vector<Rigid3>& 
                           const std::string& label, const EvalOptions& options) {
   const auto [span_begin, span_end] = RunSpan(run, full_gt.size());
   const Trajectory gt(full_gt.begin() + static_cast<long>(span_begin), full_gt.begin() + static_cast<long>(span_end));
+  CheckEvalOptions(options);
   RunEvaluation out;
   RunMetrics& m = out.metrics;
   m.label = label;

@@ -71,6 +71,21 @@ DriftResult RelativeDrift(const Trajectory& gt, const Trajectory& estimate, cons
                           const std::vector<double>& fractions = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8},
                           int step = 1);
 
+// Relative pose error over a fixed time interval (independent of the estimate's rate): for every
+// associated pose i, j is the first associated pose with t_j >= t_i + delta_s (the pair is skipped
+// when t_j - t_i > 1.5 delta_s, a gap in the estimate), and E = (gt_i^-1 gt_j)^-1 (est_i^-1 est_j):
+// translation RMS |t(E)| [m], 100 * sum |t(E)| / sum d_ij [%] with d_ij the ground truth's distance
+// between i and j, rotation RMS angle(E) [deg].
+struct RelativePoseError {
+  double delta_s = 1.0;
+  int num_pairs = 0;
+  double translation_rmse_m = 0.0;
+  double translation_pct = 0.0;
+  double rotation_rmse_deg = 0.0;
+};
+RelativePoseError ComputeRelativePoseError(const Trajectory& gt, const Trajectory& estimate,
+                                           const Association& association, double delta_s = 1.0);
+
 // Extrinsic error of camera i relative to camera 0 at one frame (the gauge of online calibration):
 //   cam_i_from_cam0 = cam_i_from_rig * cam0_from_rig^-1, estimated vs ground truth;
 //   rotation error = angle(gt^-1 est) in degrees, translation error = |t_est - t_gt| in metres.
@@ -91,6 +106,21 @@ struct ExtrinsicError {
 std::vector<ExtrinsicError> ExtrinsicErrors(const std::vector<ExtrinsicsRecord>& extrinsics,
                                             const std::vector<Rigid3>& gt_cam_from_rig);
 
+// The metrics that depend on the reported body, recomputed after removing the fixed body offset
+// that the hand-eye calibration of eval/body_offset.h finds ("body-aligned"; the raw figures count
+// the offset as error).
+struct BodyAlignedMetrics {
+  bool available = false;
+  std::string note;                  // why unavailable, or which offset directions the motion leaves free
+  double offset_rotation_deg = 0.0;  // angle of rig_from_body's rotation
+  Eigen::Vector3d offset_translation_m = Eigen::Vector3d::Zero();  // rig_from_body's translation
+  int offset_translation_rank = 0;  // directions of the translation the motion determines (0..3)
+  double offset_rotation_residual_deg = 0.0;
+  std::optional<double> rmse_origin_m;
+  DriftResult drift;
+  RelativePoseError rpe;
+};
+
 // Everything `rovo eval` reports for one run.
 struct RunMetrics {
   std::string label;
@@ -106,9 +136,14 @@ struct RunMetrics {
   std::optional<double> rmse_origin_m;
   std::optional<double> relative_rmse_pct;  // 100 * rmse_se3 / path length
   DriftResult drift;
-  double mean_inlier_ratio = 0.0;      // over frames with status ok
-  double mean_reproj_error_deg = 0.0;  // over frames with status ok
-  double mean_time_ms = 0.0;           // over all frames
+  RelativePoseError rpe;
+  BodyAlignedMetrics body;              // drift, RPE and origin error after removing the body offset
+  std::string align = "se3";            // se3 | sim3 (EvalOptions::align)
+  double scale = 1.0;                   // sim3: the estimate's positions were multiplied by it first
+  std::string association = "nearest";  // nearest | interpolate (EvalOptions::association)
+  double mean_inlier_ratio = 0.0;       // over frames with status ok
+  double mean_reproj_error_deg = 0.0;   // over frames with status ok
+  double mean_time_ms = 0.0;            // over all frames
   // Per camera i >= 1 (index i-1): error at the last frame, and mean over frames.
   std::vector<double> final_ext_rotation_deg, final_ext_translation_m;
   std::vector<double> mean_ext_rotation_deg, mean_ext_translation_m;
@@ -125,6 +160,7 @@ struct FrameError {
   Eigen::Vector3d gt_position = Eigen::Vector3d::Zero();
   Eigen::Vector3d aligned_position = Eigen::Vector3d::Zero();
   double error_m = 0.0;
+  Rigid3 gt_world_from_rig;  // the ground truth at `timestamp` (interpolated with association interpolate)
 };
 
 struct RunEvaluation {
@@ -136,7 +172,19 @@ struct RunEvaluation {
 
 struct EvalOptions {
   double time_tolerance_s = 0.0;  // 0 = a quarter of the gt frame interval
+  // nearest: each ground-truth frame pairs with the nearest estimate within the tolerance;
+  // interpolate: the ground truth is interpolated (slerp + linear, only inside its time range) at
+  // every estimate's time, for estimates at any rate; auto: nearest unless more than 10 % of the
+  // estimates are not within the tolerance of a ground-truth frame (e.g. VIO output at 200 Hz).
+  std::string association = "auto";
+  // se3: rigid alignment (metric systems); sim3: the scale too (Umeyama), for monocular systems:
+  // the estimate's positions are scaled by it before every metric.
+  std::string align = "se3";
+  double rpe_delta_s = 1.0;  // interval of the relative pose error
 };
+
+// Throws std::invalid_argument naming the field when association or align is not a known value.
+void CheckEvalOptions(const EvalOptions& options);
 
 // Scores one run; `gt_cam_from_rig` is the dataset's ground-truth rig extrinsics.
 RunEvaluation EvaluateRun(const Trajectory& gt, const std::vector<Rigid3>& gt_cam_from_rig, const RunData& run,

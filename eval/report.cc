@@ -38,6 +38,76 @@ std::string Csv(std::initializer_list<std::string> fields) {
 
 std::string Num(double value) { return Fmt("%.10g", value); }
 
+// The keys of the association, alignment, RPE and body-aligned metrics (all optional when read back:
+// metrics.json files written before them lack them).
+void AddBodyFrameJson(const RunMetrics& m, nlohmann::json* out) {
+  nlohmann::json& j = *out;
+  j["association"] = m.association;
+  j["align"] = m.align;
+  j["sim3_scale"] = m.scale;
+  j["rpe_delta_s"] = m.rpe.delta_s;
+  j["rpe_pairs"] = m.rpe.num_pairs;
+  j["rpe_translation_m"] = m.rpe.translation_rmse_m;
+  j["rpe_translation_pct"] = m.rpe.translation_pct;
+  j["rpe_rotation_deg"] = m.rpe.rotation_rmse_deg;
+  const BodyAlignedMetrics& b = m.body;
+  j["body_aligned_available"] = b.available;
+  j["body_aligned_note"] = b.note;
+  j["body_offset_rotation_deg"] = b.offset_rotation_deg;
+  j["body_offset_translation_m"] = {b.offset_translation_m.x(), b.offset_translation_m.y(), b.offset_translation_m.z()};
+  j["body_offset_translation_rank"] = b.offset_translation_rank;
+  j["body_offset_rotation_residual_deg"] = b.offset_rotation_residual_deg;
+  j["body_aligned_rmse_origin_m"] = OptToJson(b.rmse_origin_m);
+  j["body_aligned_drift_translation_pct"] = b.drift.translation_pct;
+  j["body_aligned_drift_rotation_deg_per_100m"] = b.drift.rotation_deg_per_100m;
+  j["body_aligned_drift_segments"] = b.drift.num_segments;
+  j["body_aligned_rpe_pairs"] = b.rpe.num_pairs;
+  j["body_aligned_rpe_translation_m"] = b.rpe.translation_rmse_m;
+  j["body_aligned_rpe_translation_pct"] = b.rpe.translation_pct;
+  j["body_aligned_rpe_rotation_deg"] = b.rpe.rotation_rmse_deg;
+}
+
+template <typename T>
+void ReadOptional(const nlohmann::json& j, const char* key, T* value) {
+  if (j.contains(key) && !j.at(key).is_null()) *value = j.at(key).get<T>();
+}
+
+void ReadBodyFrameJson(const nlohmann::json& j, RunMetrics* m) {
+  ReadOptional(j, "association", &m->association);
+  ReadOptional(j, "align", &m->align);
+  ReadOptional(j, "sim3_scale", &m->scale);
+  ReadOptional(j, "rpe_delta_s", &m->rpe.delta_s);
+  ReadOptional(j, "rpe_pairs", &m->rpe.num_pairs);
+  ReadOptional(j, "rpe_translation_m", &m->rpe.translation_rmse_m);
+  ReadOptional(j, "rpe_translation_pct", &m->rpe.translation_pct);
+  ReadOptional(j, "rpe_rotation_deg", &m->rpe.rotation_rmse_deg);
+  BodyAlignedMetrics& b = m->body;
+  ReadOptional(j, "body_aligned_available", &b.available);
+  ReadOptional(j, "body_aligned_note", &b.note);
+  ReadOptional(j, "body_offset_rotation_deg", &b.offset_rotation_deg);
+  if (j.contains("body_offset_translation_m")) {
+    const auto t = j.at("body_offset_translation_m").get<std::vector<double>>();
+    if (t.size() == 3) b.offset_translation_m = Eigen::Vector3d(t[0], t[1], t[2]);
+  }
+  ReadOptional(j, "body_offset_translation_rank", &b.offset_translation_rank);
+  ReadOptional(j, "body_offset_rotation_residual_deg", &b.offset_rotation_residual_deg);
+  if (j.contains("body_aligned_rmse_origin_m") && j.at("body_aligned_rmse_origin_m").is_number()) {
+    b.rmse_origin_m = j.at("body_aligned_rmse_origin_m").get<double>();
+  }
+  ReadOptional(j, "body_aligned_drift_translation_pct", &b.drift.translation_pct);
+  ReadOptional(j, "body_aligned_drift_rotation_deg_per_100m", &b.drift.rotation_deg_per_100m);
+  ReadOptional(j, "body_aligned_drift_segments", &b.drift.num_segments);
+  ReadOptional(j, "body_aligned_rpe_pairs", &b.rpe.num_pairs);
+  ReadOptional(j, "body_aligned_rpe_translation_m", &b.rpe.translation_rmse_m);
+  ReadOptional(j, "body_aligned_rpe_translation_pct", &b.rpe.translation_pct);
+  ReadOptional(j, "body_aligned_rpe_rotation_deg", &b.rpe.rotation_rmse_deg);
+}
+
+// "raw → body-aligned" of one figure (n/a when the body offset could not be estimated).
+std::string RawAndAligned(const char* format, double raw, bool available, double aligned) {
+  return Fmt(format, raw) + " → " + (available ? Fmt(format, aligned) : std::string("n/a"));
+}
+
 }  // namespace
 
 nlohmann::json MetricsToJson(const RunMetrics& m) {
@@ -58,6 +128,7 @@ nlohmann::json MetricsToJson(const RunMetrics& m) {
   j["drift_rotation_deg_per_100m"] = m.drift.rotation_deg_per_100m;
   j["drift_segments"] = m.drift.num_segments;
   j["drift_segment_lengths_m"] = m.drift.segment_lengths_m;
+  AddBodyFrameJson(m, &j);
   j["mean_inlier_ratio"] = m.mean_inlier_ratio;
   j["mean_reproj_error_deg"] = m.mean_reproj_error_deg;
   j["mean_time_ms"] = m.mean_time_ms;
@@ -110,6 +181,7 @@ RunMetrics MetricsFromJson(const nlohmann::json& j, const std::string& what) {
     m.max_final_ext_rotation_deg = field("max_final_ext_rotation_deg").get<double>();
     m.max_final_ext_translation_m = field("max_final_ext_translation_m").get<double>();
     m.alignment_note = field("alignment_note").get<std::string>();
+    ReadBodyFrameJson(j, &m);
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(what + ": bad metrics object: " + e.what());
   }
@@ -126,20 +198,44 @@ std::string MetricsLegendMarkdown() {
          "[deg]; **ext rot / ext trans** = largest error over cameras i >= 1 of cam_i_from_cam0 at the last frame "
          "[deg / m]; **ms/frame** = mean wall time per frame. Frames = associated / ground-truth frames. Mode "
          "external: a trajectory written by another system, without frames.csv/run.json/extrinsics.csv, so "
-         "inliers, reproj, ext rot, ext trans and ms/frame are n/a.\n";
+         "inliers, reproj, ext rot, ext trans and ms/frame are n/a. **RPE** = relative pose error over --rpe-delta "
+         "(default 1 s) "
+         "(translation % of the distance travelled, rotation RMS deg). Columns \"raw → body-aligned\": the raw "
+         "figure compares the body the system reports (rovo: the rig with camera 0 as the gauge, so a perturbed "
+         "camera 0 turns it; a VIO: its IMU) with the ground truth's rig, so a fixed body offset counts as error; "
+         "body-aligned removes the offset that hand-eye calibration (AX = XB over the relative motions) finds "
+         "first. **body offset** = that offset's rotation [deg] and translation [m] (the translation only along "
+         "the directions the motion determines: planar motion leaves the vertical free). SE(3) and Sim(3) "
+         "alignment remove a world offset, which no figure counts; with --align sim3 the estimate's positions are "
+         "scaled first.\n";
 }
 
 std::string RunTableMarkdown(const std::vector<RunMetrics>& runs) {
   std::string md =
-      "| run | mode | noise set | frames | RMSE SE(3) [m] | rel. [%] | RMSE origin [m] | drift [%] | drift "
-      "[deg/100m] | inliers [%] | reproj [deg] | ext rot [deg] | ext trans [m] | ms/frame |\n"
-      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+      "| run | mode | noise set | frames | RMSE SE(3) [m] | rel. [%] | RMSE origin [m] raw → body-aligned | drift "
+      "[%] raw → body-aligned | drift [deg/100m] raw → body-aligned | RPE [%] raw → body-aligned | RPE "
+      "[deg] raw → body-aligned | body offset [deg, m] | inliers [%] | reproj [deg] | ext rot [deg] | ext trans "
+      "[m] | ms/frame |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const RunMetrics& m : runs) {
-    md += "| " + m.label + " | " + m.mode + " | " + (m.noise_set >= 0 ? std::to_string(m.noise_set) : "-") + " | " +
+    const BodyAlignedMetrics& b = m.body;
+    const std::string origin = FmtOpt("%.4f", m.rmse_origin_m) + " → " + FmtOpt("%.4f", b.rmse_origin_m);
+    const std::string offset =
+        b.available
+            ? Fmt("%.3f", b.offset_rotation_deg) + ", " + Fmt("%.3f", b.offset_translation_m.norm()) +
+                  (b.offset_translation_rank < 3 ? " (" + std::to_string(b.offset_translation_rank) + " of 3 axes)"
+                                                 : std::string())
+            : std::string("n/a");
+    std::string sequence = m.label + " | " + m.mode;
+    if (m.align == "sim3") sequence += " (sim3 ×" + Fmt("%.4g", m.scale) + ")";
+    md += "| " + sequence + " | " + (m.noise_set >= 0 ? std::to_string(m.noise_set) : "-") + " | " +
           std::to_string(m.associated_frames) + "/" + std::to_string(m.gt_frames) + " | " +
-          FmtOpt("%.4f", m.rmse_se3_m) + " | " + FmtOpt("%.4f", m.relative_rmse_pct) + " | " +
-          FmtOpt("%.4f", m.rmse_origin_m) + " | " + Fmt("%.3f", m.drift.translation_pct) + " | " +
-          Fmt("%.3f", m.drift.rotation_deg_per_100m) + " | " +
+          FmtOpt("%.4f", m.rmse_se3_m) + " | " + FmtOpt("%.4f", m.relative_rmse_pct) + " | " + origin + " | " +
+          RawAndAligned("%.3f", m.drift.translation_pct, b.available, b.drift.translation_pct) + " | " +
+          RawAndAligned("%.3f", m.drift.rotation_deg_per_100m, b.available, b.drift.rotation_deg_per_100m) + " | " +
+          RawAndAligned("%.3f", m.rpe.translation_pct, b.available, b.rpe.translation_pct) + " | " +
+          RawAndAligned("%.4f", m.rpe.rotation_rmse_deg, b.available, b.rpe.rotation_rmse_deg) + " | " + offset +
+          " | " +
           (m.mode == "external"  // no frames.csv / extrinsics.csv
                ? std::string("n/a | n/a | n/a | n/a | n/a |\n")
                : Fmt("%.1f", 100.0 * m.mean_inlier_ratio) + " | " + Fmt("%.3f", m.mean_reproj_error_deg) + " | " +
@@ -193,8 +289,9 @@ static void WriteRunFiles(const std::string& run_out, const RunEvaluation& evalu
     // Line k of both files is the k-th associated frame; the estimate is mapped into the gt world.
     Trajectory est_aligned, gt_associated;
     for (const FrameError& e : evaluation.frame_errors) {
-      gt_associated.push_back(gt[static_cast<size_t>(e.gt_index)]);
-      const StampedPose& est = run.trajectory[static_cast<size_t>(e.estimate_index)];
+      gt_associated.push_back({e.timestamp, e.gt_world_from_rig});
+      StampedPose est = run.trajectory[static_cast<size_t>(e.estimate_index)];
+      est.world_from_rig.translation *= evaluation.metrics.scale;  // 1 unless --align sim3
       est_aligned.push_back({est.timestamp, evaluation.gt_from_est * est.world_from_rig});
     }
     WriteKitti((fs::path(run_out) / "kitti_estimate.txt").string(), est_aligned);
@@ -215,21 +312,72 @@ static nlohmann::json RunJson(const RunEvaluation& evaluation, const RunData& ru
 }
 
 static std::string SummaryHeader() {
-  return Csv({"label", "mode", "noise_set", "run_seed", "gt_frames", "associated_frames", "missing_frames",
-              "lost_frames", "path_length_m", "rmse_se3_m", "relative_rmse_pct", "rmse_origin_m",
-              "drift_translation_pct", "drift_rotation_deg_per_100m", "mean_inlier_ratio", "mean_reproj_error_deg",
-              "max_final_ext_rotation_deg", "max_final_ext_translation_m", "mean_time_ms"});
+  return Csv({"label",
+              "mode",
+              "noise_set",
+              "run_seed",
+              "gt_frames",
+              "associated_frames",
+              "missing_frames",
+              "lost_frames",
+              "path_length_m",
+              "rmse_se3_m",
+              "relative_rmse_pct",
+              "rmse_origin_m",
+              "drift_translation_pct",
+              "drift_rotation_deg_per_100m",
+              "mean_inlier_ratio",
+              "mean_reproj_error_deg",
+              "max_final_ext_rotation_deg",
+              "max_final_ext_translation_m",
+              "mean_time_ms",
+              "align",
+              "sim3_scale",
+              "association",
+              "rpe_translation_pct",
+              "rpe_rotation_deg",
+              "body_aligned_rmse_origin_m",
+              "body_aligned_drift_translation_pct",
+              "body_aligned_drift_rotation_deg_per_100m",
+              "body_aligned_rpe_translation_pct",
+              "body_aligned_rpe_rotation_deg",
+              "body_offset_rotation_deg",
+              "body_offset_translation_rank"});
 }
 
 // One summary.csv row; `run_seed` is the run's metrics.json seed as JSON text.
 static std::string SummaryRow(const RunMetrics& m, const nlohmann::json& run_seed) {
-  return Csv({m.label, m.mode, std::to_string(m.noise_set), run_seed.dump(), std::to_string(m.gt_frames),
-              std::to_string(m.associated_frames), std::to_string(m.missing_frames), std::to_string(m.lost_frames),
-              Num(m.path_length_m), m.rmse_se3_m ? Num(*m.rmse_se3_m) : "",
-              m.relative_rmse_pct ? Num(*m.relative_rmse_pct) : "", m.rmse_origin_m ? Num(*m.rmse_origin_m) : "",
-              Num(m.drift.translation_pct), Num(m.drift.rotation_deg_per_100m), Num(m.mean_inlier_ratio),
-              Num(m.mean_reproj_error_deg), Num(m.max_final_ext_rotation_deg), Num(m.max_final_ext_translation_m),
-              Num(m.mean_time_ms)});
+  return Csv({m.label,
+              m.mode,
+              std::to_string(m.noise_set),
+              run_seed.dump(),
+              std::to_string(m.gt_frames),
+              std::to_string(m.associated_frames),
+              std::to_string(m.missing_frames),
+              std::to_string(m.lost_frames),
+              Num(m.path_length_m),
+              m.rmse_se3_m ? Num(*m.rmse_se3_m) : "",
+              m.relative_rmse_pct ? Num(*m.relative_rmse_pct) : "",
+              m.rmse_origin_m ? Num(*m.rmse_origin_m) : "",
+              Num(m.drift.translation_pct),
+              Num(m.drift.rotation_deg_per_100m),
+              Num(m.mean_inlier_ratio),
+              Num(m.mean_reproj_error_deg),
+              Num(m.max_final_ext_rotation_deg),
+              Num(m.max_final_ext_translation_m),
+              Num(m.mean_time_ms),
+              m.align,
+              Num(m.scale),
+              m.association,
+              Num(m.rpe.translation_pct),
+              Num(m.rpe.rotation_rmse_deg),
+              m.body.rmse_origin_m ? Num(*m.body.rmse_origin_m) : "",
+              m.body.available ? Num(m.body.drift.translation_pct) : "",
+              m.body.available ? Num(m.body.drift.rotation_deg_per_100m) : "",
+              m.body.available ? Num(m.body.rpe.translation_pct) : "",
+              m.body.available ? Num(m.body.rpe.rotation_rmse_deg) : "",
+              m.body.available ? Num(m.body.offset_rotation_deg) : "",
+              std::to_string(m.body.offset_translation_rank)});
 }
 
 // The dataset-wide files: groundtruth.csv, summary.csv, table.md, metrics.json and (with plots) report.html.

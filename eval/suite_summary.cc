@@ -20,6 +20,31 @@ Stat ComputeStat(const std::vector<double>& values) {
   return s;
 }
 
+namespace {
+
+// The RPE and body-aligned metrics (eval/body_offset.h): outer empty when `name` is not one of them,
+// inner empty when the run has no value.
+std::optional<std::optional<double>> BodyFrameMetricValue(const RunMetrics& m, const std::string& name) {
+  using Value = std::optional<double>;
+  const BodyAlignedMetrics& b = m.body;
+  const Value rpe = m.rpe.num_pairs > 0 ? Value(0.0) : std::nullopt;
+  const Value body_drift = b.available && b.drift.num_segments > 0 ? Value(0.0) : std::nullopt;
+  const Value body_rpe = b.available && b.rpe.num_pairs > 0 ? Value(0.0) : std::nullopt;
+  if (name == "rpe_translation_pct") return rpe ? Value(m.rpe.translation_pct) : std::nullopt;
+  if (name == "rpe_rotation_deg") return rpe ? Value(m.rpe.rotation_rmse_deg) : std::nullopt;
+  if (name == "body_aligned_rmse_origin_m") return b.available ? b.rmse_origin_m : std::nullopt;
+  if (name == "body_aligned_drift_translation_pct") return body_drift ? Value(b.drift.translation_pct) : std::nullopt;
+  if (name == "body_aligned_drift_rotation_deg_per_100m") {
+    return body_drift ? Value(b.drift.rotation_deg_per_100m) : std::nullopt;
+  }
+  if (name == "body_aligned_rpe_translation_pct") return body_rpe ? Value(b.rpe.translation_pct) : std::nullopt;
+  if (name == "body_aligned_rpe_rotation_deg") return body_rpe ? Value(b.rpe.rotation_rmse_deg) : std::nullopt;
+  if (name == "body_offset_rotation_deg") return b.available ? Value(b.offset_rotation_deg) : std::nullopt;
+  return std::nullopt;
+}
+
+}  // namespace
+
 const std::vector<std::string>& AggregatedMetricNames() {
   static const std::vector<std::string> names = {"rmse_se3_m",
                                                  "relative_rmse_pct",
@@ -32,7 +57,15 @@ const std::vector<std::string>& AggregatedMetricNames() {
                                                  "max_final_ext_translation_m",
                                                  "mean_time_ms",
                                                  "lost_frames",
-                                                 "missing_frames"};
+                                                 "missing_frames",
+                                                 "rpe_translation_pct",
+                                                 "rpe_rotation_deg",
+                                                 "body_aligned_rmse_origin_m",
+                                                 "body_aligned_drift_translation_pct",
+                                                 "body_aligned_drift_rotation_deg_per_100m",
+                                                 "body_aligned_rpe_translation_pct",
+                                                 "body_aligned_rpe_rotation_deg",
+                                                 "body_offset_rotation_deg"};
   return names;
 }
 
@@ -52,6 +85,7 @@ std::optional<double> MetricValue(const RunMetrics& m, const std::string& name) 
   if (name == "mean_time_ms") return m.mean_time_ms;
   if (name == "lost_frames") return static_cast<double>(m.lost_frames);
   if (name == "missing_frames") return static_cast<double>(m.missing_frames);
+  if (const auto v = BodyFrameMetricValue(m, name)) return *v;
   throw std::invalid_argument("unknown metric \"" + name + "\"");
 }
 

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "datasets/dataset.h"
+#include "datasets/dataset_cameras.h"
 #include "datasets/io.h"
 #include "datasets/lens_angle_scale.h"
 #include "datasets/progress.h"
@@ -262,7 +263,12 @@ Trajectory GroundTruthIfAny(const std::string& dataset_dir) {
 VoSummary RunVo(const VoOptions& options) {
   const auto run_start = Clock::now();
   options.Check();
-  const DatasetInfo info = ReadDatasetInfo(options.io.dataset_dir);
+  const DatasetInfo full_info = ReadDatasetInfo(options.io.dataset_dir);
+  const std::vector<int> vo_cameras = VoCameraIndices(options.io.cameras, full_info.rig);
+  // The VO sees only these cameras; its camera j is dataset camera vo_cameras[j].
+  const DatasetInfo info = static_cast<int>(vo_cameras.size()) == full_info.rig.NumCameras()
+                               ? full_info
+                               : SelectDatasetCameras(full_info, vo_cameras, "vo: --cameras");
   const int num_cams = info.rig.NumCameras();
   const int begin = options.io.frames.begin;
   const int end = options.io.frames.end < 0 ? info.frame_count : options.io.frames.end;
@@ -323,7 +329,9 @@ VoSummary RunVo(const VoOptions& options) {
     CountFrame(rec, &summary, &ok_ratio_sum, &ok_error_sum);
     run.frames.push_back(rec);
     run.trajectory.push_back({rec.timestamp, result.world_from_rig});
-    for (int j = 0; j < num_cams; ++j) run.extrinsics.push_back({frame, rec.timestamp, j, backend.cam_from_rig()[j]});
+    for (int j = 0; j < num_cams; ++j) {
+      run.extrinsics.push_back({frame, rec.timestamp, vo_cameras[static_cast<size_t>(j)], backend.cam_from_rig()[j]});
+    }
     progress.Add();
   }
   if (auto update = backend.FinishPendingBa()) ApplyBaUpdate(*update, backend.cam_from_rig(), &run, &ms);
@@ -333,6 +341,7 @@ VoSummary RunVo(const VoOptions& options) {
   summary.mean_reproj_error_deg = summary.frames_ok > 0 ? ok_error_sum / summary.frames_ok : 0.0;
   summary.seconds = std::chrono::duration<double>(Clock::now() - run_start).count();
   run.info = RunInfoJson(options, info, backend_options, summary, startup, begin, end, world_from_rig0);
+  run.info["vo_cameras"] = vo_cameras;
   WriteRun(options.io.out_dir, run);
   return summary;
 }

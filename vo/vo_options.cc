@@ -1,6 +1,7 @@
 #include "vo/vo_options.h"
 
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -28,6 +29,47 @@ std::string ExtrinsicsModeName(ExtrinsicsMode mode) {
 void VoIoOptions::Check() const {
   if (dataset_dir.empty()) throw std::invalid_argument("vo: no dataset folder given");
   if (out_dir.empty()) throw std::invalid_argument("vo: no output (run) folder given");
+}
+
+std::vector<int> VoCameraIndices(const std::string& cameras, const Rig& rig) {
+  std::vector<int> out;
+  if (cameras == "auto" || cameras == "all") {
+    for (int i = 0; i < rig.NumCameras(); ++i) {
+      if (cameras == "all" || rig.cameras[static_cast<size_t>(i)].camera.max_fov_deg > 180.0) out.push_back(i);
+    }
+    if (out.empty()) {
+      for (int i = 0; i < rig.NumCameras(); ++i) out.push_back(i);
+    }
+    return out;
+  }
+  std::stringstream list(cameras);
+  for (std::string item; std::getline(list, item, ',');) {
+    size_t used = 0;
+    int index = -1;
+    try {
+      index = std::stoi(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size()) {
+      throw std::invalid_argument("vo: --cameras " + cameras + ": `" + item +
+                                  "` is not a camera index (auto, all or "
+                                  "indices such as 0,1,2,3)");
+    }
+    if (index < 0 || index >= rig.NumCameras()) {
+      throw std::invalid_argument("vo: --cameras " + cameras + ": camera " + item + " does not exist (the rig has " +
+                                  std::to_string(rig.NumCameras()) + ")");
+    }
+    if (!out.empty() && index <= out.back()) {
+      throw std::invalid_argument("vo: --cameras " + cameras + ": indices must increase");
+    }
+    out.push_back(index);
+  }
+  if (out.empty() || out.front() != 0) {
+    throw std::invalid_argument("vo: --cameras " + cameras +
+                                ": must include camera 0 (the gauge of the rig frame and of the extrinsics)");
+  }
+  return out;
 }
 
 void VoStartOptions::Check() const {

@@ -34,7 +34,11 @@ struct VoIoOptions {
   int threads = 0;       // 0: all cores
   bool quiet = false;    // no progress output
   bool preload = false;  // decode all frames before the loop (timing without PNG decoding)
-  void Check() const;    // throws std::invalid_argument naming the flag
+  // The dataset cameras the VO uses: "auto" (the cameras whose lens sees more than 180 degrees, the
+  // fisheye ring ROVO is made for, when the rig has any; else all), "all", or indices "0,1,2,3"
+  // (increasing, with camera 0, the gauge of the extrinsics). run.json "vo_cameras" lists them.
+  std::string cameras = "auto";
+  void Check() const;  // throws std::invalid_argument naming the flag
 };
 
 // The starting extrinsics: the rig's (GTExt), a stored perturbed set or a fresh draw (NoisyExt, OnlineExt).
@@ -71,6 +75,10 @@ struct VoOptions {
   BackendOptions backend;  // backend.ba.optimize_extrinsics is set by RunVo from start.mode
   void Check() const;      // every part's; throws std::invalid_argument naming the flag or field
 };
+
+// The dataset cameras the VO uses (VoIoOptions::cameras) for `rig`; throws std::invalid_argument
+// naming --cameras.
+std::vector<int> VoCameraIndices(const std::string& cameras, const Rig& rig);
 
 // ---- The registry ----
 
@@ -124,6 +132,12 @@ void VisitIo(VoIoOptions& io, Visitor& visitor, int part) {
                        kUnbounded, false},
             io.frames);
     visitor(OptionSpec{"--threads", "threads", "Worker threads of the front-end (0: all cores)"}, io.threads);
+    visitor(OptionSpec{"--cameras", "cameras",
+                       "Dataset cameras the VO uses: auto (those whose lens sees more than 180 deg, e.g. the fisheye "
+                       "ring of rovo4_stereo without its forward pair; else all), all, or indices 0,1,2,3 "
+                       "(increasing, with camera 0)",
+                       -kUnbounded, kUnbounded, true, Reuse::kYesMissingIsDefault},
+            io.cameras);
   } else {
     visitor(OptionSpec{"--quiet", nullptr, "No progress output"}, io.quiet);
   }

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "datasets/dataset_cameras.h"
 #include "datasets/exchange/exchange_imu.h"
 #include "datasets/io.h"
 
@@ -148,6 +149,11 @@ std::string Readme(const std::string& dataset_dir, const DatasetInfo& info, cons
       << (info.imu ? ImuReadmeLines(*info.imu) : RigReadmeLines())
       << "- An ocam lens whose affine turns the image axes is exported in a camera frame turned about the optical\n"
       << "  axis by `roll_deg` (rovo_export.json; 0 for ideal affines); the extrinsics above include that turn.\n"
+      << "- Images: "
+      << (options.grayscale ? "8-bit grey, the sRGB-encoded relative luminance (Rec. 709 weights 0.2126, 0.7152,\n"
+                              "  0.0722 on the linearised sRGB values) of the rendered colour images.\n"
+                            : "as rendered.\n")
+      << "- Cameras: camK of this export is the dataset camera rovo_export.json `cameras[K]` names.\n"
       << "- Timestamps: integer nanoseconds = round(rovo time in seconds x 1e9); image file names are those.\n"
       << "- `camchain-perturbed-N.yaml` / `calibration-perturbed-N.json`: the dataset's perturbed extrinsic sets\n"
       << "  (NoisyExt / OnlineExt starting points; sigma and seed in the file's header / `rovo_perturbation`).\n\n"
@@ -212,6 +218,18 @@ void WriteCalibrations(const ExportOptions& options, const DatasetInfo& info, co
       WriteJsonFileAtomic((fs::path(options.out_dir) / ("calibration" + suffix + ".json")).string(), json);
     }
   }
+}
+
+// rovo_export.json "cameras": each exported camera's name and its source camera in the dataset.
+nlohmann::json CameraMapJson(const DatasetInfo& full, const std::vector<int>& cameras) {
+  nlohmann::json out = nlohmann::json::array();
+  for (int k = 0; k < (cameras.empty() ? full.rig.NumCameras() : static_cast<int>(cameras.size())); ++k) {
+    const int source = cameras.empty() ? k : cameras[static_cast<size_t>(k)];
+    out.push_back({{"name", "cam" + std::to_string(k)},
+                   {"source_index", source},
+                   {"source_name", full.rig.cameras[static_cast<size_t>(source)].name}});
+  }
+  return out;
 }
 
 ExchangeLensModel ChooseModel(const ExportOptions& options,
@@ -310,7 +328,11 @@ void FromKalibrFields(const KalibrLensFields& f, const std::string& what, Exchan
 }
 
 ExportReport ExportDataset(const std::string& dataset_dir, const ExportOptions& options) {
-  const DatasetInfo info = ReadDatasetInfo(dataset_dir);
+  const DatasetInfo full_info = ReadDatasetInfo(dataset_dir);
+  const DatasetInfo info = options.cameras.empty()
+                               ? full_info
+                               : SelectDatasetCameras(full_info, options.cameras,
+                                                      "--cameras (" + DatasetJsonPath(dataset_dir) + ": rig.cameras)");
   const std::vector<ExchangeLensModel> candidates = ExchangeFormatModels(options.format);
   if (options.model && std::find(candidates.begin(), candidates.end(), *options.model) == candidates.end()) {
     throw std::invalid_argument("--model " + ExchangeLensModelName(*options.model) + ": the " +
@@ -346,8 +368,13 @@ ExportReport ExportDataset(const std::string& dataset_dir, const ExportOptions& 
     for (int f = 0; f < info.frame_count; ++f) {
       const double t = report.ground_truth ? gt[static_cast<size_t>(f)].timestamp : f / info.frame_rate;
       const std::string file = std::to_string(SecondsToNs(t)) + ".png";
-      CopyFileAtomic(ImagePath(dataset_dir, info.rig.cameras[k].name, f),
-                     CamDir(options.out_dir, camera.name) + "/data/" + file);
+      const std::string image = ImagePath(dataset_dir, info.rig.cameras[k].name, f);
+      const std::string exported = CamDir(options.out_dir, camera.name) + "/data/" + file;
+      if (options.grayscale) {
+        WriteGrayPng(image, exported);
+      } else {
+        CopyFileAtomic(image, exported);
+      }
       list += std::to_string(SecondsToNs(t)) + "," + file + "\n";
     }
     WriteFileAtomic(CamDir(options.out_dir, camera.name) + "/data.csv", list);
@@ -361,7 +388,12 @@ ExportReport ExportDataset(const std::string& dataset_dir, const ExportOptions& 
   WriteExchangeImu(dataset_dir, info, options.format == ExchangeFormat::kKalibr, options.out_dir);
   WriteCalibrations(options, info, report);
   WriteFileAtomic((fs::path(options.out_dir) / "README.md").string(), Readme(dataset_dir, info, options, report));
-  WriteJsonFileAtomic((fs::path(options.out_dir) / "rovo_export.json").string(), ExportJson(info, options, report));
+  nlohmann::json export_json = ExportJson(info, options, report);
+  export_json["cameras"] = CameraMapJson(full_info, options.cameras);
+  export_json["images"] = options.grayscale ? "8-bit grey: sRGB-encoded relative luminance Y = 0.2126 R + 0.7152 G + "
+                                              "0.0722 B (Rec. 709) of the linearised rendered sRGB values"
+                                            : "as rendered";
+  WriteJsonFileAtomic((fs::path(options.out_dir) / "rovo_export.json").string(), export_json);
   return report;
 }
 

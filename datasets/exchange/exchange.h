@@ -68,6 +68,14 @@ int64_t SecondsToNs(double seconds);
 // Image list of mav0/camK/data.csv: (timestamp ns, file name). Throws naming the file and line.
 std::vector<std::pair<int64_t, std::string>> ReadEurocImageList(const std::string& path);
 
+// The 8-bit grey value of an 8-bit sRGB pixel: the relative luminance Y = 0.2126 R + 0.7152 G +
+// 0.0722 B (Rec. 709 / sRGB primaries, as rovo's grayscale sensor measures) of the linearised
+// values, encoded again with the sRGB curve.
+uint8_t GrayFromSrgb8(uint8_t r, uint8_t g, uint8_t b);
+// Writes `from` (an 8-bit PNG, RGB or grey) as an 8-bit single-channel PNG at `to` (atomically;
+// kept when `to` already holds a grey image). Throws naming the file.
+void WriteGrayPng(const std::string& from, const std::string& to);
+
 // Kalibr (exchange_kalibr.cc). `header` is written as # comment lines first.
 std::string KalibrCamchainYaml(const std::vector<ExchangeCamera>& cameras, const std::string& header);
 std::vector<ExchangeCamera> ReadKalibrCamchain(const std::string& path);
@@ -81,6 +89,12 @@ struct ExportOptions {
   std::string out_dir;
   std::optional<ExchangeLensModel> model;  // default: the format's model with the smallest max error
   double max_fit_error_px = 5.0;           // refuse when a camera's fit is worse
+  // The dataset's cameras to export, in this order, renumbered cam0, cam1, ... (empty: all);
+  // rovo_export.json "cameras" names the source camera of each.
+  std::vector<int> cameras;
+  // 8-bit grey images (WriteGrayPng), as EuRoC's own data are and as Basalt reads them (it takes an
+  // RGB PNG's first channel); false copies the rendered images as they are.
+  bool grayscale = true;
 };
 
 struct ExportReport {

@@ -1,8 +1,11 @@
 // EuRoC/ASL files: camera sensor.yaml, image lists, the ground-truth csv.
+#include <OpenImageIO/imageio.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <sstream>
 #include <stdexcept>
 
@@ -26,7 +29,61 @@ std::vector<double> ReadNumbers(const YAML::Node& node, const std::string& path,
   return out;
 }
 
+double SrgbToLinear(double v) { return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4); }
+double LinearToSrgb(double v) { return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055; }
+
+// The 8-bit grey value of each 8-bit sRGB value triple is costly per pixel (pow), so per channel a
+// table of linear values.
+const std::vector<double>& LinearTable() {
+  static const std::vector<double> table = [] {
+    std::vector<double> t(256);
+    for (int i = 0; i < 256; ++i) t[static_cast<size_t>(i)] = SrgbToLinear(i / 255.0);
+    return t;
+  }();
+  return table;
+}
+
 }  // namespace
+
+uint8_t GrayFromSrgb8(uint8_t r, uint8_t g, uint8_t b) {
+  const std::vector<double>& lin = LinearTable();
+  const double y = 0.2126 * lin[r] + 0.7152 * lin[g] + 0.0722 * lin[b];
+  return static_cast<uint8_t>(std::clamp(std::lround(255.0 * LinearToSrgb(std::clamp(y, 0.0, 1.0))), 0L, 255L));
+}
+
+void WriteGrayPng(const std::string& from, const std::string& to) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(to, ec)) {  // resumable: a finished grey image is kept
+    auto done = OIIO::ImageInput::open(to);
+    if (done && done->spec().nchannels == 1) return;
+  }
+  auto in = OIIO::ImageInput::open(from);
+  if (!in) throw std::runtime_error(from + ": cannot read image: " + OIIO::geterror());
+  const OIIO::ImageSpec spec = in->spec();
+  const int channels = spec.nchannels;
+  std::vector<uint8_t> pixels(static_cast<size_t>(spec.width) * spec.height * channels);
+  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, pixels.data())) {
+    throw std::runtime_error(from + ": cannot read image: " + in->geterror());
+  }
+  in->close();
+  std::vector<uint8_t> gray(static_cast<size_t>(spec.width) * spec.height);
+  for (size_t i = 0; i < gray.size(); ++i) {
+    const uint8_t* p = &pixels[i * static_cast<size_t>(channels)];
+    gray[i] = channels >= 3 ? GrayFromSrgb8(p[0], p[1], p[2]) : p[0];
+  }
+  fs::create_directories(fs::path(to).parent_path());
+  const std::string tmp = TempPathFor(to);
+  auto out = OIIO::ImageOutput::create("png");
+  OIIO::ImageSpec out_spec(spec.width, spec.height, 1, OIIO::TypeDesc::UINT8);
+  out_spec.attribute("png:compressionLevel", 1);  // as the renderer writes its PNGs (render/image_io.cc)
+  out_spec.attribute("png:filter", 0x20);         // libpng's "Up" filter only
+  if (!out || !out->open(tmp, out_spec) || !out->write_image(OIIO::TypeDesc::UINT8, gray.data())) {
+    throw std::runtime_error(to + ": cannot write the grey image: " + (out ? out->geterror() : OIIO::geterror()));
+  }
+  out->close();
+  CommitTempFile(tmp, to);
+}
 
 int64_t SecondsToNs(double seconds) { return std::llround(seconds * 1e9); }
 

@@ -15,6 +15,8 @@ namespace {
 struct ExportArgs {
   std::string dataset, format = "euroc", out, model;
   double max_fit_error_px = 5.0;
+  std::vector<int> cameras;
+  bool keep_color = false;
 };
 
 void RunExportRos2(const ExportArgs& args) {
@@ -45,6 +47,8 @@ void RunExport(const ExportArgs& args) {
   options.out_dir = args.out;
   if (!args.model.empty()) options.model = ExchangeLensModelFromName(args.model);
   options.max_fit_error_px = args.max_fit_error_px;
+  options.cameras = args.cameras;
+  options.grayscale = !args.keep_color;
   const ExportReport report = ExportDataset(args.dataset, options);
   std::printf("Lens fits (every model the %s format carries):\n%s\n", args.format.c_str(), report.fit_table.c_str());
   double worst = 0.0, half_px = 1e9;
@@ -125,6 +129,14 @@ void AddExchangeCommands(CommandTree& tree) {
   exp->add_option("--max-fit-error", args->max_fit_error_px, "Refuse when a camera's fit errs by more (px)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  exp->add_option("--cameras", args->cameras,
+                  "Export only these cameras of the dataset, in this order, as cam0, cam1, ... (e.g. 4,5 for the "
+                  "forward stereo pair of the rovo4_stereo rig; rovo_export.json \"cameras\" names the source of "
+                  "each). Basalt needs exactly two cameras that see the same scene (docs/systems.md)")
+      ->delimiter(',');
+  exp->add_flag("--keep-color", args->keep_color,
+                "Copy the rendered colour images; by default the images are written as 8-bit grey (sRGB-encoded "
+                "Rec. 709 relative luminance), as EuRoC's own are and as Basalt reads them");
   exp->callback([args] { RunExport(*args); });
 
   auto in_dir = std::make_shared<std::string>();

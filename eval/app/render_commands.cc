@@ -229,8 +229,10 @@ void AddRenderCommand(CLI::App& root) {
   cmd->add_flag("--quick", args->options.quick, "The preset's quick form: fewer frames, smaller images");
   cmd->add_option(
       "--rig", args->options.rig,
-      "Rig preset (rovo4, omnimvs4, rovo4_real) or rig.json; default: the scene folder's rig.json, else the "
-      "scene's rig_preset, else rovo4 (the rig used is printed)");
+      "Rig preset (rovo4, omnimvs4, rovo4_real; rovo4_stereo / rovo4_mono: rovo4 plus a forward stereo pair "
+      "cam4, cam5 / a forward camera cam4 with 100-degree equidistant lenses, for stereo and monocular systems) "
+      "or rig.json; default: the scene folder's rig.json, else the scene's rig_preset, else rovo4 (the rig used "
+      "is printed)");
   cmd->add_option("--out", args->options.out_dir, "Output dataset folder")->required();
   cmd->add_option("--frames", args->frames, "Trajectory frame range A:B (B exclusive; default: all)");
   cmd->add_option("--shard", args->shard, "Render only shard I of N (chunks of 8 frames), e.g. 0/4");

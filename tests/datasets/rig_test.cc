@@ -18,7 +18,8 @@ double WrapDeg(double a) {
 }
 
 TEST(RigPresets, NamesAndUnknown) {
-  EXPECT_THAT(RigPresetNames(), ::testing::ElementsAre("rovo4", "omnimvs4", "rovo4_real"));
+  EXPECT_THAT(RigPresetNames(),
+              ::testing::ElementsAre("rovo4", "omnimvs4", "rovo4_real", "rovo4_stereo", "rovo4_mono"));
   try {
     MakeRigPreset("nope");
     ADD_FAILURE();
@@ -28,9 +29,43 @@ TEST(RigPresets, NamesAndUnknown) {
   for (const std::string& name : RigPresetNames()) {
     const Rig rig = MakeRigPreset(name);
     EXPECT_NO_THROW(rig.Check(name));
-    ASSERT_EQ(rig.NumCameras(), 4) << name;
-    for (int i = 0; i < 4; ++i) EXPECT_EQ(rig.cameras[i].name, "cam" + std::to_string(i)) << name;
+    const int expected = name == "rovo4_stereo" ? 6 : name == "rovo4_mono" ? 5 : 4;
+    ASSERT_EQ(rig.NumCameras(), expected) << name;
+    for (int i = 0; i < expected; ++i) EXPECT_EQ(rig.cameras[i].name, "cam" + std::to_string(i)) << name;
   }
+}
+
+TEST(RigPresets, ForwardStereoAndMonoBesideTheRing) {
+  const Rig ring = MakeRigPreset("rovo4");
+  for (const std::string name : {"rovo4_stereo", "rovo4_mono"}) {
+    const Rig rig = MakeRigPreset(name);
+    // The ring is rovo4's, unchanged, as cameras 0-3.
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_EQ(rig.cameras[i].camera.params, ring.cameras[i].camera.params) << name;
+      EXPECT_TRUE(rig.cameras[i].cam_from_rig.translation.isApprox(ring.cameras[i].cam_from_rig.translation)) << name;
+    }
+    for (int i = 4; i < rig.NumCameras(); ++i) {
+      const RigCamera& rc = rig.cameras[i];
+      EXPECT_EQ(rc.camera.model, CameraModelId::kEquidistant) << name;
+      EXPECT_NEAR(CameraYawDeg(rc.cam_from_rig), 0.0, 1e-9) << name;  // looks forward (+x)
+      EXPECT_NEAR(CameraPitchDeg(rc.cam_from_rig), 0.0, 1e-9) << name;
+      // 100 degrees across the width: the image edge's bearing is 50 degrees off the axis.
+      const double f = rc.camera.params[0];
+      EXPECT_NEAR(0.5 * rc.camera.width / f * 180.0 / M_PI, 50.0, 1e-9);
+      EXPECT_GT(rc.camera.max_fov_deg,
+                2.0 * std::hypot(0.5 * rc.camera.width, 0.5 * rc.camera.height) / f * 180.0 / M_PI);
+      EXPECT_LT(rc.camera.max_fov_deg, 180.0);
+    }
+  }
+  const Rig stereo = MakeRigPreset("rovo4_stereo");
+  const Eigen::Vector3d left = CameraPositionInRig(stereo.cameras[4].cam_from_rig);
+  const Eigen::Vector3d right = CameraPositionInRig(stereo.cameras[5].cam_from_rig);
+  EXPECT_NEAR((left - right).norm(), 0.4, 1e-12);  // baseline
+  EXPECT_GT(left.y(), right.y());                  // cam4 is the left camera (rig y = left)
+  // Parallel optical axes: a rectified-ready pair.
+  EXPECT_LT(RotationDistanceDeg(stereo.cameras[4].cam_from_rig.rotation, stereo.cameras[5].cam_from_rig.rotation),
+            1e-9);
+  EXPECT_EQ(MakeRigPreset("rovo4_mono").NumCameras(), 5);
 }
 
 TEST(RigPresets, Rovo4Geometry) {

@@ -9,6 +9,7 @@ Written from the formats' documentation, not from rovo's C++ code:
 - EuRoC ground-truth columns from the EuRoC MAV dataset's documentation (timestamp [ns], p_RS_R xyz,
   q_RS wxyz, v_RS_R xyz, b_w_RS_S xyz, b_a_RS_S xyz);
 - Kalibr camchain (T_cn_cnm1, T_cam_imu) and Basalt calibration (value0/T_imu_cam) layouts.
+- PNG decoding from the PNG specification (grey exports: the Rec. 709 luminance of the sRGB images);
 Usage: exchange_check.py EXPORT_DIR DATASET_DIR FORMAT   (exit 1 with a message on any mismatch)
 """
 import csv
@@ -16,6 +17,7 @@ import json
 import math
 import os
 import sys
+import zlib
 
 import numpy as np
 import yaml
@@ -196,9 +198,12 @@ def check_lenses(export_dir, dataset, fmt):
             angle = math.degrees(math.atan2(math.hypot(pc[0], pc[1]), pc[2]))
             if angle > cam["max_fov_deg"] / 2 or math.hypot(pc[0], pc[1]) == 0:
                 continue
-            uv_true = project_ocam(cam["params"], pc) if cam["model"] == "ocam" else None
-            if uv_true is None:
-                fail("this check needs an ocam dataset")
+            if cam["model"] == "ocam":
+                uv_true = project_ocam(cam["params"], pc)
+            elif cam["model"] == "equidistant":  # FORMAT.md: fx fy cx cy k1..k4, Kannala-Brandt on the angle
+                uv_true = project_kb4(*cam["params"][:8], pc)
+            else:
+                fail("this check needs ocam or equidistant lenses, not %s" % cam["model"])
             if not (-0.5 <= uv_true[0] < cam["width"] - 0.5 and -0.5 <= uv_true[1] < cam["height"] - 0.5):
                 continue
             pe = cam_from_rig[:3, :3] @ p + cam_from_rig[:3, 3]
@@ -247,8 +252,75 @@ def check_ground_truth(export_dir, dataset_dir):
     print("ground truth: %d poses match groundtruth.tum" % len(rows))
 
 
+def read_png(path):
+    """8-bit, non-interlaced PNG (grey, grey+alpha, RGB, RGBA) from the PNG specification (ISO/IEC 15948):
+    IHDR, the concatenated IDAT zlib stream, per-row filters None/Sub/Up/Average/Paeth."""
+    data = open(path, "rb").read()
+    if data[:8] != b"\x89PNG\r\n\x1a\n":
+        fail("%s: not a PNG" % path)
+    pos, idat = 8, b""
+    while pos < len(data):
+        length = int.from_bytes(data[pos:pos + 4], "big")
+        kind = data[pos + 4:pos + 8]
+        body = data[pos + 8:pos + 8 + length]
+        if kind == b"IHDR":
+            width, height = int.from_bytes(body[0:4], "big"), int.from_bytes(body[4:8], "big")
+            depth, color, interlace = body[8], body[9], body[12]
+        elif kind == b"IDAT":
+            idat += body
+        pos += 12 + length
+    if depth != 8 or interlace != 0 or color not in (0, 2, 4, 6):
+        fail("%s: unsupported PNG (depth %d, colour type %d)" % (path, depth, color))
+    channels = {0: 1, 2: 3, 4: 2, 6: 4}[color]
+    raw = zlib.decompress(idat)
+    stride = width * channels
+    out = np.zeros((height, stride), dtype=np.int64)
+    prev = np.zeros(stride, dtype=np.int64)
+    for y in range(height):
+        row = np.frombuffer(raw, dtype=np.uint8, count=stride, offset=y * (stride + 1) + 1).astype(np.int64)
+        kind = raw[y * (stride + 1)]
+        if kind == 0:
+            cur = row
+        elif kind == 2:
+            cur = (row + prev) % 256
+        else:  # Sub, Average, Paeth depend on the left neighbour: byte by byte
+            cur = np.zeros(stride, dtype=np.int64)
+            for x in range(stride):
+                a = cur[x - channels] if x >= channels else 0
+                b = prev[x]
+                c = prev[x - channels] if x >= channels else 0
+                if kind == 1:
+                    pred = a
+                elif kind == 3:
+                    pred = (a + b) // 2
+                else:
+                    p = a + b - c
+                    pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                    pred = a if pa <= pb and pa <= pc else (b if pb <= pc else c)
+                cur[x] = (row[x] + pred) % 256
+        out[y] = cur
+        prev = cur
+    return out.reshape(height, width, channels)
+
+
+def srgb_to_linear(v):
+    return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
+
+
+def linear_to_srgb(v):
+    return np.where(v <= 0.0031308, 12.92 * v, 1.055 * np.power(v, 1 / 2.4) - 0.055)
+
+
+def expected_grey(rgb):
+    """Relative luminance (Rec. 709 / sRGB primaries) of the linearised sRGB values, sRGB-encoded."""
+    lin = srgb_to_linear(rgb[:, :, :3] / 255.0)
+    y = 0.2126 * lin[:, :, 0] + 0.7152 * lin[:, :, 1] + 0.0722 * lin[:, :, 2]
+    return np.rint(255.0 * linear_to_srgb(np.clip(y, 0.0, 1.0)))
+
+
 def check_images(export_dir, dataset_dir, dataset):
     tum = np.loadtxt(os.path.join(dataset_dir, "groundtruth.tum"), comments="#")
+    grey = json.load(open(os.path.join(export_dir, "rovo_export.json"))).get("images", "").startswith("8-bit grey")
     for cam in dataset["rig"]["cameras"]:
         k = dataset["rig"]["cameras"].index(cam)
         with open(os.path.join(export_dir, "mav0", "cam%d" % k, "data.csv")) as f:
@@ -258,16 +330,34 @@ def check_images(export_dir, dataset_dir, dataset):
         for i, (stamp, name) in enumerate(rows):
             if int(stamp) != round(tum[i, 0] * 1e9) or name != stamp + ".png":
                 fail("cam%d: row %d: %s,%s" % (k, i, stamp, name))
-            a = open(os.path.join(export_dir, "mav0", "cam%d" % k, "data", name), "rb").read()
-            b = open(os.path.join(dataset_dir, cam["name"], "%06d.png" % i), "rb").read()
-            if a != b:
+            exported = os.path.join(export_dir, "mav0", "cam%d" % k, "data", name)
+            source = os.path.join(dataset_dir, cam["name"], "%06d.png" % i)
+            if grey:
+                a, b = read_png(exported), read_png(source)
+                if a.shape != (b.shape[0], b.shape[1], 1):
+                    fail("cam%d: image %s is not one grey channel of the source's size: %s" % (k, name, a.shape))
+                diff = np.abs(a[:, :, 0] - expected_grey(b))
+                if diff.max() > 1 or np.count_nonzero(diff) > 1e-4 * diff.size:
+                    fail("cam%d: image %s: grey values differ from the luminance by up to %d" % (k, name, diff.max()))
+            elif open(exported, "rb").read() != open(source, "rb").read():
                 fail("cam%d: image %s differs from the dataset's frame %d" % (k, name, i))
-    print("images: identical, named by their timestamps")
+    print("images: %s, named by their timestamps" % ("grey luminance of the dataset's" if grey else "identical"))
 
 
 def main():
     export_dir, dataset_dir, fmt = sys.argv[1:4]
     dataset = json.load(open(os.path.join(dataset_dir, "dataset.json")))
+    # A camera subset (--cameras): exported camK is the dataset camera rovo_export.json cameras[K] names.
+    mapping = json.load(open(os.path.join(export_dir, "rovo_export.json"))).get("cameras")
+    if mapping is not None:
+        source = dataset["rig"]["cameras"]
+        for k, entry in enumerate(mapping):
+            if entry["name"] != "cam%d" % k or source[entry["source_index"]]["name"] != entry["source_name"]:
+                fail("rovo_export.json: cameras[%d] = %s" % (k, entry))
+        dataset["rig"]["cameras"] = [source[e["source_index"]] for e in mapping]
+        for k in range(len(mapping), len(source) + 1):
+            if os.path.exists(os.path.join(export_dir, "mav0", "cam%d" % k)):
+                fail("cam%d exported, but rovo_export.json lists %d cameras" % (k, len(mapping)))
     check_lenses(export_dir, dataset, fmt)
     check_ground_truth(export_dir, dataset_dir)
     check_images(export_dir, dataset_dir, dataset)

@@ -123,21 +123,49 @@ std::string ExchangeTest::root_;
 
 TEST_F(ExchangeTest, KalibrDoubleSphereExportPassesTheIndependentReaderAndRoundTrips) {
   const std::string out = root_ + "/kalibr";
-  ExportAndCheck("kalibr", "--model ds", out);
+  ExportAndCheck("kalibr", "--model ds --keep-color", out);
   EXPECT_TRUE(fs::exists(out + "/camchain-perturbed-0.yaml") || ReadDatasetInfo(Dataset()).perturbed.empty());
   CheckRoundTrip(out, "kalibr");
 }
 
 TEST_F(ExchangeTest, BasaltExportPassesTheIndependentReaderAndRoundTrips) {
   const std::string out = root_ + "/basalt";
-  ExportAndCheck("basalt", "", out);
+  ExportAndCheck("basalt", "--keep-color", out);
   CheckRoundTrip(out, "basalt");
 }
 
 TEST_F(ExchangeTest, EurocExportPassesTheIndependentReaderAndRoundTrips) {
   const std::string out = root_ + "/euroc";
-  ExportAndCheck("euroc", "", out);
+  ExportAndCheck("euroc", "--keep-color", out);
   CheckRoundTrip(out, "euroc", false);
+}
+
+// --cameras 3,1: two cameras, renumbered cam0 = dataset cam3, cam1 = dataset cam1, in every file (the
+// independent reader checks lenses, extrinsics and images against the mapped dataset cameras), grey
+// images by default (the reader decodes the PNGs itself and recomputes the luminance).
+TEST_F(ExchangeTest, CameraSubsetWithGreyImagesPassesTheIndependentReader) {
+  for (const std::string format : {"basalt", "euroc"}) {
+    const std::string out = root_ + "/subset_" + format;
+    ExportAndCheck(format, "--cameras 3,1", out);
+    EXPECT_TRUE(fs::exists(out + "/mav0/cam1/data.csv"));
+    EXPECT_FALSE(fs::exists(out + "/mav0/cam2"));
+    const nlohmann::json report = ReadJsonFile(out + "/rovo_export.json");
+    ASSERT_EQ(report["cameras"].size(), 2u);
+    EXPECT_EQ(report["cameras"][0]["source_name"], "cam3");
+    EXPECT_EQ(report["cameras"][1]["source_index"], 1);
+  }
+  const nlohmann::json basalt = ReadJsonFile(root_ + "/subset_basalt/calibration.json");
+  EXPECT_EQ(basalt["value0"]["T_imu_cam"].size(), 2u);
+  if (!ReadDatasetInfo(Dataset()).perturbed.empty()) {
+    EXPECT_EQ(ReadJsonFile(root_ + "/subset_basalt/calibration-perturbed-0.json")["value0"]["T_imu_cam"].size(), 2u);
+  }
+  const std::string log = root_ + "/bad_subset.log";
+  EXPECT_EQ(RunShell(std::string(ROVO_BINARY) + " dataset export " + Dataset() + " --cameras 0,7 --out " + root_ +
+                         "/bad_subset",
+                     log),
+            1);
+  EXPECT_NE(ReadFile(log).find("--cameras"), std::string::npos) << ReadFile(log);
+  EXPECT_NE(ReadFile(log).find("camera 7 does not exist"), std::string::npos) << ReadFile(log);
 }
 
 TEST_F(ExchangeTest, ExportRefusesAFitWorseThanTheBound) {
