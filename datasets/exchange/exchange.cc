@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "datasets/dataset_cameras.h"
+#include "datasets/exchange/exchange_imu.h"
 #include "datasets/io.h"
 
 namespace rovo {
@@ -100,6 +101,42 @@ std::vector<ExchangeCamera> ExchangeCameras(const Rig& rig, ExchangeLensModel mo
   return out;
 }
 
+// The README's frame conventions: the body is the rig without an IMU, the IMU with one.
+std::string RigReadmeLines() {
+  return "- Body frame B = the rovo rig frame (REP-103: x forward, y left, z up). World frame W: z up (gravity -z).\n"
+         "- Camera frames: x right, y down, z along the optical axis. Pixel centres at integer coordinates, the\n"
+         "  top-left pixel's centre at (0, 0).\n"
+         "- `mav0/camK/sensor.yaml` `T_BS`: body_from_camera (x_B = T_BS x_cam), row-major 4x4.\n"
+         "- Kalibr `camchain*.yaml`: `T_cn_cnm1` = camN_from_cam(N-1); `T_cam_imu` = camN_from_body (the rig stands\n"
+         "  in for the IMU; there is no IMU data).\n"
+         "- Basalt `calibration*.json`: `T_imu_cam` = body_from_camera, quaternions normalised.\n"
+         "- `mav0/state_groundtruth_estimate0/data.csv`: EuRoC columns, `p_RS_R` = rig position in the world,\n"
+         "  `q_RS` = world_from_rig rotation (w, x, y, z), `v_RS_R` = world-frame velocity by central differences\n"
+         "  of the positions, biases zero (no IMU). R = world, S = rig.\n";
+}
+
+std::string ImuReadmeLines(const ImuRecord& imu) {
+  return "- Body frame B = the IMU (`mav0/imu0`, EuRoC's S; its mount on the rovo rig is `rovo_imu_from_rig` in\n"
+         "  `mav0/imu0/sensor.yaml`). World frame W: z up (gravity -z, " +
+         YamlNumber(imu.gravity_m_s2) +
+         " m/s^2).\n"
+         "- Camera frames: x right, y down, z along the optical axis. Pixel centres at integer coordinates, the\n"
+         "  top-left pixel's centre at (0, 0).\n"
+         "- `mav0/camK/sensor.yaml` `T_BS`: imu_from_camera (x_B = T_BS x_cam), row-major 4x4.\n"
+         "- `mav0/imu0/data.csv`: angular rate (rad/s) and specific force (m/s^2) in the IMU frame at " +
+         YamlNumber(imu.rate_hz) + " Hz,\n  stamped on the IMU clock: t_imu = t_cam + " +
+         YamlNumber(imu.time_offset_s) +
+         " s; `sensor.yaml` has the noise densities and random walks;\n"
+         "  `rovo_exact.csv` the noise-free samples (rovo extension).\n"
+         "- Kalibr `camchain*.yaml`: `T_cn_cnm1` = camN_from_cam(N-1); `T_cam_imu` = camN_from_imu,\n"
+         "  `timeshift_cam_imu` = the IMU clock offset; `imu.yaml`: the IMU's noise and rate.\n"
+         "- Basalt `calibration*.json`: `T_imu_cam` = imu_from_camera, quaternions normalised; the IMU's noise\n"
+         "  densities and random walks, `imu_update_rate`, `cam_time_offset_ns`.\n"
+         "- `mav0/state_groundtruth_estimate0/data.csv`: EuRoC columns at every IMU sample, `p_RS_R` = IMU position\n"
+         "  in the world, `q_RS` = world_from_imu rotation (w, x, y, z), `v_RS_R` = the IMU's world-frame velocity,\n"
+         "  `b_w_RS_S`, `b_a_RS_S` = the true biases; stamped at the sample's camera-clock time. R = world, S = IMU.\n";
+}
+
 std::string Readme(const std::string& dataset_dir, const DatasetInfo& info, const ExportOptions& options,
                    const ExportReport& report) {
   std::ostringstream out;
@@ -109,16 +146,7 @@ std::string Readme(const std::string& dataset_dir, const DatasetInfo& info, cons
       << " synchronous cameras at " << info.frame_rate << " Hz. Format: " << ExchangeFormatName(options.format)
       << ", lens model: " << ExchangeLensModelName(report.model) << ".\n\n"
       << "## Frames and conventions\n\n"
-      << "- Body frame B = the rovo rig frame (REP-103: x forward, y left, z up). World frame W: z up (gravity -z).\n"
-      << "- Camera frames: x right, y down, z along the optical axis. Pixel centres at integer coordinates, the\n"
-      << "  top-left pixel's centre at (0, 0).\n"
-      << "- `mav0/camK/sensor.yaml` `T_BS`: body_from_camera (x_B = T_BS x_cam), row-major 4x4.\n"
-      << "- Kalibr `camchain*.yaml`: `T_cn_cnm1` = camN_from_cam(N-1); `T_cam_imu` = camN_from_body (the rig stands\n"
-      << "  in for the IMU; there is no IMU data).\n"
-      << "- Basalt `calibration*.json`: `T_imu_cam` = body_from_camera, quaternions normalised.\n"
-      << "- `mav0/state_groundtruth_estimate0/data.csv`: EuRoC columns, `p_RS_R` = rig position in the world,\n"
-      << "  `q_RS` = world_from_rig rotation (w, x, y, z), `v_RS_R` = world-frame velocity by central differences\n"
-      << "  of the positions, biases zero (no IMU). R = world, S = rig.\n"
+      << (info.imu ? ImuReadmeLines(*info.imu) : RigReadmeLines())
       << "- An ocam lens whose affine turns the image axes is exported in a camera frame turned about the optical\n"
       << "  axis by `roll_deg` (rovo_export.json; 0 for ideal affines); the extrinsics above include that turn.\n"
       << "- Images: "
@@ -173,13 +201,15 @@ void WriteCalibrations(const ExportOptions& options, const DatasetInfo& info, co
   }
   for (const auto& [suffix, set] : sets) {
     const std::vector<ExchangeCamera> cameras =
-        ExchangeCameras(info.rig, report.model, report.fits, set ? set->cam_from_rig : info.rig.Extrinsics());
+        ExchangeCameras(info.rig, report.model, report.fits,
+                        ExchangeCamFromBody(info, set ? set->cam_from_rig : info.rig.Extrinsics()));
     if (options.format == ExchangeFormat::kKalibr) {
       const std::string header = set ? PerturbationHeader(*set) : "rovo ground-truth extrinsics";
       WriteFileAtomic((fs::path(options.out_dir) / ("camchain" + suffix + ".yaml")).string(),
-                      KalibrCamchainYaml(cameras, header));
+                      WithKalibrTimeshift(KalibrCamchainYaml(cameras, header), info));
     } else {
       nlohmann::json json = BasaltCalibrationJson(cameras);
+      if (info.imu) SetBasaltImu(*info.imu, &json);
       if (set) {
         json["rovo_perturbation"] = {{"sigma_rotation_deg", set->sigma_rotation_deg},
                                      {"sigma_translation_m", set->sigma_translation_m},
@@ -331,7 +361,7 @@ ExportReport ExportDataset(const std::string& dataset_dir, const ExportOptions& 
   report.ground_truth = !gt.empty();
   report.frames = info.frame_count;
   const std::vector<ExchangeCamera> cameras =
-      ExchangeCameras(info.rig, report.model, report.fits, info.rig.Extrinsics());
+      ExchangeCameras(info.rig, report.model, report.fits, ExchangeCamFromBody(info, info.rig.Extrinsics()));
   for (size_t k = 0; k < cameras.size(); ++k) {
     const ExchangeCamera& camera = cameras[k];
     std::string list = "#timestamp [ns],filename\n";
@@ -352,9 +382,10 @@ ExportReport ExportDataset(const std::string& dataset_dir, const ExportOptions& 
     WriteFileAtomic(CamDir(options.out_dir, camera.name) + "/sensor.yaml",
                     EurocSensorYaml(camera, info.frame_rate, comment));
   }
-  if (report.ground_truth) {
+  if (report.ground_truth && !info.imu) {
     WriteFileAtomic(CamDir(options.out_dir, "state_groundtruth_estimate0") + "/data.csv", EurocGroundTruthCsv(gt));
   }
+  WriteExchangeImu(dataset_dir, info, options.format == ExchangeFormat::kKalibr, options.out_dir);
   WriteCalibrations(options, info, report);
   WriteFileAtomic((fs::path(options.out_dir) / "README.md").string(), Readme(dataset_dir, info, options, report));
   nlohmann::json export_json = ExportJson(info, options, report);

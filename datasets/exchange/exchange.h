@@ -1,14 +1,21 @@
 #pragma once
 // Datasets for other systems and from them: EuRoC/ASL folders with Kalibr camchains or Basalt
-// calibration files (docs/exchange.md has the layout, the frame conventions and the lens fits).
+// calibration files (docs/exchange.md has the layout, the frame conventions and the lens fits);
+// ROS 2 bags are ros2_bag.h.
 //
 //   <out>/mav0/camK/data/<timestamp_ns>.png, data.csv, sensor.yaml   (EuRoC/ASL layout)
 //   <out>/mav0/state_groundtruth_estimate0/data.csv                  (EuRoC ground-truth columns)
-//   <out>/camchain.yaml, camchain-perturbed-N.yaml                   (--format kalibr)
+//   <out>/mav0/imu0/data.csv, sensor.yaml, rovo_exact.csv            (with an IMU, exchange_imu.h)
+//   <out>/camchain.yaml, camchain-perturbed-N.yaml, imu.yaml         (--format kalibr)
 //   <out>/calibration.json, calibration-perturbed-N.json             (--format basalt)
 //   <out>/README.md, rovo_export.json                                (conventions, lens fit errors)
-// The EuRoC body frame is the rovo rig frame (REP-103): T_BS = rig_from_cam, Kalibr's T_cam_imu =
-// cam_from_rig, Basalt's T_imu_cam = rig_from_cam; T_cn_cnm1 = camN_from_cam(N-1).
+// Without an IMU the EuRoC body frame is the rovo rig frame (REP-103): T_BS = rig_from_cam, Kalibr's
+// T_cam_imu = cam_from_rig, Basalt's T_imu_cam = rig_from_cam; T_cn_cnm1 = camN_from_cam(N-1). With
+// an IMU (`rovo render ... --imu`) the body is the IMU: T_BS = imu_from_cam, T_cam_imu = cam_from_imu,
+// T_imu_cam = imu_from_cam, the ground truth at the IMU rate with the IMU's pose and true biases.
+// A quick dataset with its IMU, exported:
+//   rovo render --preset cloudy_urban --quick --imu --out data/cloudy_imu
+//   rovo dataset export data/cloudy_imu --format euroc|kalibr|basalt|ros2 --out DIR
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -36,7 +43,7 @@ struct ExchangeCamera {
   int width = 0;
   int height = 0;
   double max_fov_deg = 0.0;  // 0 when the file does not say
-  Rigid3 cam_from_rig;
+  Rigid3 cam_from_rig;       // cam_from_body: the rig, or the IMU when the dataset has one (exchange_imu.h)
 };
 
 // Kalibr's field values of a lens: camera_model, intrinsics, distortion_model, distortion_coeffs.
@@ -120,6 +127,10 @@ struct ImportReport {
 // state_groundtruth_estimate0/data.csv exists, perturbed sets from camchain-perturbed-N.yaml /
 // calibration-perturbed-N.json beside the calibration.
 ImportReport ImportDataset(const std::string& in_dir, const ImportOptions& options);
+
+// Full FOV cone of an imported lens that does not state it: twice the widest angle from the axis of
+// any border pixel's bearing (within the model's valid set), so the whole image is usable.
+double ImageFovDeg(const Camera& lens);
 
 // Numbers for the YAML files of the exchange formats: full precision (%.17g), lists as [a, b, c].
 std::string YamlNumber(double value);

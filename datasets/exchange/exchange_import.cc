@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "datasets/exchange/exchange.h"
+#include "datasets/exchange/exchange_imu.h"
 #include "datasets/io.h"
 
 namespace rovo {
@@ -26,34 +27,13 @@ std::vector<std::string> CameraFolders(const std::string& in_dir) {
   return names;
 }
 
-// Full FOV of an imported lens: the file's max_fov_deg, else the widest bearing of any border
-// pixel (within the model's valid set), so the whole image is usable.
-double ImportedFov(const Camera& lens) {
-  Camera wide = lens;
-  wide.max_fov_deg = 360.0;
-  double max_angle = 0.0;
-  auto visit = [&](double u, double v) {
-    const std::optional<Eigen::Vector3d> bearing = wide.Unproject(Eigen::Vector2d(u, v));
-    if (bearing) max_angle = std::max(max_angle, std::atan2(bearing->head<2>().norm(), bearing->z()));
-  };
-  for (int u = 0; u < lens.width; ++u) {
-    visit(u, 0);
-    visit(u, lens.height - 1);
-  }
-  for (int v = 0; v < lens.height; ++v) {
-    visit(0, v);
-    visit(lens.width - 1, v);
-  }
-  return std::min(359.0, 2.0 * max_angle / kDegToRad - 0.01);
-}
-
 Rig RigFromExchange(const std::vector<ExchangeCamera>& cameras, const std::string& what) {
   Rig rig;
   for (const ExchangeCamera& c : cameras) {
     RigCamera rc;
     rc.name = c.name;
     rc.camera = CameraFromExchangeLens(c.model, c.params, c.width, c.height, 360.0, what + ": " + c.name);
-    rc.camera.max_fov_deg = c.max_fov_deg > 0 ? c.max_fov_deg : ImportedFov(rc.camera);
+    rc.camera.max_fov_deg = c.max_fov_deg > 0 ? c.max_fov_deg : ImageFovDeg(rc.camera);
     rc.cam_from_rig = c.cam_from_rig;
     rig.cameras.push_back(rc);
   }
@@ -183,6 +163,25 @@ double MedianRate(const std::vector<int64_t>& stamps) {
 
 }  // namespace
 
+double ImageFovDeg(const Camera& lens) {
+  Camera wide = lens;
+  wide.max_fov_deg = 360.0;
+  double max_angle = 0.0;
+  auto visit = [&](double u, double v) {
+    const std::optional<Eigen::Vector3d> bearing = wide.Unproject(Eigen::Vector2d(u, v));
+    if (bearing) max_angle = std::max(max_angle, std::atan2(bearing->head<2>().norm(), bearing->z()));
+  };
+  for (int u = 0; u < lens.width; ++u) {
+    visit(u, 0);
+    visit(u, lens.height - 1);
+  }
+  for (int v = 0; v < lens.height; ++v) {
+    visit(0, v);
+    visit(lens.width - 1, v);
+  }
+  return std::min(359.0, 2.0 * max_angle / kDegToRad - 0.01);
+}
+
 ImportReport ImportDataset(const std::string& in_dir, const ImportOptions& options) {
   const std::vector<std::string> folders = CameraFolders(in_dir);
   std::string calibration = options.calibration;
@@ -231,7 +230,8 @@ ImportReport ImportDataset(const std::string& in_dir, const ImportOptions& optio
       CommitTempFile(tmp, to);
     }
   }
-  const Trajectory gt = GroundTruthAt(in_dir, stamps);
+  Trajectory gt = GroundTruthAt(in_dir, stamps);
+  ApplyExchangeImu(in_dir, options.out_dir, &info, &gt);  // the body is the IMU when mav0/imu0 exists
   ImportReport report;
   if (!gt.empty()) WriteTum(GroundTruthPath(options.out_dir), gt);
   info.has_ground_truth = !gt.empty();

@@ -1,10 +1,12 @@
 // `rovo dataset export | import | lens-fit`: exchange with EuRoC, Kalibr and Basalt (datasets/exchange/exchange.h).
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
 
 #include "datasets/exchange/exchange.h"
+#include "datasets/exchange/ros2_bag.h"
 #include "eval/app/commands.h"
 
 namespace rovo {
@@ -17,7 +19,29 @@ struct ExportArgs {
   bool keep_color = false;
 };
 
+void RunExportRos2(const ExportArgs& args) {
+  if (!args.model.empty() && args.model != "kb4") {
+    throw CLI::ValidationError("--model", "a ROS 2 bag carries the equidistant (kb4) lens only");
+  }
+  Ros2ExportOptions options;
+  options.out_dir = args.out;
+  options.max_fit_error_px = args.max_fit_error_px;
+  const Ros2ExportReport report = ExportRos2Bag(args.dataset, options);
+  double worst = 0.0;
+  for (const LensFit& f : report.fits) worst = std::max(worst, f.max_error_px);
+  std::printf("exported %d frames (%s ground truth, %s IMU) to %s, equidistant lens fit max error %.3f px\n",
+              report.frames, report.ground_truth ? "with" : "without", report.imu ? "with" : "without",
+              report.bag_path.c_str(), worst);
+  for (const auto& [topic, count] : report.messages) {
+    std::printf("  %-28s %llu messages\n", topic.c_str(), static_cast<unsigned long long>(count));
+  }
+}
+
 void RunExport(const ExportArgs& args) {
+  if (args.format == "ros2") {
+    RunExportRos2(args);
+    return;
+  }
   ExportOptions options;
   options.format = ExchangeFormatFromName(args.format);
   options.out_dir = args.out;
@@ -37,6 +61,21 @@ void RunExport(const ExportArgs& args) {
       "%.1f deg from the axis\n",
       report.frames, report.ground_truth ? "with" : "without", args.out.c_str(), args.format.c_str(),
       ExchangeLensModelName(report.model).c_str(), worst, half_px);
+  const DatasetInfo info = ReadDatasetInfo(args.dataset);
+  if (info.imu) {
+    std::printf("with the IMU: %d samples at %g Hz in mav0/imu0 (the body frame of every file is the IMU)\n",
+                info.imu->sample_count, info.imu->rate_hz);
+  }
+}
+
+void RunImportRos2(const std::string& bag, const std::string& out_dir) {
+  const Ros2ImportReport report = ImportRos2Bag(bag, out_dir);
+  std::printf("imported %d frames x %d cameras, %s, %s to %s\n", report.frames, report.cameras,
+              report.ground_truth ? "ground truth from the odometry" : "no ground truth (no nav_msgs/msg/Odometry)",
+              report.imu ? "with the IMU" : "no IMU", out_dir.c_str());
+  for (const ValidationIssue& issue : report.issues) {
+    std::printf("  %s: %s: %s\n", issue.file.c_str(), issue.field.c_str(), issue.message.c_str());
+  }
 }
 
 void RunImport(const std::string& in_dir, const ImportOptions& options) {
@@ -75,12 +114,14 @@ void AddExchangeCommands(CommandTree& tree) {
       "export",
       "Write a dataset as a EuRoC/ASL folder (mav0/camK/data/<ns>.png, data.csv, sensor.yaml, ground truth in "
       "EuRoC's csv) plus a Kalibr camchain.yaml or Basalt calibration.json per extrinsic set, and a README with the "
-      "frame conventions. The ocam lens is fitted with the chosen model over its whole FOV; the fit error is "
+      "frame conventions; or (--format ros2) a ROS 2 bag: metadata.yaml and one MCAP file with images, camera "
+      "infos (equidistant lens), the IMU, /tf_static and the ground truth as nav_msgs/Odometry "
+      "(docs/exchange.md). The ocam lens is fitted with the chosen model over its whole FOV; the fit error is "
       "printed and written to the README, and the export is refused above --max-fit-error.");
   exp->add_option("dataset", args->dataset, "rovo dataset folder")->required();
-  exp->add_option("--format", args->format, "euroc | kalibr | basalt")
+  exp->add_option("--format", args->format, "euroc | kalibr | basalt | ros2")
       ->capture_default_str()
-      ->check(CLI::IsMember({"euroc", "kalibr", "basalt"}));
+      ->check(CLI::IsMember({"euroc", "kalibr", "basalt", "ros2"}));
   exp->add_option("--out", args->out, "Output folder")->required();
   exp->add_option("--model", args->model,
                   "Lens model: ds | eucm | kb4 | omni (default: the format's model with the smallest max error)")
@@ -105,16 +146,23 @@ void AddExchangeCommands(CommandTree& tree) {
       "import",
       "Make a rovo dataset from a EuRoC-style multi-camera folder (mav0/camK/data.csv + PNGs) and its calibration: "
       "a Kalibr camchain.yaml (T_cam_imu as cam_from_rig, else camera 0 is the rig), a Basalt calibration.json, or "
-      "the folder's own mav0/camK/sensor.yaml (--format euroc). Ground truth from "
+      "the folder's own mav0/camK/sensor.yaml (--format euroc), or a ROS 2 bag folder or .mcap file (--format ros2). "
+      "Ground truth from "
       "mav0/state_groundtruth_estimate0/data.csv when present; *-perturbed-N files become perturbed sets.");
-  imp->add_option("dir", *in_dir, "EuRoC-style folder")->required()->check(CLI::ExistingDirectory);
-  imp->add_option("--format", *format, "euroc | kalibr | basalt")
+  imp->add_option("dir", *in_dir, "EuRoC-style folder, or a ROS 2 bag (folder or .mcap)")
+      ->required()
+      ->check(CLI::ExistingPath);
+  imp->add_option("--format", *format, "euroc | kalibr | basalt | ros2")
       ->capture_default_str()
-      ->check(CLI::IsMember({"euroc", "kalibr", "basalt"}));
+      ->check(CLI::IsMember({"euroc", "kalibr", "basalt", "ros2"}));
   imp->add_option("--calib", options->calibration,
                   "Calibration file (default: DIR/camchain.yaml or DIR/calibration.json)");
   imp->add_option("--out", options->out_dir, "rovo dataset folder to write")->required();
   imp->callback([in_dir, format, options] {
+    if (*format == "ros2") {
+      RunImportRos2(*in_dir, options->out_dir);
+      return;
+    }
     options->format = ExchangeFormatFromName(*format);
     RunImport(*in_dir, *options);
   });
