@@ -217,6 +217,14 @@ std::vector<ExtrinsicError> ExtrinsicErrors(const std::vector<ExtrinsicsRecord>&
   return errors;
 }
 
+double GtPathLength(const Trajectory& gt) {
+  double length = 0.0;
+  for (size_t i = 1; i < gt.size(); ++i) {
+    length += (gt[i].world_from_rig.translation - gt[i - 1].world_from_rig.translation).norm();
+  }
+  return length;
+}
+
 namespace {
 
 double MedianInterval(const Trajectory& trajectory) {
@@ -225,14 +233,6 @@ double MedianInterval(const Trajectory& trajectory) {
   if (dt.empty()) return 0.0;
   std::nth_element(dt.begin(), dt.begin() + static_cast<long>(dt.size() / 2), dt.end());
   return dt[dt.size() / 2];
-}
-
-double GtPathLength(const Trajectory& gt) {
-  double length = 0.0;
-  for (size_t i = 1; i < gt.size(); ++i) {
-    length += (gt[i].world_from_rig.translation - gt[i - 1].world_from_rig.translation).norm();
-  }
-  return length;
 }
 
 // A run over frames [a, b) of the dataset (run.json "frames") is scored against that span of the
@@ -252,15 +252,42 @@ std::pair<size_t, size_t> RunSpan(const RunData& run, size_t gt_size) {
 
 // Associates the run's poses with `gt` (the run's span, starting at `span_begin` of the full ground
 // truth), aligns them and fills the trajectory metrics, gt_from_est and the per-frame errors.
-void ScoreTrajectory(const Trajectory& gt, const RunData& run, size_t span_begin, const EvalOptions& options,
+// EvalOptions::sim3: the estimate scaled by the Sim(3) alignment's scale (unchanged when it cannot be
+// found, with a note).
+Trajectory ScaledEstimate(const Trajectory& gt, const Trajectory& estimate, const Association& association,
+                          RunMetrics* m) {
+  std::vector<Eigen::Vector3d> src, dst;
+  for (const auto& [i, j] : association.pairs) {
+    src.push_back(estimate[static_cast<size_t>(j)].world_from_rig.translation);
+    dst.push_back(gt[static_cast<size_t>(i)].world_from_rig.translation);
+  }
+  Trajectory scaled = estimate;
+  try {
+    const double scale = AlignUmeyama(src, dst, /*with_scale=*/true).scale;
+    for (StampedPose& p : scaled) p.world_from_rig.translation *= scale;
+    m->sim3_scale = scale;
+  } catch (const std::invalid_argument& e) {
+    m->alignment_note = std::string("Sim(3) scale impossible: ") + e.what() + "; scored unscaled";
+  }
+  return scaled;
+}
+
+void ScoreTrajectory(const Trajectory& gt, const RunData& run_in, size_t span_begin, const EvalOptions& options,
                      RunEvaluation* out) {
   RunMetrics& m = out->metrics;
+  RunData scaled_run;
+  const RunData* run_ptr = &run_in;
   double tolerance = options.time_tolerance_s;
   if (tolerance <= 0.0) {
     const double interval = MedianInterval(gt);
     tolerance = interval > 0.0 ? 0.25 * interval : 1e-3;
   }
-  const Association association = AssociateByTimestamp(gt, run.trajectory, tolerance);
+  const Association association = AssociateByTimestamp(gt, run_in.trajectory, tolerance);
+  if (options.sim3 && !association.pairs.empty()) {
+    scaled_run.trajectory = ScaledEstimate(gt, run_in.trajectory, association, &m);
+    run_ptr = &scaled_run;
+  }
+  const RunData& run = *run_ptr;
   m.associated_frames = static_cast<int>(association.pairs.size());
   m.missing_frames = static_cast<int>(association.gt_without_estimate.size());
 

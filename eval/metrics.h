@@ -47,6 +47,9 @@ struct Association {
 };
 Association AssociateByTimestamp(const Trajectory& gt, const Trajectory& estimate, double tolerance_s);
 
+// Length of the ground-truth path: the sum of the distances between consecutive positions.
+double GtPathLength(const Trajectory& gt);
+
 // Root mean square of |p_gt_i - gt_from_est * p_est_i| over the pairs.
 double TranslationRmse(const Trajectory& gt, const Trajectory& estimate, const Association& association,
                        const Rigid3& gt_from_est);
@@ -115,6 +118,7 @@ struct RunMetrics {
   double max_final_ext_rotation_deg = 0.0;
   double max_final_ext_translation_m = 0.0;
   std::string alignment_note;  // why rmse is empty, if it is
+  std::optional<double> sim3_scale;  // EvalOptions::sim3: the scale applied to the estimate
 };
 
 // Per-frame error along the path (after SE(3) alignment, or origin alignment as fallback).
@@ -136,6 +140,9 @@ struct RunEvaluation {
 
 struct EvalOptions {
   double time_tolerance_s = 0.0;  // 0 = a quarter of the gt frame interval
+  // Monocular systems: the estimate's positions are first scaled by the scale of the Sim(3) Umeyama
+  // alignment (RunMetrics::sim3_scale); every metric is then computed as for a metric estimate.
+  bool sim3 = false;
 };
 
 // Scores one run; `gt_cam_from_rig` is the dataset's ground-truth rig extrinsics.

@@ -68,6 +68,7 @@ nlohmann::json MetricsToJson(const RunMetrics& m) {
   j["max_final_ext_rotation_deg"] = m.max_final_ext_rotation_deg;
   j["max_final_ext_translation_m"] = m.max_final_ext_translation_m;
   j["alignment_note"] = m.alignment_note;
+  if (m.sim3_scale) j["sim3_scale"] = *m.sim3_scale;  // only Sim(3)-scored runs have it
   return j;
 }
 
@@ -110,6 +111,7 @@ RunMetrics MetricsFromJson(const nlohmann::json& j, const std::string& what) {
     m.max_final_ext_rotation_deg = field("max_final_ext_rotation_deg").get<double>();
     m.max_final_ext_translation_m = field("max_final_ext_translation_m").get<double>();
     m.alignment_note = field("alignment_note").get<std::string>();
+    if (j.contains("sim3_scale")) m.sim3_scale = opt("sim3_scale");
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(what + ": bad metrics object: " + e.what());
   }
@@ -287,11 +289,16 @@ std::vector<RunEvaluation> EvaluateAndReport(const std::string& dataset_dir, con
   std::string summary = SummaryHeader();
   for (const std::string& run_dir : run_dirs) {
     std::string note;
-    const RunData run = ReadRunOrTrajectory(run_dir, gt, options.trajectory_format, &note);
+    const size_t index = evaluations.size();
+    RunData run = ReadRunOrTrajectory(run_dir, gt, options.trajectory_format, &note);
+    if (options.frame_end > 0 && !run.info.contains("frames")) run.info["frames"] = {0, options.frame_end};
     if (!note.empty() && !options.quiet) std::printf("%s\n", note.c_str());
-    const std::string label = UniqueRunLabel(run_dir, &label_count);
+    const std::string label =
+        UniqueRunLabel(index < options.labels.size() ? options.labels[index] : run_dir, &label_count);
+    EvalOptions eval = options.eval;
+    if (index < options.sim3.size()) eval.sim3 = options.sim3[index];
 
-    RunEvaluation evaluation = EvaluateRun(gt, gt_cam_from_rig, run, label, options.eval);
+    RunEvaluation evaluation = EvaluateRun(gt, gt_cam_from_rig, run, label, eval);
     const RunMetrics& m = evaluation.metrics;
     const std::string run_out = (fs::path(out_dir) / label).string();
     EnsureWritableDir(run_out);
