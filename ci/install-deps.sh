@@ -15,6 +15,7 @@ PACKAGES=(
   blender
   chromium
   slurm-wlm munge
+  colmap
 )
 
 missing=()

@@ -58,7 +58,8 @@ std::string RunStatusCounts(const PresetSummary& p) {
 }
 
 std::string SuiteTableMarkdown(const std::vector<PresetSummary>& presets, bool quick) {
-  const bool systems = std::any_of(presets.begin(), presets.end(), [](const PresetSummary& p) { return p.system != "rovo"; });
+  const bool systems =
+      std::any_of(presets.begin(), presets.end(), [](const PresetSummary& p) { return p.system != "rovo"; });
   std::string md = std::string("| sequence | ") + (systems ? "system | runs | " : "") +
                    "frames | length [m] | RMSE NoisyExt [m] | RMSE OnlineExt [m] | RMSE GTExt [m] | rel. "
                    "Noisy/Online/GT "
@@ -101,9 +102,9 @@ std::string SuiteTableMarkdown(const std::vector<PresetSummary>& presets, bool q
     const std::string inliers = own ? mean("online", "mean_inlier_ratio", "%.1f", 100.0) + " / " +
                                           mean("gt", "mean_inlier_ratio", "%.1f", 100.0)
                                     : "-";
-    const std::string reproj = own ? mean("online", "mean_reproj_error_deg", "%.3f") + " / " +
-                                         mean("gt", "mean_reproj_error_deg", "%.3f")
-                                   : "-";
+    const std::string reproj =
+        own ? mean("online", "mean_reproj_error_deg", "%.3f") + " / " + mean("gt", "mean_reproj_error_deg", "%.3f")
+            : "-";
     const std::string ext_rot = own ? mean_std("online", "max_final_ext_rotation_deg", "%.3f") : "-";
     md += "| " + name + " | " + system_cells + frames + " | " + Fmt("%.1f", p.path_length_m) + " | " +
           mean_std("noisy", "rmse_se3_m", "%.3f") + " | " + mean_std("online", "rmse_se3_m", "%.3f") + " | " +
@@ -143,8 +144,8 @@ std::string DrawTableMarkdown(const std::vector<PresetSummary>& presets, double 
     std::string failed;
     for (int64_t seed : c.failed_seeds) failed += (failed.empty() ? "" : ", ") + std::to_string(seed);
     md += "| `" + p.preset + "`" + (p.system != "rovo" ? " " + p.system : std::string()) + " | " + std::to_string(n) +
-          " | " + FmtStat(draws->Find("rmse_se3_m"), n, "%.3f") +
-          " | " + FmtStat(draws->Find("max_final_ext_rotation_deg"), n, "%.3f") + " | " +
+          " | " + FmtStat(draws->Find("rmse_se3_m"), n, "%.3f") + " | " +
+          FmtStat(draws->Find("max_final_ext_rotation_deg"), n, "%.3f") + " | " +
           Fmt("%.0f", 100.0 * c.converged / std::max(1, c.draws)) + " % (" + std::to_string(c.converged) + " of " +
           std::to_string(c.draws) + ") | " + (failed.empty() ? "-" : failed) + " |\n";
   }

@@ -16,8 +16,8 @@
 #include <stdexcept>
 
 #include "datasets/io.h"
-#include "render/render.h"
 #include "eval/orchestration/suite_systems.h"
+#include "render/render.h"
 #include "rovo/version.h"
 
 namespace rovo {

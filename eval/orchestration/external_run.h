@@ -10,9 +10,10 @@
 namespace rovo {
 
 struct ChildSpec {
-  std::vector<std::string> argv;                          // argv[0]: the program's path
-  std::vector<std::pair<std::string, std::string>> env;   // set on top of this process's environment
-  std::string stdout_path, stderr_path;                   // truncated, written by the child
+  std::vector<std::string> argv;                         // argv[0]: the program's path
+  std::vector<std::pair<std::string, std::string>> env;  // set on top of this process's environment
+  std::string stdout_path, stderr_path;                  // absolute; truncated, written by the child
+  std::string cwd;                                       // the child's working folder ("" = this one's)
   double timeout_s = 600.0;
 };
 
@@ -23,10 +24,10 @@ struct ChildResult {
   int signal = 0;           // when a signal ended it (SIGKILL after a timeout)
   bool timed_out = false;
   double wall_s = 0.0;
-  double user_cpu_s = 0.0;    // the child and the descendants it waited for (wait4)
+  double user_cpu_s = 0.0;  // the child and the descendants it waited for (wait4)
   double system_cpu_s = 0.0;
-  double peak_rss_mb = 0.0;   // resident memory of the child's process group at its peak (sampled
-                              // every 20 ms from /proc: the sum over the group, or one process's VmHWM)
+  double peak_rss_mb = 0.0;  // resident memory of the child's process group at its peak (sampled
+                             // every 20 ms from /proc: the sum over the group, or one process's VmHWM)
 };
 
 // Runs the child to its end or the timeout (SIGTERM to the group, SIGKILL 2 s later); kills what is

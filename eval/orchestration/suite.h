@@ -105,7 +105,8 @@ uint64_t StoredNoiseSetSeed(uint64_t scene_seed, int k);
 
 // The "suite" object of a gates file (`rovo gate --run`, eval/gate.h): presets (strings), quick (bool),
 // noise_sets (1..1000), scene_seed and vo_seed (non-negative integers), vo_threads (0..1024),
-// max_new_features (-1..1000000); omitted fields keep quick true, noise_sets 1, seeds 0, vo_threads 0,
+// max_new_features (-1..1000000), systems (description files, relative to the gates file's folder);
+// omitted fields keep quick true, noise_sets 1, seeds 0, vo_threads 0,
 // max_new_features -1. Throws std::runtime_error "<gates_what>: suite.<field>: ..." otherwise.
 SuiteOptions GateSuiteOptions(const nlohmann::json& gates, const std::string& gates_what);
 
@@ -127,11 +128,11 @@ struct SuiteRun {
 
 // Everything a suite does, decided from its options alone (no file is read).
 struct SuitePlan {
-  SuiteOptions options;                   // presets filled in (all when none were named)
-  std::string data_dir;                   // options.data_dir or <out>/data
-  std::vector<std::string> dataset_dirs;  // per preset
-  std::vector<int> frame_ends;            // per preset: runs cover frames [0, end)
-  std::vector<SuiteRun> runs;             // per preset: gt, noisy_k / online_k, draw_d; then each system's
+  SuiteOptions options;                    // presets filled in (all when none were named)
+  std::string data_dir;                    // options.data_dir or <out>/data
+  std::vector<std::string> dataset_dirs;   // per preset
+  std::vector<int> frame_ends;             // per preset: runs cover frames [0, end)
+  std::vector<SuiteRun> runs;              // per preset: gt, noisy_k / online_k, draw_d; then each system's
   std::vector<SystemDescription> systems;  // options.systems, read
 };
 // Validates the options (throws std::invalid_argument naming the option) and reads the system

@@ -39,8 +39,10 @@ nlohmann::json PresetJson(const PresetSummary& p, const SuiteOptions& options) {
   pj["path_length_m"] = p.path_length_m;
   pj["align"] = p.align;
   if (p.cost) {
-    pj["cost_per_run"] = {
-        {"runs", p.cost->runs}, {"wall_s", p.cost->wall_s}, {"cpu_s", p.cost->cpu_s}, {"peak_rss_mb", p.cost->peak_rss_mb}};
+    pj["cost_per_run"] = {{"runs", p.cost->runs},
+                          {"wall_s", p.cost->wall_s},
+                          {"cpu_s", p.cost->cpu_s},
+                          {"peak_rss_mb", p.cost->peak_rss_mb}};
   }
   for (const ModeSummary& m : p.modes) {
     nlohmann::json mj;

@@ -187,8 +187,8 @@ SuitePlan PlanSuite(const SuiteOptions& options) {
     PlanPresetRuns(options, i, (fs::path(options.out_dir) / "runs" / preset).string(), frame_end, &plan.runs);
   }
   for (size_t i = 0; i < plan.options.presets.size(); ++i) {
-    PlanSystemRuns(plan, i, (fs::path(options.out_dir) / "runs" / plan.options.presets[i]).string(),
-                   plan.frame_ends[i], &plan.runs);
+    PlanSystemRuns(plan, i, (fs::path(options.out_dir) / "runs" / plan.options.presets[i]).string(), plan.frame_ends[i],
+                   &plan.runs);
   }
   return plan;
 }
@@ -232,6 +232,17 @@ SuiteOptions GateSuiteOptions(const nlohmann::json& gates, const std::string& ga
   options.vo_seed = seed("vo_seed");
   options.vo_threads = static_cast<int>(integer("vo_threads", 0, 0, 1024));
   options.max_new_features = static_cast<int>(integer("max_new_features", -1, -1, 1000000));
+  if (s.contains("systems")) {
+    if (!s["systems"].is_array()) fail("systems", "expected an array of system description files");
+    for (const nlohmann::json& file : s["systems"]) {
+      if (!file.is_string() || file.get<std::string>().empty()) {
+        fail("systems", "expected an array of system description files");
+      }
+      const fs::path path(file.get<std::string>());
+      options.systems.push_back(
+          (path.is_relative() ? fs::absolute(gates_what).parent_path() / path : path).lexically_normal().string());
+    }
+  }
   return options;
 }
 

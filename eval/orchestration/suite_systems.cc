@@ -151,8 +151,9 @@ void EurocCalibration(const std::string& export_dir, const std::string& run_dir,
   const std::vector<ExchangeCamera> given_cameras = GivenCameras(exported, info, cameras, given);
   for (const ExchangeCamera& camera : given_cameras) {
     const fs::path from = fs::path(export_dir) / "mav0" / camera.name, to = view / "mav0" / camera.name;
-    out->files.emplace_back((to / "sensor.yaml").string(),
-                            EurocSensorYaml(camera, info.frame_rate, "rovo " + camera.name + ", the run's calibration"));
+    out->files.emplace_back(
+        (to / "sensor.yaml").string(),
+        EurocSensorYaml(camera, info.frame_rate, "rovo " + camera.name + ", the run's calibration"));
     out->links.emplace_back((to / "data").string(), (from / "data").string());
     out->links.emplace_back((to / "data.csv").string(), (from / "data.csv").string());
   }
@@ -191,7 +192,8 @@ RunCalibration MakeRunCalibration(const SystemDescription& system, const std::st
     EurocCalibration(export_dir, run_dir, info, cameras, given, &out);
   }
   std::string all;
-  for (const auto& [path, content] : out.files) all += fs::path(path).lexically_relative(run_dir).string() + "\n" + content;
+  for (const auto& [path, content] : out.files)
+    all += fs::path(path).lexically_relative(run_dir).string() + "\n" + content;
   out.hash = HashHex(all.data(), all.size());
   return out;
 }
@@ -318,17 +320,20 @@ bool RunSystemRun(const SuitePlan& plan, const SuiteRun& run, int threads, bool 
   const SystemDescription& system = SystemOf(plan, run);
   const std::string& dataset_dir = plan.dataset_dirs[run.preset_index];
   const DatasetInfo info = ReadDatasetInfo(dataset_dir);
-  const std::string export_dir =
-      system.input == "rovo" ? "" : EnsureExport(plan, run.preset_index, system, info);
+  const std::string export_dir = system.input == "rovo" ? "" : EnsureExport(plan, run.preset_index, system, info);
   const std::string run_dir = fs::absolute(run.run_dir).lexically_normal().string();
   const RunCalibration calibration = MakeRunCalibration(system, fs::absolute(dataset_dir).lexically_normal().string(),
                                                         export_dir, run_dir, info, GivenExtrinsics(info, run.settings));
-  const SystemPlaceholders values{calibration.input,       calibration.calibration,
-                                  run_dir + "/out",        std::to_string(threads),
-                                  std::to_string(plan.options.vo_seed), ModeName(run.settings.mode)};
+  const SystemPlaceholders values{calibration.input,
+                                  calibration.calibration,
+                                  run_dir + "/out",
+                                  std::to_string(threads),
+                                  std::to_string(plan.options.vo_seed),
+                                  ModeName(run.settings.mode)};
   const std::vector<std::string> argv = ExpandCommand(system, values);
   std::vector<std::pair<std::string, std::string>> env;
-  for (const auto& [key, value] : system.env) env.emplace_back(key, ExpandPlaceholders(value, values, system.file, "env." + key));
+  for (const auto& [key, value] : system.env)
+    env.emplace_back(key, ExpandPlaceholders(value, values, system.file, "env." + key));
   if (FinishedRunMatches(run_dir, argv, EnvJson(env), calibration.hash)) {
     if (!plan.options.quiet) std::fprintf(stderr, "rovo suite: run %s is complete, skipping\n", run_dir.c_str());
     return false;
@@ -338,33 +343,34 @@ bool RunSystemRun(const SuitePlan& plan, const SuiteRun& run, int threads, bool 
   fs::create_directories(fs::path(run_dir) / "out");
   WriteRunCalibration(calibration);
   if (!quiet) std::fprintf(stderr, "rovo suite: %s: %s\n", system.name.c_str(), ShellQuoteWords(argv).c_str());
-  ChildSpec spec{argv, env, run_dir + "/stdout.log", run_dir + "/stderr.log", system.timeout_s};
+  ChildSpec spec{argv, env, run_dir + "/stdout.log", run_dir + "/stderr.log", run_dir + "/out", system.timeout_s};
   const ChildResult child = RunChild(spec);
-  nlohmann::json record = {{"generator", "rovo suite"},
-                           {"generator_version", ROVO_VERSION},
-                           {"system", system.name},
-                           {"description", fs::absolute(system.file).lexically_normal().string()},
-                           {"run", run.name},
-                           {"mode", ModeName(run.settings.mode)},
-                           {"noise_set", run.settings.mode == ExtrinsicsMode::kGroundTruth ? -1 : run.settings.noise_set},
-                           {"draw_seed", run.settings.draw_seed},
-                           {"seed", plan.options.vo_seed},
-                           {"threads", threads},
-                           {"command", argv},
-                           {"command_line", ShellQuoteWords(argv)},
-                           {"env", EnvJson(env)},
-                           {"input", calibration.input},
-                           {"calibration", calibration.calibration},
-                           {"calibration_sha", calibration.hash},
-                           {"timeout_s", system.timeout_s},
-                           {"exit_code", child.exit_code},
-                           {"signal", child.signal},
-                           {"timed_out", child.timed_out},
-                           {"wall_s", child.wall_s},
-                           {"user_cpu_s", child.user_cpu_s},
-                           {"system_cpu_s", child.system_cpu_s},
-                           {"cpu_s", child.user_cpu_s + child.system_cpu_s},
-                           {"peak_rss_mb", child.peak_rss_mb}};
+  nlohmann::json record = {
+      {"generator", "rovo suite"},
+      {"generator_version", ROVO_VERSION},
+      {"system", system.name},
+      {"description", fs::absolute(system.file).lexically_normal().string()},
+      {"run", run.name},
+      {"mode", ModeName(run.settings.mode)},
+      {"noise_set", run.settings.mode == ExtrinsicsMode::kGroundTruth ? -1 : run.settings.noise_set},
+      {"draw_seed", run.settings.draw_seed},
+      {"seed", plan.options.vo_seed},
+      {"threads", threads},
+      {"command", argv},
+      {"command_line", ShellQuoteWords(argv)},
+      {"env", EnvJson(env)},
+      {"input", calibration.input},
+      {"calibration", calibration.calibration},
+      {"calibration_sha", calibration.hash},
+      {"timeout_s", system.timeout_s},
+      {"exit_code", child.exit_code},
+      {"signal", child.signal},
+      {"timed_out", child.timed_out},
+      {"wall_s", child.wall_s},
+      {"user_cpu_s", child.user_cpu_s},
+      {"system_cpu_s", child.system_cpu_s},
+      {"cpu_s", child.user_cpu_s + child.system_cpu_s},
+      {"peak_rss_mb", child.peak_rss_mb}};
   const std::string trajectory = ExpandPlaceholders(system.trajectory, values, system.file, "trajectory");
   record["trajectory"] = trajectory;
   ReadBackTrajectory(child, trajectory, ReadTum(GroundTruthPath(dataset_dir)), run_dir, &record);

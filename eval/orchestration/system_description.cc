@@ -25,8 +25,9 @@ namespace {
 }
 
 const std::vector<std::string>& KnownKeys() {
-  static const std::vector<std::string> keys = {"name",  "input", "command",   "trajectory", "online_calibration",
-                                                "timeout_s", "align", "env", "needs_imu", "cameras", "lens"};
+  static const std::vector<std::string> keys = {"name",      "input", "command", "trajectory", "online_calibration",
+                                                "timeout_s", "align", "env",     "needs_imu",  "cameras",
+                                                "lens"};
   return keys;
 }
 
@@ -135,8 +136,9 @@ SystemDescription ParseSystemDescription(const std::string& yaml_text, const std
   for (const auto& item : root) {
     const std::string key = item.first.IsScalar() ? item.first.Scalar() : "?";
     if (std::find(KnownKeys().begin(), KnownKeys().end(), key) == KnownKeys().end()) {
-      Fail(file, key, "unknown key (known: name, input, command, trajectory, online_calibration, timeout_s, align, "
-                      "env, needs_imu, cameras, lens)");
+      Fail(file, key,
+           "unknown key (known: name, input, command, trajectory, online_calibration, timeout_s, align, "
+           "env, needs_imu, cameras, lens)");
     }
   }
   SystemDescription s;

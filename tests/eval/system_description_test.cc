@@ -1,5 +1,7 @@
 // System descriptions (eval/orchestration/system_description.h) and the child runner
 // (eval/orchestration/external_run.h).
+#include "eval/orchestration/system_description.h"
+
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <unistd.h>
@@ -11,7 +13,6 @@
 
 #include "datasets/io.h"
 #include "eval/orchestration/external_run.h"
-#include "eval/orchestration/system_description.h"
 
 namespace rovo {
 namespace {
@@ -32,7 +33,8 @@ std::string ErrorOf(const std::string& yaml) {
 
 TEST(SystemDescription, ReadsKeysAndDefaults) {
   const SystemDescription s = ParseSystemDescription(
-      std::string(kValid) + "online_calibration: true\ntimeout_s: 12.5\nalign: sim3\nenv: {OMP_NUM_THREADS: \"{threads}\"}\nlens: kb4\n",
+      std::string(kValid) +
+          "online_calibration: true\ntimeout_s: 12.5\nalign: sim3\nenv: {OMP_NUM_THREADS: \"{threads}\"}\nlens: kb4\n",
       "sys.yaml");
   EXPECT_EQ(s.name, "mine");
   EXPECT_EQ(s.input, "euroc");
@@ -72,8 +74,9 @@ TEST(SystemDescription, ErrorsNameTheFileAndTheField) {
   EXPECT_NE(ErrorOf(std::string(kValid) + "timeout: 3\n").find("sys.yaml: timeout: unknown key"), std::string::npos);
   EXPECT_NE(ErrorOf(std::string(kValid) + "cameras: [0, 0]\n").find("sys.yaml: cameras: camera 0 is listed twice"),
             std::string::npos);
-  EXPECT_NE(ErrorOf("name: a\ninput: euroc\ncommand: \"x 'y\"\ntrajectory: t\n").find("sys.yaml: command: unterminated"),
-            std::string::npos);
+  EXPECT_NE(
+      ErrorOf("name: a\ninput: euroc\ncommand: \"x 'y\"\ntrajectory: t\n").find("sys.yaml: command: unterminated"),
+      std::string::npos);
   EXPECT_NE(ErrorOf("name: rovo\ninput: euroc\ncommand: x\ntrajectory: t\n").find("sys.yaml: name:"),
             std::string::npos);
   EXPECT_NE(ErrorOf("[1, 2").find("sys.yaml: not YAML"), std::string::npos);
@@ -115,20 +118,25 @@ class ChildTest : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
   ChildSpec Spec(const std::string& script, double timeout_s = 30.0) const {
-    return {{"/bin/sh", "-c", script}, {{"ROVO_CHILD_TEST", "v"}}, (dir_ / "out.log").string(),
-            (dir_ / "err.log").string(), timeout_s};
+    return {{"/bin/sh", "-c", script},
+            {{"ROVO_CHILD_TEST", "v"}},
+            (dir_ / "out.log").string(),
+            (dir_ / "err.log").string(),
+            dir_.string(),
+            timeout_s};
   }
   fs::path dir_;
 };
 
 TEST_F(ChildTest, ExitStatusOutputAndEnvironment) {
-  const ChildResult r = RunChild(Spec("echo out; echo \"err $ROVO_CHILD_TEST\" >&2; exit 3"));
+  const ChildResult r = RunChild(Spec("echo out; echo \"err $ROVO_CHILD_TEST\" >&2; pwd > cwd.txt; exit 3"));
   EXPECT_TRUE(r.started);
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_EQ(r.signal, 0);
   EXPECT_FALSE(r.timed_out);
   EXPECT_EQ(ReadFile((dir_ / "out.log").string()), "out\n");
   EXPECT_EQ(FileTail((dir_ / "err.log").string(), 100), "err v\n");
+  EXPECT_EQ(ReadFile((dir_ / "cwd.txt").string()), fs::canonical(dir_).string() + "\n");
 }
 
 TEST_F(ChildTest, CrashIsASignal) {
@@ -167,8 +175,9 @@ TEST_F(ChildTest, MissingProgramDoesNotStart) {
 
 TEST_F(ChildTest, MeasuresCpuAndMemory) {
   // About 64 MB held by a child of the shell while it spins.
-  const ChildResult r = RunChild(Spec("python3 -c \"b = bytearray(64 << 20); import time; t = time.time()\n"
-                                      "while time.time() - t < 0.5: b[0] = 1\""));
+  const ChildResult r =
+      RunChild(Spec("python3 -c \"b = bytearray(64 << 20); import time; t = time.time()\n"
+                    "while time.time() - t < 0.5: b[0] = 1\""));
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_GT(r.user_cpu_s + r.system_cpu_s, 0.2);
   EXPECT_GT(r.peak_rss_mb, 60.0);

@@ -113,9 +113,9 @@ CommandResult SystemsSuiteTest::first_;
 
 TEST_F(SystemsSuiteTest, TableShowsEverySystemAndHowItsRunsEnded) {
   ASSERT_EQ(first_.status, 0) << first_.output;
-  for (const char* row : {"| rovo | 5 ok |", "| reference | 3 ok |", "| reference_mono (Sim(3)) | 3 ok |",
-                          "| crash | 3 crashed |", "| hang | 3 timeout |", "| silent | 3 no trajectory |",
-                          "| garbage | 3 unparsable trajectory |"}) {
+  for (const char* row :
+       {"| rovo | 5 ok |", "| reference | 3 ok |", "| reference_mono (Sim(3)) | 3 ok |", "| crash | 3 crashed |",
+        "| hang | 3 timeout |", "| silent | 3 no trajectory |", "| garbage | 3 unparsable trajectory |"}) {
     EXPECT_NE(first_.output.find(row), std::string::npos) << row << "\n" << first_.output;
   }
   EXPECT_NE(ReadFile(suite_dir_ + "/table.md").find("| crash | 3 crashed |"), std::string::npos);
