@@ -5,6 +5,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -42,8 +43,8 @@ const SystemDescription& SystemOf(const SuitePlan& plan, const SuiteRun& run) {
 // The rig cameras the export writes, in export order.
 std::vector<int> ExportCameras(const SystemDescription& system, int rig_cameras) {
   if (!system.cameras.empty()) return system.cameras;
-  std::vector<int> all;
-  for (int i = 0; i < rig_cameras; ++i) all.push_back(i);
+  std::vector<int> all(static_cast<size_t>(std::max(0, rig_cameras)));
+  for (int i = 0; i < rig_cameras; ++i) all[static_cast<size_t>(i)] = i;
   return all;
 }
 
@@ -92,7 +93,7 @@ std::string EnsureExport(const SuitePlan& plan, size_t preset_index, const Syste
                          const DatasetInfo& info) {
   const int frames = plan.frame_ends[preset_index];
   const bool part = frames < info.frame_count;
-  const std::string dir = ExportDirFor(plan, preset_index, system) + (part ? "_frames_" + std::to_string(frames) : "");
+  std::string dir = ExportDirFor(plan, preset_index, system) + (part ? "_frames_" + std::to_string(frames) : "");
   EnsureWritableDir(fs::path(dir).parent_path().string());
   const FileLock lock(fs::path(dir).parent_path().string() + "/export.lock");
   const std::string marker = (fs::path(dir) / "rovo_export.json").string();
