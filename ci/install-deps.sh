@@ -4,7 +4,7 @@
 # Usage: ci/install-deps.sh [demo|all]   (default all)
 #   demo: what building rovo and running `rovo demo` need (ci/demo.sh);
 #   all:  also what the tests use: lint tools, Blender (exporter and Cycles cross-checks), Chromium
-#         (report screenshots), Slurm (batch tests).
+#         (report screenshots), Slurm (batch tests), COLMAP (the third-party system of the suite tests).
 set -euo pipefail
 what=${1:-all}
 
@@ -20,7 +20,7 @@ PACKAGES=(
 )
 case "$what" in
   demo) ;;
-  all) PACKAGES+=(clang-format clang-tidy blender chromium slurm-wlm munge) ;;
+  all) PACKAGES+=(clang-format clang-tidy blender chromium slurm-wlm munge colmap) ;;
   *) echo "install-deps: unknown set '$what' (demo or all)" >&2; exit 2 ;;
 esac
 

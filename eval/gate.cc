@@ -18,9 +18,17 @@ std::string Fmt(double value) {
 
 // The suite's mean of a metric (suite.json /presets/<preset>/modes/<mode>/<metric>, with n > 0 runs),
 // or none when any part is missing or not of the expected type.
-std::optional<double> SuiteMean(const nlohmann::json& suite, const std::string& preset, const std::string& mode,
-                                const std::string& metric) {
+// Another system's figures are under /systems/<system>/presets/...
+std::optional<double> SuiteMean(const nlohmann::json& suite, const std::string& system, const std::string& preset,
+                                const std::string& mode, const std::string& metric) {
   const nlohmann::json* node = &suite;
+  if (system != "rovo") {
+    if (!suite.is_object() || !suite.contains("systems") || !suite["systems"].is_object() ||
+        !suite["systems"].contains(system)) {
+      return std::nullopt;
+    }
+    node = &suite["systems"][system];
+  }
   for (const std::string& key : {std::string("presets"), preset, std::string("modes"), mode, metric}) {
     if (!node->is_object()) return std::nullopt;
     const auto it = node->find(key);
@@ -68,11 +76,12 @@ std::vector<GateCheck> CheckGates(const nlohmann::json& gates, const std::string
       throw std::runtime_error(where + ": field \"" + (has_max ? "max" : "min") + "\" must be a number");
     c.is_max = has_max;
     c.bound = bound.get<double>();
+    if (g.contains("system")) c.system = text("system");
     if (g.contains("note")) {
       if (!g["note"].is_string()) throw std::runtime_error(where + ": field \"note\" must be a string");
       c.note = g["note"].get<std::string>();
     }
-    c.value = SuiteMean(suite, c.preset, c.mode, c.metric);
+    c.value = SuiteMean(suite, c.system, c.preset, c.mode, c.metric);
     c.pass = c.value && (c.is_max ? *c.value <= c.bound : *c.value >= c.bound);
     checks.push_back(c);
   }
@@ -86,8 +95,9 @@ bool AllGatesPass(const std::vector<GateCheck>& checks) {
 std::string GateTableMarkdown(const std::vector<GateCheck>& checks) {
   std::string md = "| preset | mode | metric | value (mean) | bound | result |\n|---|---|---|---|---|---|\n";
   for (const GateCheck& c : checks) {
-    md += "| " + c.preset + " | " + c.mode + " | " + c.metric + " | " + (c.value ? Fmt(*c.value) : "missing") + " | " +
-          (c.is_max ? "<= " : ">= ") + Fmt(c.bound) + " | " + (c.pass ? "pass" : "**FAIL**") + " |\n";
+    md += "| " + c.preset + (c.system != "rovo" ? " (" + c.system + ")" : "") + " | " + c.mode + " | " + c.metric +
+          " | " + (c.value ? Fmt(*c.value) : "missing") + " | " + (c.is_max ? "<= " : ">= ") + Fmt(c.bound) + " | " +
+          (c.pass ? "pass" : "**FAIL**") + " |\n";
   }
   return md;
 }

@@ -8,8 +8,11 @@
 // Each gate names a preset, a mode (gt|noisy|online), a metric of AggregatedMetricNames() and a
 // bound "max" (value <= max passes) or "min" (value >= min passes). The value is the metric's
 // mean over the suite's noise sets. A metric missing from the suite fails its gate.
+// A gate may name a "system" (default "rovo"): the value is then that system's (docs/systems.md), from
+// suite.json's /systems/<system>/presets/...
 // "suite" (read by `rovo gate --run`, GateSuiteOptions in eval/orchestration/suite.h) may also hold "vo_seed",
-// "vo_threads" and "max_new_features" (SuiteOptions); omitted ones take SuiteOptions' defaults.
+// "vo_threads", "max_new_features" and "systems" (description files, relative to the gates file's
+// folder; SuiteOptions); omitted ones take SuiteOptions' defaults.
 
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -20,7 +23,8 @@ namespace rovo {
 
 struct GateCheck {
   std::string preset, mode, metric;
-  bool is_max = true;  // bound kind: value <= bound (max) or value >= bound (min)
+  std::string system = "rovo";  // "system": another system of the suite (suite.json /systems/<system>)
+  bool is_max = true;           // bound kind: value <= bound (max) or value >= bound (min)
   double bound = 0.0;
   std::optional<double> value;
   bool pass = false;

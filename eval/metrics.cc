@@ -264,6 +264,14 @@ std::vector<ExtrinsicError> ExtrinsicErrors(const std::vector<ExtrinsicsRecord>&
   return errors;
 }
 
+double GtPathLength(const Trajectory& gt) {
+  double length = 0.0;
+  for (size_t i = 1; i < gt.size(); ++i) {
+    length += (gt[i].world_from_rig.translation - gt[i - 1].world_from_rig.translation).norm();
+  }
+  return length;
+}
+
 namespace {
 
 double MedianInterval(const Trajectory& trajectory) {
@@ -272,14 +280,6 @@ double MedianInterval(const Trajectory& trajectory) {
   if (dt.empty()) return 0.0;
   std::nth_element(dt.begin(), dt.begin() + static_cast<long>(dt.size() / 2), dt.end());
   return dt[dt.size() / 2];
-}
-
-double GtPathLength(const Trajectory& gt) {
-  double length = 0.0;
-  for (size_t i = 1; i < gt.size(); ++i) {
-    length += (gt[i].world_from_rig.translation - gt[i - 1].world_from_rig.translation).norm();
-  }
-  return length;
 }
 
 // A run over frames [a, b) of the dataset (run.json "frames") is scored against that span of the

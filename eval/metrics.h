@@ -47,6 +47,9 @@ struct Association {
 };
 Association AssociateByTimestamp(const Trajectory& gt, const Trajectory& estimate, double tolerance_s);
 
+// Length of the ground-truth path: the sum of the distances between consecutive positions.
+double GtPathLength(const Trajectory& gt);
+
 // Root mean square of |p_gt_i - gt_from_est * p_est_i| over the pairs.
 double TranslationRmse(const Trajectory& gt, const Trajectory& estimate, const Association& association,
                        const Rigid3& gt_from_est);
@@ -149,7 +152,7 @@ struct RunMetrics {
   std::vector<double> mean_ext_rotation_deg, mean_ext_translation_m;
   double max_final_ext_rotation_deg = 0.0;
   double max_final_ext_translation_m = 0.0;
-  std::string alignment_note;  // why rmse is empty, if it is
+  std::string alignment_note;        // why rmse is empty, if it is
 };
 
 // Per-frame error along the path (after SE(3) alignment, or origin alignment as fallback).

@@ -435,11 +435,16 @@ std::vector<RunEvaluation> EvaluateAndReport(const std::string& dataset_dir, con
   std::string summary = SummaryHeader();
   for (const std::string& run_dir : run_dirs) {
     std::string note;
-    const RunData run = ReadRunOrTrajectory(run_dir, gt, options.trajectory_format, &note);
+    const size_t index = evaluations.size();
+    RunData run = ReadRunOrTrajectory(run_dir, gt, options.trajectory_format, &note);
+    if (options.frame_end > 0 && !run.info.contains("frames")) run.info["frames"] = {0, options.frame_end};
     if (!note.empty() && !options.quiet) std::printf("%s\n", note.c_str());
-    const std::string label = UniqueRunLabel(run_dir, &label_count);
+    const std::string label =
+        UniqueRunLabel(index < options.labels.size() ? options.labels[index] : run_dir, &label_count);
+    EvalOptions eval = options.eval;
+    if (index < options.sim3.size() && options.sim3[index]) eval.align = "sim3";
 
-    RunEvaluation evaluation = EvaluateRun(gt, gt_cam_from_rig, run, label, options.eval);
+    RunEvaluation evaluation = EvaluateRun(gt, gt_cam_from_rig, run, label, eval);
     const RunMetrics& m = evaluation.metrics;
     const std::string run_out = (fs::path(out_dir) / label).string();
     EnsureWritableDir(run_out);

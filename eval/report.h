@@ -26,6 +26,11 @@ struct EvalReportOptions {
   bool quiet = false;
   EvalOptions eval;
   std::string trajectory_format = "auto";  // of runs from other systems (eval/foreign_run.h)
+  // Per run (in run_dirs order; shorter or empty: the defaults): its label instead of the folder's
+  // name, and whether it is scored after Sim(3) scaling (EvalOptions::align sim3).
+  std::vector<std::string> labels;
+  std::vector<bool> sim3;
+  int frame_end = 0;  // > 0: runs that do not say which frames they cover cover [0, frame_end)
 };
 
 nlohmann::json MetricsToJson(const RunMetrics& metrics);

@@ -26,6 +26,9 @@ struct ModeSummary {
   std::vector<RunMetrics> runs;
   std::vector<std::pair<std::string, Stat>> stats;  // name -> stat, names in kAggregatedMetrics order
   std::vector<int64_t> draw_seeds;                  // draws: the seed of each run, in runs order
+  // Per run, in runs order (filled by the suite's merge; empty elsewhere): its folder and how it
+  // ended ("ok", or an external system's failure: crashed, timeout, failed, no trajectory, ...).
+  std::vector<std::string> run_dirs, statuses;
   std::optional<Stat> Find(const std::string& name) const;
 };
 
@@ -40,8 +43,18 @@ struct DrawConvergence {
 };
 DrawConvergence ComputeDrawConvergence(const ModeSummary& draws);
 
+// What an external system's runs cost (suite_systems.h: wall and CPU time from wait4, peak resident
+// memory), mean over the runs that started.
+struct SystemCost {
+  int runs = 0;
+  double wall_s = 0.0, cpu_s = 0.0, peak_rss_mb = 0.0;
+};
+
 struct PresetSummary {
   std::string preset;
+  std::string system = "rovo";  // rovo's pipeline, or an external system's name (docs/systems.md)
+  std::string align = "se3";    // how its runs are scored: se3, or sim3 (scale fitted first)
+  std::optional<SystemCost> cost;
   std::string dataset_dir;
   int frames = 0;                  // frames the runs cover (the first N of the dataset)
   int dataset_frames = 0;          // frames of the preset's trajectory; > frames for a --frames suite

@@ -39,14 +39,35 @@ std::optional<PaperRow> PaperRowForPreset(const std::string& preset) {
   return std::nullopt;
 }
 
+std::string RunStatusCounts(const PresetSummary& p) {
+  std::vector<std::pair<std::string, int>> counts;
+  for (const ModeSummary& m : p.modes) {
+    for (const std::string& status : m.statuses) {
+      const std::string word = status.substr(0, status.find(" ("));
+      auto it = std::find_if(counts.begin(), counts.end(), [&](const auto& c) { return c.first == word; });
+      if (it == counts.end()) {
+        counts.emplace_back(word, 1);
+      } else {
+        ++it->second;
+      }
+    }
+  }
+  std::string out;
+  for (const auto& [word, n] : counts) out += (out.empty() ? "" : ", ") + std::to_string(n) + " " + word;
+  return out.empty() ? "-" : out;
+}
+
 std::string SuiteTableMarkdown(const std::vector<PresetSummary>& presets, bool quick) {
-  std::string md =
-      "| sequence | frames | length [m] | RMSE NoisyExt [m] | RMSE OnlineExt [m] | RMSE GTExt [m] | rel. "
-      "Noisy/Online/GT "
-      "[%] | paper rel. Noisy/Online/GT [%] | inliers Online/GT [%] | paper | reproj Online/GT [deg] | paper | "
-      "ext rot Online [deg] | drift Online / GT [%] raw → body-aligned |\n"
-      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  const bool systems =
+      std::any_of(presets.begin(), presets.end(), [](const PresetSummary& p) { return p.system != "rovo"; });
+  std::string md = std::string("| sequence | ") + (systems ? "system | runs | " : "") +
+                   "frames | length [m] | RMSE NoisyExt [m] | RMSE OnlineExt [m] | RMSE GTExt [m] | rel. "
+                   "Noisy/Online/GT "
+                   "[%] | paper rel. Noisy/Online/GT [%] | inliers Online/GT [%] | paper | reproj Online/GT [deg] | "
+                   "paper | ext rot Online [deg] | drift Online / GT [%] raw → body-aligned |\n|---|" +
+                   (systems ? "---|---|" : "") + "---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const PresetSummary& p : presets) {
+    const bool own = p.system == "rovo";  // external systems report no inliers, reprojection or extrinsics
     auto stat = [&](const char* mode, const char* name) -> std::optional<Stat> {
       const ModeSummary* m = p.Find(mode);
       return m ? m->Find(name) : std::nullopt;
@@ -76,18 +97,34 @@ std::string SuiteTableMarkdown(const std::vector<PresetSummary>& presets, bool q
     const std::string frames =
         std::to_string(p.frames) +
         (p.dataset_frames > p.frames ? " of " + std::to_string(p.dataset_frames) : std::string());
-    md += "| " + name + " | " + frames + " | " + Fmt("%.1f", p.path_length_m) + " | " +
+    const std::string system_cells =
+        systems ? p.system + (p.align == "sim3" ? " (Sim(3))" : "") + " | " + RunStatusCounts(p) + " | " : "";
+    const std::string inliers = own ? mean("online", "mean_inlier_ratio", "%.1f", 100.0) + " / " +
+                                          mean("gt", "mean_inlier_ratio", "%.1f", 100.0)
+                                    : "-";
+    const std::string reproj =
+        own ? mean("online", "mean_reproj_error_deg", "%.3f") + " / " + mean("gt", "mean_reproj_error_deg", "%.3f")
+            : "-";
+    const std::string ext_rot = own ? mean_std("online", "max_final_ext_rotation_deg", "%.3f") : "-";
+    md += "| " + name + " | " + system_cells + frames + " | " + Fmt("%.1f", p.path_length_m) + " | " +
           mean_std("noisy", "rmse_se3_m", "%.3f") + " | " + mean_std("online", "rmse_se3_m", "%.3f") + " | " +
           mean_std("gt", "rmse_se3_m", "%.3f") + " | " + mean("noisy", "relative_rmse_pct", "%.2f") + " / " +
           mean("online", "relative_rmse_pct", "%.3f") + " / " + mean("gt", "relative_rmse_pct", "%.3f") + " | " +
-          paper_rel + " | " + mean("online", "mean_inlier_ratio", "%.1f", 100.0) + " / " +
-          mean("gt", "mean_inlier_ratio", "%.1f", 100.0) + " | " + paper_inl + " | " +
-          mean("online", "mean_reproj_error_deg", "%.3f") + " / " + mean("gt", "mean_reproj_error_deg", "%.3f") +
-          " | " + paper_rep + " | " + mean_std("online", "max_final_ext_rotation_deg", "%.3f") + " | " +
-          mean("online", "drift_translation_pct", "%.2f") + " → " +
+          paper_rel + " | " + inliers + " | " + paper_inl + " | " + reproj + " | " + paper_rep + " | " + ext_rot +
+          " | " + mean("online", "drift_translation_pct", "%.2f") + " → " +
           mean("online", "body_aligned_drift_translation_pct", "%.2f") + " / " +
-          mean("gt", "drift_translation_pct", "%.2f") + " → " +
-          mean("gt", "body_aligned_drift_translation_pct", "%.2f") + " |\n";
+          mean("gt", "drift_translation_pct", "%.2f") + " → " + mean("gt", "body_aligned_drift_translation_pct", "%.2f") +
+          " |\n";
+  }
+  if (systems) {
+    md +=
+        "\nsystem: rovo = this pipeline; others run from their description (docs/systems.md), scored on the "
+        "trajectory they wrote; Sim(3): the estimate is scaled by the Sim(3) alignment's scale first (monocular "
+        "systems). runs: how the system's runs ended (ok, crashed, timeout, failed = non-zero exit, no "
+        "trajectory, unparsable trajectory); a run that did not end ok has no RMSE, so the mean is over fewer "
+        "runs (\"k of K runs\"). Other systems report no inlier ratio, reprojection error or extrinsics (-). "
+        "NoisyExt gives a system the perturbed extrinsics in its own calibration file; OnlineExt runs only "
+        "for systems that calibrate online.\n";
   }
   md +=
       "\nRMSE = translation RMSE after SE(3) Umeyama alignment (mean ± std over the noise sets; GTExt runs once; "
@@ -112,8 +149,9 @@ std::string DrawTableMarkdown(const std::vector<PresetSummary>& presets, double 
     const DrawConvergence c = ComputeDrawConvergence(*draws);
     std::string failed;
     for (int64_t seed : c.failed_seeds) failed += (failed.empty() ? "" : ", ") + std::to_string(seed);
-    md += "| `" + p.preset + "` | " + std::to_string(n) + " | " + FmtStat(draws->Find("rmse_se3_m"), n, "%.3f") +
-          " | " + FmtStat(draws->Find("max_final_ext_rotation_deg"), n, "%.3f") + " | " +
+    md += "| `" + p.preset + "`" + (p.system != "rovo" ? " " + p.system : std::string()) + " | " + std::to_string(n) +
+          " | " + FmtStat(draws->Find("rmse_se3_m"), n, "%.3f") + " | " +
+          FmtStat(draws->Find("max_final_ext_rotation_deg"), n, "%.3f") + " | " +
           Fmt("%.0f", 100.0 * c.converged / std::max(1, c.draws)) + " % (" + std::to_string(c.converged) + " of " +
           std::to_string(c.draws) + ") | " + (failed.empty() ? "-" : failed) + " |\n";
   }
@@ -125,6 +163,26 @@ std::string DrawTableMarkdown(const std::vector<PresetSummary>& presets, double 
          "est(cam_i_from_cam0) · true(cam_i_from_cam0)⁻¹ at the last frame; a draw has converged when it is below "
          "the threshold. Draw seeds (suite.json \"draw_seeds\") are derived from the scene and VO seeds and never "
          "equal a stored noise set's.\n";
+}
+
+}  // namespace rovo
+
+namespace rovo {
+
+std::string SystemCostMarkdown(const std::vector<PresetSummary>& presets) {
+  std::string md;
+  for (const PresetSummary& p : presets) {
+    if (!p.cost) continue;
+    md += "| `" + p.preset + "` | " + p.system + " | " + std::to_string(p.cost->runs) + " | " +
+          Fmt("%.1f", p.cost->wall_s) + " | " + Fmt("%.1f", p.cost->cpu_s) + " | " + Fmt("%.0f", p.cost->peak_rss_mb) +
+          " |\n";
+  }
+  if (md.empty()) return "";
+  return "## Cost of the other systems' runs\n\n| sequence | system | runs | wall per run [s] | CPU per run [s] | "
+         "peak memory [MB] |\n|---|---|---|---|---|---|\n" +
+         md +
+         "\nwall and CPU (user + system) time of the system's process and the children it waited for (wait4), mean "
+         "over its runs; peak memory = the largest resident set of one of those processes over the runs.\n";
 }
 
 }  // namespace rovo

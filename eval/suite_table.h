@@ -17,10 +17,14 @@ struct PaperRow {
 };
 std::optional<PaperRow> PaperRowForPreset(const std::string& preset);
 
-// Table I layout: per preset, RMSE SE(3) of NoisyExt / OnlineExt / GTExt (mean +- std over noise
+// Table I layout (one row per preset and system; with other systems than rovo, a system column and
+// how its runs ended): per preset, RMSE SE(3) of NoisyExt / OnlineExt / GTExt (mean +- std over noise
 // sets) with our relative error and the paper's (RMSE / path length), inlier ratio and
 // reprojection error Online/GT beside the paper's, final extrinsic error of OnlineExt.
 std::string SuiteTableMarkdown(const std::vector<PresetSummary>& presets, bool quick);
+
+// Per preset and external system: wall and CPU time per run, peak memory; "" when there is none.
+std::string SystemCostMarkdown(const std::vector<PresetSummary>& presets);
 
 // Per preset with draws: RMSE, final extrinsic error (mean +- std) and the convergence rate; "" when
 // no preset has draws.

@@ -77,6 +77,11 @@ void AddSuiteOptions(CLI::App* cmd, SuiteCliArgs* args) {
                   "New detections per view and frame at most, while the view has tracks, in every run (rovo vo "
                   "--max-new-features; 0: no limit; default: rovo vo's). Runs made with another value are redone")
       ->check(CLI::Range(0, 100000));
+  cmd->add_option("--system", options->systems,
+                  "Description file of another odometry system to run through the same plan beside rovo's pipeline "
+                  "(repeatable; docs/systems.md): GTExt with the true calibration, NoisyExt with each noise set or "
+                  "draw written into the calibration it reads, OnlineExt when it calibrates online")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("--no-plots", args->no_plots, "Skip plots and report.html");
   cmd->add_option("--out", options->out_dir, "Suite output folder")->required();
 }
@@ -85,6 +90,8 @@ void PrintSuite(const std::vector<PresetSummary>& summaries, const SuiteOptions&
   std::printf("%s\n", SuiteTableMarkdown(summaries, options.quick).c_str());
   const std::string draws = DrawTableMarkdown(summaries, options.draw_sigma_deg);
   if (!draws.empty()) std::printf("%s\n", draws.c_str());
+  const std::string cost = SystemCostMarkdown(summaries);
+  if (!cost.empty()) std::printf("%s\n", cost.c_str());
   std::printf("Suite: %s (suite.json, table.md%s)\n", options.out_dir.c_str(), options.plots ? ", report.html" : "");
 }
 

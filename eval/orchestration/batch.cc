@@ -16,6 +16,7 @@
 #include <stdexcept>
 
 #include "datasets/io.h"
+#include "eval/orchestration/suite_systems.h"
 #include "render/render.h"
 #include "rovo/version.h"
 
@@ -118,7 +119,8 @@ std::string TaskWhat(const BatchLayout& layout, const std::string& stage, int in
   }
   if (stage == "vo") {
     const SuiteRun& run = plan.runs.at(index);
-    return "vo " + plan.options.presets[run.preset_index] + "/" + run.name;
+    const std::string system = run.system >= 0 ? plan.systems[static_cast<size_t>(run.system)].name + "/" : "";
+    return "vo " + plan.options.presets[run.preset_index] + "/" + system + run.name;
   }
   return "merge";
 }
@@ -192,8 +194,10 @@ BatchLayout PlanBatch(const SuiteOptions& suite, const BatchOptions& options) {
           .lexically_normal()
           .string();
   absolute.jobs = 1;
+  for (std::string& system : absolute.systems) system = fs::absolute(system).lexically_normal().string();
   BatchLayout layout;
   layout.suite = PlanSuite(absolute);
+  CheckSuiteSystems(layout.suite);
   layout.options = options;
   BatchOptions& o = layout.options;
   o.dir =
@@ -214,7 +218,12 @@ BatchLayout PlanBatch(const SuiteOptions& suite, const BatchOptions& options) {
   if (o.render.time.empty()) {
     o.render.time = TimeFor(shard_frames * (quick ? kRenderCoreSecondsQuick : kRenderCoreSecondsFull) / o.render.cpus);
   }
-  if (o.vo.time.empty()) o.vo.time = TimeFor(frames * (quick ? kVoSecondsQuick : kVoSecondsFull));
+  if (o.vo.time.empty()) {
+    // An external system's task may take its whole timeout, and the export before it.
+    double seconds = frames * (quick ? kVoSecondsQuick : kVoSecondsFull);
+    for (const SystemDescription& system : layout.suite.systems) seconds = std::max(seconds, system.timeout_s + 600.0);
+    o.vo.time = TimeFor(seconds);
+  }
   if (o.merge.time.empty()) o.merge.time = TimeFor(layout.suite.runs.size() * 20.0);
   return layout;
 }

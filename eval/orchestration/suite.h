@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "eval/metrics.h"
+#include "eval/orchestration/system_description.h"
 #include "eval/suite_summary.h"
 #include "eval/suite_table.h"
 #include "vo/pipeline.h"
@@ -77,6 +78,8 @@ struct SuiteOptions {
   }
   bool plots = true;
   bool quiet = false;
+  // Description files of other systems (--system, docs/systems.md) run beside rovo's own pipeline.
+  std::vector<std::string> systems;
 };
 
 // What a suite run must have been made with to be reused: its frames, mode, noise set or draw seed,
@@ -104,7 +107,8 @@ uint64_t StoredNoiseSetSeed(uint64_t scene_seed, int k);
 
 // The "suite" object of a gates file (`rovo gate --run`, eval/gate.h): presets (strings), quick (bool),
 // noise_sets (1..1000), scene_seed and vo_seed (non-negative integers), vo_threads (0..1024),
-// max_new_features (-1..1000000); omitted fields keep quick true, noise_sets 1, seeds 0, vo_threads 0,
+// max_new_features (-1..1000000), systems (description files, relative to the gates file's folder);
+// omitted fields keep quick true, noise_sets 1, seeds 0, vo_threads 0,
 // max_new_features -1. Throws std::runtime_error "<gates_what>: suite.<field>: ..." otherwise.
 SuiteOptions GateSuiteOptions(const nlohmann::json& gates, const std::string& gates_what);
 
@@ -120,31 +124,35 @@ struct SuiteRun {
   size_t preset_index = 0;
   std::string name;  // gt | noisy_<k> | online_<k> | draw_<d>: the run folder's name
   std::string run_dir;
+  int system = -1;  // -1: rovo's pipeline; else an index into SuitePlan::systems (suite_systems.h)
   RunSettings settings;
 };
 
 // Everything a suite does, decided from its options alone (no file is read).
 struct SuitePlan {
-  SuiteOptions options;                   // presets filled in (all when none were named)
-  std::string data_dir;                   // options.data_dir or <out>/data
-  std::vector<std::string> dataset_dirs;  // per preset
-  std::vector<int> frame_ends;            // per preset: runs cover frames [0, end)
-  std::vector<SuiteRun> runs;             // per preset: gt, noisy_k / online_k, draw_d
+  SuiteOptions options;                    // presets filled in (all when none were named)
+  std::string data_dir;                    // options.data_dir or <out>/data
+  std::vector<std::string> dataset_dirs;   // per preset
+  std::vector<int> frame_ends;             // per preset: runs cover frames [0, end)
+  std::vector<SuiteRun> runs;              // per preset: gt, noisy_k / online_k, draw_d; then each system's
+  std::vector<SystemDescription> systems;  // options.systems, read
 };
-// Validates the options (throws std::invalid_argument naming the option).
+// Validates the options (throws std::invalid_argument naming the option) and reads the system
+// descriptions (throws std::runtime_error naming the file and field).
 SuitePlan PlanSuite(const SuiteOptions& options);
 
 // Renders shard `shard` of `shards` of preset `preset_index`'s dataset with `threads` threads
 // (render/render.h: chunks of 8 frames); a complete dataset is not touched. Resumable.
 void RenderSuiteDataset(const SuitePlan& plan, size_t preset_index, int shard, int shards, int threads);
 // Runs one VO run with `threads` threads unless a reusable one exists (RunReusable); returns whether it
-// ran. `quiet` silences the run's progress.
+// ran. `quiet` silences the run's progress. An external system's run goes to RunSystemRun
+// (suite_systems.h): a failure of the system is recorded, not thrown.
 bool RunSuiteRun(const SuitePlan& plan, const SuiteRun& run, int threads, bool quiet);
 // Evaluates every run of the plan, writes reports/, suite.json, table.md and report.html.
 std::vector<PresetSummary> MergeSuite(const SuitePlan& plan);
 
-// The whole suite in this process: PlanSuite, RenderSuiteDataset, RunSuiteRun (--jobs at a time),
-// MergeSuite.
+// The whole suite in this process: PlanSuite, the systems' checks (before any rendering),
+// RenderSuiteDataset, RunSuiteRun (--jobs at a time), MergeSuite.
 std::vector<PresetSummary> RunSuite(const SuiteOptions& options);
 
 }  // namespace rovo

@@ -16,6 +16,7 @@
 #include "datasets/run.h"
 #include "eval/format.h"
 #include "eval/orchestration/suite.h"
+#include "eval/orchestration/suite_systems.h"
 #include "eval/plots.h"
 #include "eval/report.h"
 #include "render/render.h"
@@ -62,7 +63,8 @@ nlohmann::json SuiteOptionsToJson(const SuiteOptions& o) {
           {"vo_seed", o.vo_seed},
           {"max_new_features", o.max_new_features},
           {"plots", o.plots},
-          {"quiet", o.quiet}};
+          {"quiet", o.quiet},
+          {"systems", o.systems}};
 }
 
 SuiteOptions SuiteOptionsFromJson(const nlohmann::json& j, const std::string& source) {
@@ -89,6 +91,8 @@ SuiteOptions SuiteOptionsFromJson(const nlohmann::json& j, const std::string& so
     get("max_new_features", &o.max_new_features);
     get("plots", &o.plots);
     get("quiet", &o.quiet);
+    field = "systems";
+    if (j.contains("systems")) o.systems = j.at("systems").get<std::vector<std::string>>();
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(source + ": field \"" + field + "\": " + e.what());
   }
@@ -172,6 +176,7 @@ SuitePlan PlanSuite(const SuiteOptions& options) {
   if (plan.options.presets.empty()) {
     for (const ScenePreset& p : ScenePresets()) plan.options.presets.push_back(p.name);
   }
+  for (const std::string& file : options.systems) plan.systems.push_back(ReadSystemDescription(file));
   plan.data_dir = options.data_dir.empty() ? (fs::path(options.out_dir) / "data").string() : options.data_dir;
   for (size_t i = 0; i < plan.options.presets.size(); ++i) {
     const std::string& preset = plan.options.presets[i];
@@ -181,6 +186,10 @@ SuitePlan PlanSuite(const SuiteOptions& options) {
     plan.dataset_dirs.push_back(DatasetDirFor(plan.data_dir, preset, options));
     plan.frame_ends.push_back(frame_end);
     PlanPresetRuns(options, i, (fs::path(options.out_dir) / "runs" / preset).string(), frame_end, &plan.runs);
+  }
+  for (size_t i = 0; i < plan.options.presets.size(); ++i) {
+    PlanSystemRuns(plan, i, (fs::path(options.out_dir) / "runs" / plan.options.presets[i]).string(), plan.frame_ends[i],
+                   &plan.runs);
   }
   return plan;
 }
@@ -224,6 +233,17 @@ SuiteOptions GateSuiteOptions(const nlohmann::json& gates, const std::string& ga
   options.vo_seed = seed("vo_seed");
   options.vo_threads = static_cast<int>(integer("vo_threads", 0, 0, 1024));
   options.max_new_features = static_cast<int>(integer("max_new_features", -1, -1, 1000000));
+  if (s.contains("systems")) {
+    if (!s["systems"].is_array()) fail("systems", "expected an array of system description files");
+    for (const nlohmann::json& file : s["systems"]) {
+      if (!file.is_string() || file.get<std::string>().empty()) {
+        fail("systems", "expected an array of system description files");
+      }
+      const fs::path path(file.get<std::string>());
+      options.systems.push_back(
+          (path.is_relative() ? fs::absolute(gates_what).parent_path() / path : path).lexically_normal().string());
+    }
+  }
   return options;
 }
 

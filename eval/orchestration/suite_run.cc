@@ -16,6 +16,7 @@
 #include "datasets/run.h"
 #include "eval/format.h"
 #include "eval/orchestration/suite.h"
+#include "eval/orchestration/suite_systems.h"
 #include "eval/plots.h"
 #include "eval/report.h"
 #include "render/render.h"
@@ -200,6 +201,10 @@ void RenderSuiteDataset(const SuitePlan& plan, size_t preset_index, int shard, i
 }
 
 bool RunSuiteRun(const SuitePlan& plan, const SuiteRun& run, int threads, bool quiet) {
+  if (run.system >= 0) {
+    CheckSuiteDataset(plan, run.preset_index);
+    return RunSystemRun(plan, run, threads, quiet);
+  }
   std::string mismatch;
   if (RunReusable(run.run_dir, run.settings, &mismatch)) {
     if (!plan.options.quiet) std::fprintf(stderr, "rovo suite: run %s is complete, skipping\n", run.run_dir.c_str());
@@ -221,6 +226,7 @@ bool RunSuiteRun(const SuitePlan& plan, const SuiteRun& run, int threads, bool q
 
 std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
   const SuitePlan plan = PlanSuite(options);
+  CheckSuiteSystems(plan);
   EnsureWritableDir(options.out_dir);
   EnsureWritableDir(plan.data_dir);
   const int cores = options.threads > 0 ? options.threads : std::max(1u, std::thread::hardware_concurrency());
@@ -233,7 +239,7 @@ std::vector<PresetSummary> RunSuite(const SuiteOptions& options) {
   std::vector<const SuiteRun*> todo;
   for (const SuiteRun& run : plan.runs) {
     std::string mismatch;
-    if (!RunReusable(run.run_dir, run.settings, &mismatch)) todo.push_back(&run);
+    if (run.system >= 0 || !RunReusable(run.run_dir, run.settings, &mismatch)) todo.push_back(&run);
   }
   const int parallel = std::min<int>(options.jobs, std::max<int>(1, static_cast<int>(todo.size())));
   const int threads_per_run = options.vo_threads > 0 ? options.vo_threads : std::max(1, cores / parallel);
