@@ -9,8 +9,8 @@
 
 #include "datasets/dataset_validate.h"
 #include "datasets/exposure_csv.h"
-#include "datasets/optics_record.h"
 #include "datasets/imu.h"
+#include "datasets/optics_record.h"
 #include "datasets/rig.h"
 #include "datasets/rig_json.h"
 #include "datasets/trajectory.h"

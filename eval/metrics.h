@@ -152,7 +152,7 @@ struct RunMetrics {
   std::vector<double> mean_ext_rotation_deg, mean_ext_translation_m;
   double max_final_ext_rotation_deg = 0.0;
   double max_final_ext_translation_m = 0.0;
-  std::string alignment_note;        // why rmse is empty, if it is
+  std::string alignment_note;  // why rmse is empty, if it is
 };
 
 // Per-frame error along the path (after SE(3) alignment, or origin alignment as fallback).

@@ -113,8 +113,8 @@ std::string SuiteTableMarkdown(const std::vector<PresetSummary>& presets, bool q
           paper_rel + " | " + inliers + " | " + paper_inl + " | " + reproj + " | " + paper_rep + " | " + ext_rot +
           " | " + mean("online", "drift_translation_pct", "%.2f") + " → " +
           mean("online", "body_aligned_drift_translation_pct", "%.2f") + " / " +
-          mean("gt", "drift_translation_pct", "%.2f") + " → " + mean("gt", "body_aligned_drift_translation_pct", "%.2f") +
-          " |\n";
+          mean("gt", "drift_translation_pct", "%.2f") + " → " +
+          mean("gt", "body_aligned_drift_translation_pct", "%.2f") + " |\n";
   }
   if (systems) {
     md +=
