@@ -9,8 +9,14 @@ set -euo pipefail
 input=$1 calibration=$2 out=$3 threads=$4 camera=${5:-cam0}
 here=$(cd "$(dirname "$0")" && pwd)
 sensor="$calibration/$camera/sensor.yaml"
-images="$input/mav0/$camera/data"
-mkdir -p "$out/masks" "$out/sparse" "$out/text"
+# COLMAP orders images by name (the sequential matcher matches each with the next ones in that order):
+# link them as zero-padded nanoseconds so that the name order is the time order (9.png < 10.png).
+images="$out/images"
+rm -rf "$images" "$out/masks" "$out/sparse" "$out/text"
+mkdir -p "$images" "$out/masks" "$out/sparse" "$out/text"
+for image in "$input/mav0/$camera/data"/*.png; do
+  ln -s "$(readlink -f "$image")" "$images/$(printf '%020d' "$((10#$(basename "$image" .png)))").png"
+done
 params=$(python3 "$here/colmap_helper.py" params "$sensor")
 python3 "$here/colmap_helper.py" masks "$sensor" "$images" "$out/masks" 85
 rm -f "$out/database.db"
@@ -19,7 +25,8 @@ colmap feature_extractor --database_path "$out/database.db" --image_path "$image
   --ImageReader.camera_params "$params" --ImageReader.mask_path "$out/masks" \
   --SiftExtraction.use_gpu 0 --SiftExtraction.num_threads "$threads" --SiftExtraction.max_num_features 2048
 colmap sequential_matcher --database_path "$out/database.db" --SiftMatching.use_gpu 0 \
-  --SiftMatching.num_threads "$threads" --SequentialMatching.overlap 5
+  --SiftMatching.num_threads "$threads" --SequentialMatching.overlap 5 \
+  --SequentialMatching.quadratic_overlap 0
 colmap mapper --database_path "$out/database.db" --image_path "$images" --output_path "$out/sparse" \
   --Mapper.num_threads "$threads" --Mapper.ba_refine_focal_length 0 --Mapper.ba_refine_principal_point 0 \
   --Mapper.ba_refine_extra_params 0

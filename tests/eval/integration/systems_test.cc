@@ -220,21 +220,24 @@ TEST(SystemsBadInput, RefusedBeforeAnyRendering) {
   fs::remove_all(dir);
 }
 
-// The real COLMAP (Debian package colmap) on the first 20 frames of the quick cloudy_urban, one noise set.
+// The real COLMAP (Debian package colmap) on the first 20 frames of the quick cloudy_urban, one noise set (its own
+// data folder: the fixture above renders 6 frames of the same preset).
 TEST(ColmapSystem, RunsBesideRovoAndIsScored) {
   const std::string suite_dir =
       (fs::temp_directory_path() / ("rovo_colmap_suite_" + std::to_string(::getpid()))).string();
   const CommandResult r = RunShell(std::string(ROVO_BINARY) +
                                    " suite --presets cloudy_urban --quick --frames 20 --seeds 1 --no-plots --out " +
-                                   suite_dir + " --data " + CacheDir("eval_systems_cache") + " --system " +
+                                   suite_dir + " --data " + CacheDir("eval_colmap_cache") + " --system " +
                                    ROVO_SOURCE_DIR + "/eval/systems/colmap/colmap.yaml");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("| colmap (Sim(3)) | 2 ok |"), std::string::npos) << r.output;
   const nlohmann::json suite = ReadJsonFile(suite_dir + "/suite.json");
   const nlohmann::json& gt = suite["systems"]["colmap"]["presets"]["cloudy_urban"]["modes"]["gt"]["runs"][0];
   EXPECT_EQ(gt["status"], "ok");
-  EXPECT_GE(gt["associated_frames"].get<int>(), 15);
-  EXPECT_LT(gt["relative_rmse_pct"].get<double>(), 5.0);
+  // COLMAP registers every image and places camera 0 within about a centimetre over the 22 m (0.05 % relative
+  // RMSE measured); images out of time order or matched across the city's repeated facades cost > 15 %.
+  EXPECT_GE(gt["associated_frames"].get<int>(), 18);
+  EXPECT_LT(gt["relative_rmse_pct"].get<double>(), 1.0);
   fs::remove_all(suite_dir);
 }
 
