@@ -57,15 +57,20 @@ std::string RunStatusCounts(const PresetSummary& p) {
   return out.empty() ? "-" : out;
 }
 
+// The header of Table I (with the system and runs columns when other systems are in it).
+static std::string SuiteTableHeader(bool systems) {
+  return std::string("| sequence | ") + (systems ? "system | runs | " : "") +
+         "frames | length [m] | RMSE NoisyExt [m] | RMSE OnlineExt [m] | RMSE GTExt [m] | rel. "
+         "Noisy/Online/GT "
+         "[%] | paper rel. Noisy/Online/GT [%] | inliers Online/GT [%] | paper | reproj Online/GT [deg] | "
+         "paper | ext rot Online [deg] | drift Online / GT [%] raw → body-aligned |\n|---|" +
+         (systems ? "---|---|" : "") + "---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+}
+
 std::string SuiteTableMarkdown(const std::vector<PresetSummary>& presets, bool quick) {
   const bool systems =
       std::any_of(presets.begin(), presets.end(), [](const PresetSummary& p) { return p.system != "rovo"; });
-  std::string md = std::string("| sequence | ") + (systems ? "system | runs | " : "") +
-                   "frames | length [m] | RMSE NoisyExt [m] | RMSE OnlineExt [m] | RMSE GTExt [m] | rel. "
-                   "Noisy/Online/GT "
-                   "[%] | paper rel. Noisy/Online/GT [%] | inliers Online/GT [%] | paper | reproj Online/GT [deg] | "
-                   "paper | ext rot Online [deg] | drift Online / GT [%] raw → body-aligned |\n|---|" +
-                   (systems ? "---|---|" : "") + "---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  std::string md = SuiteTableHeader(systems);
   for (const PresetSummary& p : presets) {
     const bool own = p.system == "rovo";  // external systems report no inliers, reprojection or extrinsics
     auto stat = [&](const char* mode, const char* name) -> std::optional<Stat> {

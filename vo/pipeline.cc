@@ -258,17 +258,22 @@ Trajectory GroundTruthIfAny(const std::string& dataset_dir) {
   return ReadTum(GroundTruthPath(dataset_dir));
 }
 
+// The dataset as the VO sees it: only the cameras of --cameras; its camera j is dataset camera
+// (*vo_cameras)[j].
+DatasetInfo DatasetForVo(const VoOptions& options, std::vector<int>* vo_cameras) {
+  DatasetInfo full_info = ReadDatasetInfo(options.io.dataset_dir);
+  *vo_cameras = VoCameraIndices(options.io.cameras, full_info.rig);
+  if (static_cast<int>(vo_cameras->size()) == full_info.rig.NumCameras()) return full_info;
+  return SelectDatasetCameras(full_info, *vo_cameras, "vo: --cameras");
+}
+
 }  // namespace
 
 VoSummary RunVo(const VoOptions& options) {
   const auto run_start = Clock::now();
   options.Check();
-  const DatasetInfo full_info = ReadDatasetInfo(options.io.dataset_dir);
-  const std::vector<int> vo_cameras = VoCameraIndices(options.io.cameras, full_info.rig);
-  // The VO sees only these cameras; its camera j is dataset camera vo_cameras[j].
-  const DatasetInfo info = static_cast<int>(vo_cameras.size()) == full_info.rig.NumCameras()
-                               ? full_info
-                               : SelectDatasetCameras(full_info, vo_cameras, "vo: --cameras");
+  std::vector<int> vo_cameras;
+  const DatasetInfo info = DatasetForVo(options, &vo_cameras);
   const int num_cams = info.rig.NumCameras();
   const int begin = options.io.frames.begin;
   const int end = options.io.frames.end < 0 ? info.frame_count : options.io.frames.end;
