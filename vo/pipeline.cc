@@ -258,6 +258,12 @@ Trajectory GroundTruthIfAny(const std::string& dataset_dir) {
   return ReadTum(GroundTruthPath(dataset_dir));
 }
 
+// TBB's parallelism capped at `threads` while the result lives (none for 0: all cores).
+std::unique_ptr<tbb::global_control> ThreadLimit(int threads) {
+  if (threads <= 0) return nullptr;
+  return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+}
+
 // The dataset as the VO sees it: only the cameras of --cameras; its camera j is dataset camera
 // (*vo_cameras)[j].
 DatasetInfo DatasetForVo(const VoOptions& options, std::vector<int>* vo_cameras) {
@@ -286,10 +292,7 @@ VoSummary RunVo(const VoOptions& options) {
   const Rigid3 world_from_rig0 =
       begin < static_cast<int>(ground_truth.size()) ? ground_truth[begin].world_from_rig : Rigid3::Identity();
 
-  std::unique_ptr<tbb::global_control> threads;
-  if (options.io.threads > 0) {
-    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, options.io.threads);
-  }
+  const std::unique_ptr<tbb::global_control> thread_limit = ThreadLimit(options.io.threads);
   EnsureWritableDir(options.io.out_dir);
 
   BackendOptions backend_options = options.backend;
