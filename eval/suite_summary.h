@@ -43,11 +43,14 @@ struct DrawConvergence {
 };
 DrawConvergence ComputeDrawConvergence(const ModeSummary& draws);
 
-// What an external system's runs cost (suite_systems.h: wall and CPU time from wait4, peak resident
-// memory), mean over the runs that started.
+// What a system's runs cost, mean over the runs that started (those that recorded it): an external
+// system's wall and CPU time from wait4 and the peak resident memory of its process group
+// (suite_systems.h); rovo's own in-process runs' wall time and getrusage(RUSAGE_SELF) CPU delta, and
+// the rovo process's maxrss (process_maxrss: not the runs' own memory).
 struct SystemCost {
   int runs = 0;
   double wall_s = 0.0, cpu_s = 0.0, peak_rss_mb = 0.0;
+  bool process_maxrss = false;  // peak_rss_mb is the whole rovo process's maxrss
 };
 
 struct PresetSummary {

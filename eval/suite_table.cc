@@ -176,18 +176,28 @@ namespace rovo {
 
 std::string SystemCostMarkdown(const std::vector<PresetSummary>& presets) {
   std::string md;
+  bool process_maxrss = false;
   for (const PresetSummary& p : presets) {
     if (!p.cost) continue;
+    process_maxrss = process_maxrss || p.cost->process_maxrss;
     md += "| `" + p.preset + "` | " + p.system + " | " + std::to_string(p.cost->runs) + " | " +
           Fmt("%.1f", p.cost->wall_s) + " | " + Fmt("%.1f", p.cost->cpu_s) + " | " + Fmt("%.0f", p.cost->peak_rss_mb) +
-          " |\n";
+          (p.cost->process_maxrss ? " (process maxrss)" : "") + " |\n";
   }
   if (md.empty()) return "";
-  return "## Cost of the other systems' runs\n\n| sequence | system | runs | wall per run [s] | CPU per run [s] | "
+  return "## Cost per system\n\n| sequence | system | runs | wall per run [s] | CPU per run [s] | "
          "peak memory [MB] |\n|---|---|---|---|---|---|\n" +
          md +
-         "\nwall and CPU (user + system) time of the system's process and the children it waited for (wait4), mean "
-         "over its runs; peak memory = the largest resident set of one of those processes over the runs.\n";
+         "\nmean over the system's runs (system_run.json of each run). Another system: wall and CPU (user + system) "
+         "time of its process and the children it waited for (wait4); peak memory = the largest resident set of its "
+         "process group over the runs." +
+         (process_maxrss
+              ? " rovo: its pipeline runs inside the suite's process, so CPU = the getrusage(RUSAGE_SELF) delta over "
+                "the run (exact with --jobs 1; system_run.json \"cpu_overlapped\" marks a run that shared the "
+                "process with another), and memory = the rovo process's maxrss (its peak since it started, rendering "
+                "included), not the run's own."
+              : "") +
+         "\n";
 }
 
 }  // namespace rovo

@@ -23,7 +23,7 @@ std::optional<PaperRow> PaperRowForPreset(const std::string& preset);
 // reprojection error Online/GT beside the paper's, final extrinsic error of OnlineExt.
 std::string SuiteTableMarkdown(const std::vector<PresetSummary>& presets, bool quick);
 
-// Per preset and external system: wall and CPU time per run, peak memory; "" when there is none.
+// Per preset and system (rovo's own included): wall and CPU time per run, peak memory; "" when there is none.
 std::string SystemCostMarkdown(const std::vector<PresetSummary>& presets);
 
 // Per preset with draws: RMSE, final extrinsic error (mean +- std) and the convergence rate; "" when

@@ -264,16 +264,17 @@ void WriteMessages(const std::string& dataset_dir, const DatasetInfo& info, cons
   }
 }
 
-// /tf_static: rig -> camK (rig_from_cam; a kb4 fit of a lens whose ocam affine turns the image axes
-// is in a camera frame turned by roll_deg about the axis) and rig -> imu.
-std::vector<RosTransform> StaticTransforms(const DatasetInfo& info, const std::vector<LensFit>& fits,
-                                           const Ros2ImuExport& imu, int64_t stamp_ns) {
+// /tf_static: rig -> camK (rig_from_cam of `extrinsics`; a kb4 fit of a lens whose ocam affine turns the
+// image axes is in a camera frame turned by roll_deg about the axis) and rig -> imu.
+std::vector<RosTransform> StaticTransforms(const DatasetInfo& info, const std::vector<Rigid3>& extrinsics,
+                                           const std::vector<LensFit>& fits, const Ros2ImuExport& imu,
+                                           int64_t stamp_ns) {
   std::vector<RosTransform> tf;
   for (size_t k = 0; k < info.rig.cameras.size(); ++k) {
     const Rigid3 exported_from_cam(
         Eigen::Quaterniond(Eigen::AngleAxisd(fits[k].roll_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ())),
         Eigen::Vector3d::Zero());
-    const Rigid3 cam_from_rig = exported_from_cam * info.rig.cameras[k].cam_from_rig;
+    const Rigid3 cam_from_rig = exported_from_cam * extrinsics[k];
     tf.push_back(Transform("rig", info.rig.cameras[k].name, cam_from_rig.Inverse(), stamp_ns));
   }
   if (!imu.samples.empty()) tf.push_back(Transform("rig", "imu", imu.imu_from_rig.Inverse(), stamp_ns));
@@ -285,6 +286,12 @@ std::vector<RosTransform> StaticTransforms(const DatasetInfo& info, const std::v
 Ros2ExportReport ExportRos2Bag(const std::string& dataset_dir, const Ros2ExportOptions& options) {
   const DatasetInfo info = ReadDatasetInfo(dataset_dir);
   Ros2ExportReport report;
+  if (!options.cam_from_rig.empty() && options.cam_from_rig.size() != info.rig.cameras.size()) {
+    throw std::runtime_error(dataset_dir + ": " + std::to_string(options.cam_from_rig.size()) +
+                             " extrinsics given for /tf_static, the rig has " +
+                             std::to_string(info.rig.cameras.size()) + " cameras");
+  }
+  const std::vector<Rigid3> extrinsics = options.cam_from_rig.empty() ? info.rig.Extrinsics() : options.cam_from_rig;
   report.fits = FitCameras(dataset_dir, info, options.max_fit_error_px);
   Trajectory gt;
   if (info.has_ground_truth && fs::exists(GroundTruthPath(dataset_dir))) gt = ReadTum(GroundTruthPath(dataset_dir));
@@ -316,7 +323,7 @@ Ros2ExportReport ExportRos2Bag(const std::string& dataset_dir, const Ros2ExportO
   for (size_t k = 0; k < info.rig.cameras.size() && info.frame_count > 0; ++k) {
     first_ns = std::min(first_ns, ImageStampNs(info, gt, 0, k));
   }
-  bag.Write(topics.tf, first_ns, EncodeRosTfMessage(StaticTransforms(info, report.fits, imu, first_ns)));
+  bag.Write(topics.tf, first_ns, EncodeRosTfMessage(StaticTransforms(info, extrinsics, report.fits, imu, first_ns)));
   WriteMessages(dataset_dir, info, gt, report.fits, imu, topics, &bag);
   bag.Close();
   WriteFileAtomic((fs::path(options.out_dir) / "metadata.yaml").string(), MetadataYaml(bag, file, custom));

@@ -38,6 +38,9 @@ namespace rovo {
 struct Ros2ExportOptions {
   std::string out_dir;
   double max_fit_error_px = 5.0;  // refuse when a camera's equidistant fit is worse
+  // The extrinsics /tf_static carries, one cam_from_rig per camera of the rig (empty: the dataset's own);
+  // a suite run's given calibration (docs/systems.md). Throws when the count is not the rig's.
+  std::vector<Rigid3> cam_from_rig;
 };
 
 struct Ros2ExportReport {

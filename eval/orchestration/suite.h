@@ -15,7 +15,8 @@
 //   <out>/reports/<preset>/                            `rovo eval` report of all runs of the preset
 //   <out>/suite.json                                   aggregated metrics per preset and mode
 //   <out>/table.md, <out>/report.html                  Table I layout with the paper's figures
-// Datasets go to <data>/<preset>[_quick]_s<seed>/ (default <data> = <out>/data).
+// Datasets go to <data>/<preset>[_quick]_s<seed>[_imu]/ (default <data> = <out>/data); _imu: rendered with
+// an IMU (`rovo render --imu`, default IMU settings), because a selected system needs one (needs_imu).
 // Resume: a run folder whose run.json is complete and records the settings asked for (RunSettings)
 // is not run again; one made with other settings is; a dataset whose frames (all, or the first --frames) exist is not
 // rendered again.
@@ -136,6 +137,7 @@ struct SuitePlan {
   std::vector<int> frame_ends;             // per preset: runs cover frames [0, end)
   std::vector<SuiteRun> runs;              // per preset: gt, noisy_k / online_k, draw_d; then each system's
   std::vector<SystemDescription> systems;  // options.systems, read
+  bool imu = false;                        // a system needs the IMU: datasets are rendered with one
 };
 // Validates the options (throws std::invalid_argument naming the option) and reads the system
 // descriptions (throws std::runtime_error naming the file and field).

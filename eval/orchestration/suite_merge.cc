@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <map>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -31,6 +32,34 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// Mean wall and CPU time per run and the peak memory; rovo's own runs name their memory
+// process_maxrss_mb (the rovo process's maxrss, not the run's own).
+nlohmann::json CostJson(const SystemCost& cost) {
+  return {{"runs", cost.runs},
+          {"wall_s", cost.wall_s},
+          {"cpu_s", cost.cpu_s},
+          {cost.process_maxrss ? "process_maxrss_mb" : "peak_rss_mb", cost.peak_rss_mb}};
+}
+
+// Each system's cost over all presets: means weighted by the presets' runs, the largest memory.
+std::map<std::string, SystemCost> CostPerSystem(const std::vector<PresetSummary>& presets) {
+  std::map<std::string, SystemCost> out;
+  for (const PresetSummary& p : presets) {
+    if (!p.cost) continue;
+    SystemCost& c = out[p.system];
+    c.wall_s += p.cost->wall_s * p.cost->runs;
+    c.cpu_s += p.cost->cpu_s * p.cost->runs;
+    c.runs += p.cost->runs;
+    c.peak_rss_mb = std::max(c.peak_rss_mb, p.cost->peak_rss_mb);
+    c.process_maxrss = p.cost->process_maxrss;
+  }
+  for (auto& [name, c] : out) {
+    c.wall_s /= c.runs;
+    c.cpu_s /= c.runs;
+  }
+  return out;
+}
+
 nlohmann::json PresetJson(const PresetSummary& p, const SuiteOptions& options) {
   nlohmann::json pj;
   pj["dataset"] = p.dataset_dir;
@@ -38,12 +67,7 @@ nlohmann::json PresetJson(const PresetSummary& p, const SuiteOptions& options) {
   pj["dataset_frames"] = p.dataset_frames;
   pj["path_length_m"] = p.path_length_m;
   pj["align"] = p.align;
-  if (p.cost) {
-    pj["cost_per_run"] = {{"runs", p.cost->runs},
-                          {"wall_s", p.cost->wall_s},
-                          {"cpu_s", p.cost->cpu_s},
-                          {"peak_rss_mb", p.cost->peak_rss_mb}};
-  }
+  if (p.cost) pj["cost_per_run"] = CostJson(*p.cost);
   for (const ModeSummary& m : p.modes) {
     nlohmann::json mj;
     for (const auto& [name, s] : m.stats) mj[name] = {{"mean", s.mean}, {"std", s.std}, {"n", s.n}};
@@ -94,6 +118,7 @@ nlohmann::json SuiteToJson(const std::vector<PresetSummary>& presets, const Suit
     if (p.system == kBuiltInSystem) j["presets"][p.preset] = pj;
     j["systems"][p.system]["presets"][p.preset] = pj;
   }
+  for (const auto& [name, cost] : CostPerSystem(presets)) j["systems"][name]["cost_per_run"] = CostJson(cost);
   for (const std::string& file : options.systems) {
     const SystemDescription d = ReadSystemDescription(file);
     j["systems"][d.name]["description"] = fs::absolute(file).lexically_normal().string();
@@ -165,6 +190,13 @@ PresetSummary SummariseSystem(const SuitePlan& plan, size_t preset_index, int sy
       cost.wall_s += record.wall_s;
       cost.cpu_s += record.cpu_s;
       cost.peak_rss_mb = std::max(cost.peak_rss_mb, record.peak_rss_mb);
+    }
+    if (const std::optional<RovoRunCost> own = system < 0 ? ReadRovoRunCost(run.run_dir) : std::nullopt) {
+      ++cost.runs;
+      cost.wall_s += own->wall_s;
+      cost.cpu_s += own->cpu_s;
+      cost.peak_rss_mb = std::max(cost.peak_rss_mb, own->memory_mb);
+      cost.process_maxrss = true;
     }
     const std::string label = summary.preset + "/" + (system >= 0 ? summary.system + "/" : "") + run.name;
     RunMetrics m = scored[r] ? *scored[r] : UnscoredRun(label, run.settings, summary.frames, record);

@@ -135,8 +135,12 @@ std::vector<std::string> RobustnessEntries(const std::vector<std::string>& prese
 
 namespace {
 
-std::string DatasetDirFor(const std::string& data_dir, const std::string& preset, const SuiteOptions& options) {
-  return (fs::path(data_dir) / (preset + (options.quick ? "_quick" : "") + "_s" + std::to_string(options.scene_seed)))
+// The dataset's folder is its reuse key: preset, quick, scene seed, and whether it carries an IMU (an IMU-less
+// dataset is never reused for a system that needs the IMU).
+std::string DatasetDirFor(const std::string& data_dir, const std::string& preset, const SuiteOptions& options,
+                          bool imu) {
+  return (fs::path(data_dir) /
+          (preset + (options.quick ? "_quick" : "") + "_s" + std::to_string(options.scene_seed) + (imu ? "_imu" : "")))
       .string();
 }
 
@@ -176,14 +180,17 @@ SuitePlan PlanSuite(const SuiteOptions& options) {
   if (plan.options.presets.empty()) {
     for (const ScenePreset& p : ScenePresets()) plan.options.presets.push_back(p.name);
   }
-  for (const std::string& file : options.systems) plan.systems.push_back(ReadSystemDescription(file));
+  for (const std::string& file : options.systems) {
+    plan.systems.push_back(ReadSystemDescription(file));
+    plan.imu = plan.imu || plan.systems.back().needs_imu;
+  }
   plan.data_dir = options.data_dir.empty() ? (fs::path(options.out_dir) / "data").string() : options.data_dir;
   for (size_t i = 0; i < plan.options.presets.size(); ++i) {
     const std::string& preset = plan.options.presets[i];
     const ScenePreset& p = FindScenePreset(ParseSuiteEntry(preset).preset);  // throws listing the valid names
     const int trajectory_frames = options.quick ? p.quick_frames : p.frames;
     const int frame_end = options.frames > 0 ? std::min(options.frames, trajectory_frames) : trajectory_frames;
-    plan.dataset_dirs.push_back(DatasetDirFor(plan.data_dir, preset, options));
+    plan.dataset_dirs.push_back(DatasetDirFor(plan.data_dir, preset, options, plan.imu));
     plan.frame_ends.push_back(frame_end);
     PlanPresetRuns(options, i, (fs::path(options.out_dir) / "runs" / preset).string(), frame_end, &plan.runs);
   }

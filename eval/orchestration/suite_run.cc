@@ -1,6 +1,9 @@
 // Running a suite's tasks: datasets, VO runs (reused when their settings match), the whole suite.
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -68,11 +71,12 @@ bool RunReusable(const std::string& run_dir, const RunSettings& want, std::strin
 
 namespace {
 
-// Whether the dataset's sensor and timing records are the ones `render` would write (a variant's
-// dataset rendered with other effects is not reused).
+// Whether the dataset's sensor and timing records are the ones `render` would write, and it has an IMU
+// exactly when `render` adds one (a variant's dataset rendered with other effects is not reused).
 bool EffectsMatch(const DatasetInfo& info, const RenderOptions& render) {
   const int n = info.rig.NumCameras();
-  if (render.sensor.enabled != info.sensor.has_value() || render.timing.Enabled() != info.timing.has_value())
+  if (render.sensor.enabled != info.sensor.has_value() || render.timing.Enabled() != info.timing.has_value() ||
+      render.imu != info.imu.has_value())
     return false;
   if (info.sensor &&
       *info.sensor != MakeSensorRecord(render.sensor, CameraSensitivities(render.sensor, n, render.seed)))
@@ -179,13 +183,14 @@ void RenderSuiteDataset(const SuitePlan& plan, size_t preset_index, int shard, i
   render.preset = entry.preset;
   ApplySuiteVariant(entry.variant, &render);
   render.seed = options.scene_seed;
+  render.imu = plan.imu;  // a system needs it (rovo render --imu, default settings)
   if (DatasetComplete(dir, plan.frame_ends[preset_index], render)) {
     if (!options.quiet) std::fprintf(stderr, "rovo suite: dataset %s is complete, not rendering\n", dir.c_str());
     return;
   }
   if (!options.quiet) {
-    std::fprintf(stderr, "rovo suite: rendering %s%s -> %s%s\n", preset.c_str(), options.quick ? " (quick)" : "",
-                 dir.c_str(),
+    std::fprintf(stderr, "rovo suite: rendering %s%s%s -> %s%s\n", preset.c_str(), options.quick ? " (quick)" : "",
+                 plan.imu ? " with an IMU" : "", dir.c_str(),
                  shards > 1 ? (" (shard " + std::to_string(shard) + "/" + std::to_string(shards) + ")").c_str() : "");
   }
   EnsureWritableDir(plan.data_dir);
@@ -200,7 +205,75 @@ void RenderSuiteDataset(const SuitePlan& plan, size_t preset_index, int shard, i
   RenderDataset(render);
 }
 
+namespace {
+
+// Suite runs of this process in flight, and started so far: a run knows whether another ran beside it
+// (--jobs > 1), which makes its process-wide CPU time include theirs.
+std::atomic<int> g_runs_in_flight{0};
+std::atomic<uint64_t> g_runs_started{0};
+
+class RunOverlap {
+ public:
+  RunOverlap() : started_before_(g_runs_started.fetch_add(1)), alone_at_start_(g_runs_in_flight.fetch_add(1) == 0) {}
+  ~RunOverlap() { g_runs_in_flight.fetch_sub(1); }
+  RunOverlap(const RunOverlap&) = delete;
+  RunOverlap& operator=(const RunOverlap&) = delete;
+  // Whether another run was in flight at the start, started since, or is in flight now.
+  bool Overlapped() const {
+    return !alone_at_start_ || g_runs_started.load() != started_before_ + 1 || g_runs_in_flight.load() > 1;
+  }
+
+ private:
+  uint64_t started_before_;
+  bool alone_at_start_;
+};
+
+double Seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); }
+
+rusage ProcessUsage() {
+  rusage usage{};
+  ::getrusage(RUSAGE_SELF, &usage);
+  return usage;
+}
+
+// rovo's own run is in-process, on several threads (so RUSAGE_THREAD would miss its workers): its CPU
+// time is the delta of getrusage(RUSAGE_SELF) over the run, exact when runs are serial (--jobs 1, and
+// every Slurm task), and marked "cpu_overlapped" when another run of this process ran beside it. Its
+// memory is the process's ru_maxrss: the peak of the whole rovo process since it started, labelled so.
+// Written as the run's system_run.json, in the layout of an external run's (suite_systems.h).
+void WriteRovoRunRecord(const SuitePlan& plan, const SuiteRun& run, int threads, double wall_s, const rusage& before,
+                        const rusage& after, bool overlapped) {
+  const double user = Seconds(after.ru_utime) - Seconds(before.ru_utime);
+  const double system = Seconds(after.ru_stime) - Seconds(before.ru_stime);
+  const nlohmann::json record = {
+      {"generator", "rovo suite"},
+      {"generator_version", ROVO_VERSION},
+      {"system", kBuiltInSystem},
+      {"run", run.name},
+      {"mode", SuiteModeName(run.settings.mode)},
+      {"noise_set", run.settings.mode == ExtrinsicsMode::kGroundTruth ? -1 : run.settings.noise_set},
+      {"draw_seed", run.settings.draw_seed},
+      {"seed", plan.options.vo_seed},
+      {"threads", threads},
+      {"status", "ok"},
+      {"in_process", true},
+      {"wall_s", wall_s},
+      {"user_cpu_s", user},
+      {"system_cpu_s", system},
+      {"cpu_s", user + system},
+      {"cpu_source", "getrusage(RUSAGE_SELF) delta over the run: the whole rovo process"},
+      {"cpu_overlapped", overlapped},
+      {"process_maxrss_mb", static_cast<double>(after.ru_maxrss) / 1024.0},
+      {"memory_source",
+       "ru_maxrss of the rovo process at the run's end: its peak since it started (rendering and earlier runs "
+       "included), not the run's own"}};
+  WriteJsonFileAtomic((fs::path(run.run_dir) / kSystemRunFile).string(), record);
+}
+
+}  // namespace
+
 bool RunSuiteRun(const SuitePlan& plan, const SuiteRun& run, int threads, bool quiet) {
+  const RunOverlap overlap;
   if (run.system >= 0) {
     CheckSuiteDataset(plan, run.preset_index);
     return RunSystemRun(plan, run, threads, quiet);
@@ -220,7 +293,11 @@ bool RunSuiteRun(const SuitePlan& plan, const SuiteRun& run, int threads, bool q
   vo.io.out_dir = run.run_dir;
   vo.io.threads = threads;
   vo.io.quiet = quiet;
+  const rusage before = ProcessUsage();
+  const auto start = std::chrono::steady_clock::now();
   RunVo(vo);
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  WriteRovoRunRecord(plan, run, threads, wall_s, before, ProcessUsage(), overlap.Overlapped());
   return true;
 }
 

@@ -13,6 +13,7 @@
 
 #include "datasets/dataset.h"
 #include "datasets/exchange/exchange.h"
+#include "datasets/exchange/ros2_bag.h"
 #include "datasets/io.h"
 #include "datasets/rig_json.h"
 #include "eval/foreign_run.h"
@@ -22,9 +23,7 @@
 
 namespace rovo {
 namespace fs = std::filesystem;
-namespace {
-
-const char* ModeName(ExtrinsicsMode mode) {
+const char* SuiteModeName(ExtrinsicsMode mode) {
   switch (mode) {
     case ExtrinsicsMode::kGroundTruth:
       return "gt";
@@ -35,6 +34,8 @@ const char* ModeName(ExtrinsicsMode mode) {
   }
   return "?";
 }
+
+namespace {
 
 const SystemDescription& SystemOf(const SuitePlan& plan, const SuiteRun& run) {
   return plan.systems.at(static_cast<size_t>(run.system));
@@ -73,22 +74,36 @@ class FileLock {
 };
 
 // The first `frames` frames of a dataset as a dataset of their own (--frames): dataset.json and
-// groundtruth.tum cut to them, the image folders linked.
+// groundtruth.tum cut to them, the image folders and the IMU's streams (whole) linked.
 std::string FramesView(const std::string& dataset_dir, const DatasetInfo& info, int frames) {
   const fs::path view = fs::path(dataset_dir + ".exports") / ("frames_" + std::to_string(frames));
   nlohmann::json json = ReadJsonFile(DatasetJsonPath(dataset_dir));
   json["frame_count"] = frames;
   const Trajectory gt = ReadTum(GroundTruthPath(dataset_dir));
   fs::create_directories(view);
-  for (const RigCamera& camera : info.rig.cameras) {
-    const fs::path link = view / camera.name;
+  std::vector<std::string> folders;
+  for (const RigCamera& camera : info.rig.cameras) folders.push_back(camera.name);
+  if (info.imu) folders.emplace_back("imu");
+  for (const std::string& folder : folders) {
+    const fs::path link = view / folder;
     std::error_code ec;
-    if (!fs::is_symlink(link, ec)) fs::create_symlink(fs::absolute(fs::path(dataset_dir) / camera.name), link);
+    if (!fs::is_symlink(link, ec)) fs::create_symlink(fs::absolute(fs::path(dataset_dir) / folder), link);
   }
   WriteTum(GroundTruthPath(view.string()),
            Trajectory(gt.begin(), gt.begin() + std::min<long>(frames, static_cast<long>(gt.size()))));
   WriteJsonFileAtomic(DatasetJsonPath(view.string()), json);
   return view.string();
+}
+
+// The dataset an export is written from: the dataset, or (--frames) the view of its first frames, made
+// under the exports' lock.
+std::string ExportSource(const SuitePlan& plan, size_t preset_index, const DatasetInfo& info) {
+  const int frames = plan.frame_ends[preset_index];
+  const std::string& dataset_dir = plan.dataset_dirs[preset_index];
+  if (frames >= info.frame_count) return dataset_dir;
+  EnsureWritableDir(dataset_dir + ".exports");
+  const FileLock lock(dataset_dir + ".exports/export.lock");
+  return FramesView(dataset_dir, info, frames);
 }
 
 // The export the system reads, written once (under a lock) and reused while it covers the frames.
@@ -136,11 +151,15 @@ struct RunCalibration {
 };
 
 // The export's cameras with the given extrinsics (the export's own turn of each camera frame kept).
+// An export's camera pose is turn * cam_from_rig * rig_from_body, the body being the rig, or the IMU
+// when the dataset has one (exchange.h); the given one is turn * given_cam_from_rig * rig_from_body.
 std::vector<ExchangeCamera> GivenCameras(std::vector<ExchangeCamera> exported, const DatasetInfo& info,
                                          const std::vector<int>& cameras, const std::vector<Rigid3>& given) {
+  const Rigid3 rig_from_body = info.imu && info.rig.imu_from_rig ? info.rig.imu_from_rig->Inverse() : Rigid3();
   for (size_t k = 0; k < exported.size() && k < cameras.size(); ++k) {
     const size_t c = static_cast<size_t>(cameras[k]);
-    exported[k].cam_from_rig = exported[k].cam_from_rig * info.rig.cameras[c].cam_from_rig.Inverse() * given[c];
+    exported[k].cam_from_rig = exported[k].cam_from_rig * (info.rig.cameras[c].cam_from_rig * rig_from_body).Inverse() *
+                               given[c] * rig_from_body;
   }
   return exported;
 }
@@ -162,8 +181,10 @@ void EurocCalibration(const std::string& export_dir, const std::string& run_dir,
     out->links.emplace_back((to / "data").string(), (from / "data").string());
     out->links.emplace_back((to / "data.csv").string(), (from / "data.csv").string());
   }
-  const fs::path gt = fs::path(export_dir) / "mav0" / "state_groundtruth_estimate0";
-  if (fs::exists(gt)) out->links.emplace_back((view / "mav0" / "state_groundtruth_estimate0").string(), gt.string());
+  for (const char* stream : {"state_groundtruth_estimate0", "imu0"}) {
+    const fs::path from = fs::path(export_dir) / "mav0" / stream;
+    if (fs::exists(from)) out->links.emplace_back((view / "mav0" / stream).string(), from.string());
+  }
   out->input = view.string();
   out->calibration = (view / "mav0").string();
 }
@@ -173,12 +194,12 @@ RunCalibration MakeRunCalibration(const SystemDescription& system, const std::st
                                   const std::vector<Rigid3>& given) {
   RunCalibration out;
   const std::vector<int> cameras = ExportCameras(system, info.rig.NumCameras());
-  if (system.input == "rovo") {
+  if (system.input == "rovo" || system.input == "ros2") {  // ros2: the run's bag is written beside it (RunBag)
     nlohmann::json rig;
     rig["schema_version"] = kRigSchemaVersion;
     rig["source"] = "rovo suite: the extrinsics of this run";
     rig["cameras"] = RigToJson(info.rig.WithExtrinsics(given))["cameras"];
-    out.input = dataset_dir;
+    out.input = system.input == "rovo" ? dataset_dir : (fs::path(run_dir) / "input").string();
     out.calibration = (fs::path(run_dir) / "calibration.json").string();
     out.files.emplace_back(out.calibration, rig.dump(2) + "\n");
   } else if (system.input == "kalibr") {
@@ -212,6 +233,16 @@ void WriteRunCalibration(const RunCalibration& calibration) {
     fs::create_symlink(target, link, ec);
     if (ec) throw std::runtime_error(link + ": cannot link to " + target + ": " + ec.message());
   }
+}
+
+// input: ros2: the run's own bag, `<run>/input/`, its /tf_static carrying the given extrinsics (a bag has
+// no calibration file to swap, so each run gets the whole bag).
+void WriteRunBag(const SuitePlan& plan, size_t preset_index, const DatasetInfo& info, const std::vector<Rigid3>& given,
+                 const std::string& bag_dir) {
+  Ros2ExportOptions options;
+  options.out_dir = bag_dir;
+  options.cam_from_rig = given;
+  ExportRos2Bag(ExportSource(plan, preset_index, info), options);
 }
 
 nlohmann::json EnvJson(const std::vector<std::pair<std::string, std::string>>& env) {
@@ -310,11 +341,6 @@ void CheckSuiteSystems(const SuitePlan& plan) {
       }
     }
     CheckSystemProgram(system);
-    if (system.needs_imu) {
-      throw std::runtime_error(system.file +
-                               ": needs_imu: the suite renders its datasets without an IMU (rovo render --imu adds "
-                               "one; a suite with an IMU is not planned yet)");
-    }
   }
 }
 
@@ -322,16 +348,18 @@ bool RunSystemRun(const SuitePlan& plan, const SuiteRun& run, int threads, bool 
   const SystemDescription& system = SystemOf(plan, run);
   const std::string& dataset_dir = plan.dataset_dirs[run.preset_index];
   const DatasetInfo info = ReadDatasetInfo(dataset_dir);
-  const std::string export_dir = system.input == "rovo" ? "" : EnsureExport(plan, run.preset_index, system, info);
+  const bool shared_export = system.input != "rovo" && system.input != "ros2";
+  const std::string export_dir = shared_export ? EnsureExport(plan, run.preset_index, system, info) : "";
   const std::string run_dir = fs::absolute(run.run_dir).lexically_normal().string();
+  const std::vector<Rigid3> given = GivenExtrinsics(info, run.settings);
   const RunCalibration calibration = MakeRunCalibration(system, fs::absolute(dataset_dir).lexically_normal().string(),
-                                                        export_dir, run_dir, info, GivenExtrinsics(info, run.settings));
+                                                        export_dir, run_dir, info, given);
   const SystemPlaceholders values{calibration.input,
                                   calibration.calibration,
                                   run_dir + "/out",
                                   std::to_string(threads),
                                   std::to_string(plan.options.vo_seed),
-                                  ModeName(run.settings.mode)};
+                                  SuiteModeName(run.settings.mode)};
   const std::vector<std::string> argv = ExpandCommand(system, values);
   std::vector<std::pair<std::string, std::string>> env;
   for (const auto& [key, value] : system.env)
@@ -344,6 +372,7 @@ bool RunSystemRun(const SuitePlan& plan, const SuiteRun& run, int threads, bool 
   fs::remove_all(run_dir, ec);  // a run of another command or calibration, or an unfinished one
   fs::create_directories(fs::path(run_dir) / "out");
   WriteRunCalibration(calibration);
+  if (system.input == "ros2") WriteRunBag(plan, run.preset_index, info, given, calibration.input);
   if (!quiet) std::fprintf(stderr, "rovo suite: %s: %s\n", system.name.c_str(), ShellQuoteWords(argv).c_str());
   ChildSpec spec{argv, env, run_dir + "/stdout.log", run_dir + "/stderr.log", run_dir + "/out", system.timeout_s};
   const ChildResult child = RunChild(spec);
@@ -353,7 +382,7 @@ bool RunSystemRun(const SuitePlan& plan, const SuiteRun& run, int threads, bool 
       {"system", system.name},
       {"description", fs::absolute(system.file).lexically_normal().string()},
       {"run", run.name},
-      {"mode", ModeName(run.settings.mode)},
+      {"mode", SuiteModeName(run.settings.mode)},
       {"noise_set", run.settings.mode == ExtrinsicsMode::kGroundTruth ? -1 : run.settings.noise_set},
       {"draw_seed", run.settings.draw_seed},
       {"seed", plan.options.vo_seed},
@@ -405,6 +434,19 @@ ExternalRunRecord ReadExternalRunRecord(const std::string& run_dir) {
     r.detail = e.what();
   }
   return r;
+}
+
+std::optional<RovoRunCost> ReadRovoRunCost(const std::string& run_dir) {
+  std::error_code ec;
+  const fs::path path = fs::path(run_dir) / kSystemRunFile;
+  if (!fs::is_regular_file(path, ec)) return std::nullopt;
+  try {
+    const nlohmann::json j = ReadJsonFile(path.string());
+    return RovoRunCost{j.at("wall_s").get<double>(), j.at("cpu_s").get<double>(),
+                       j.at("process_maxrss_mb").get<double>()};
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
 }
 
 }  // namespace rovo

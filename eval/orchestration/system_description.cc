@@ -55,16 +55,19 @@ bool Bool(const YAML::Node& root, const char* key, const std::string& file) {
 }
 
 std::string CheckInput(const std::string& input, const std::string& file) {
-  if (input == "rovo" || input == "euroc" || input == "kalibr" || input == "basalt") return input;
-  if (input == "ros2") {
-    try {
-      ExchangeFormatFromName(input);
-    } catch (const std::invalid_argument&) {
-      Fail(file, "input", "ros2: this build of rovo has no ROS 2 export (rovo export --format ros2); use euroc");
-    }
-    Fail(file, "input", "ros2: the suites do not write per-run calibrations into ROS 2 bags yet; use euroc");
-  }
+  if (input == "rovo" || input == "euroc" || input == "kalibr" || input == "basalt" || input == "ros2") return input;
   Fail(file, "input", "unknown \"" + input + "\" (rovo, euroc, kalibr, basalt, ros2)");
+}
+
+// A ROS 2 bag (ros2_bag.h) holds every camera of the rig, with the equidistant (kb4) fit of its lens.
+void CheckRos2Keys(const SystemDescription& s) {
+  if (s.input != "ros2") return;
+  if (!s.cameras.empty()) {
+    Fail(s.file, "cameras", "input ros2: a bag holds every camera of the rig (no camera subset); use euroc");
+  }
+  if (!s.lens.empty() && s.lens != "kb4") {
+    Fail(s.file, "lens", "input ros2: a bag's CameraInfo carries the equidistant fit only (kb4)");
+  }
 }
 
 void CheckName(const std::string& name, const std::string& file) {
@@ -150,6 +153,7 @@ SystemDescription ParseSystemDescription(const std::string& yaml_text, const std
   s.trajectory = Scalar(root, "trajectory", file, true);
   if (s.trajectory.empty()) Fail(file, "trajectory", "empty");
   ReadOptionalKeys(root, file, &s);
+  CheckRos2Keys(s);
   // Placeholders and quoting are checked now, with dummy values.
   const SystemPlaceholders dummy{"i", "c", "o", "1", "0", "gt"};
   for (const std::string& word : SplitCommandWords(s.command, file, "command")) {

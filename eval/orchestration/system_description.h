@@ -29,7 +29,7 @@ namespace rovo {
 struct SystemDescription {
   std::string file;  // the YAML file it was read from
   std::string name;
-  std::string input;  // rovo | euroc | kalibr | basalt
+  std::string input;  // rovo | euroc | kalibr | basalt | ros2
   std::string command;
   std::string trajectory;
   bool online_calibration = false;
@@ -45,7 +45,8 @@ struct SystemDescription {
 inline constexpr const char* kBuiltInSystem = "rovo";
 
 // Parses a description; `file` names it in errors ("<file>: <field>: <problem>"). Checks every key,
-// the placeholders of command, trajectory and env, and that a ros2 input has an exporter.
+// the placeholders of command, trajectory and env, and that a ros2 input asks for no camera subset or lens
+// other than kb4 (a bag holds every camera, with the equidistant fit).
 SystemDescription ParseSystemDescription(const std::string& yaml_text, const std::string& file);
 // Reads and parses a description file; throws std::runtime_error naming the file (and the field).
 SystemDescription ReadSystemDescription(const std::string& path);

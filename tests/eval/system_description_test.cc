@@ -58,7 +58,11 @@ TEST(SystemDescription, ErrorsNameTheFileAndTheField) {
   EXPECT_NE(ErrorOf("name: a\ninput: euroc\ncommand: x\n").find("sys.yaml: trajectory: missing"), std::string::npos);
   EXPECT_NE(ErrorOf("name: a\ninput: tum\ncommand: x\ntrajectory: t\n").find("sys.yaml: input: unknown \"tum\""),
             std::string::npos);
-  EXPECT_NE(ErrorOf("name: a\ninput: ros2\ncommand: x\ntrajectory: t\n").find("sys.yaml: input: ros2: "),
+  EXPECT_EQ(ErrorOf("name: a\ninput: ros2\ncommand: x\ntrajectory: t\n"), "");  // ros2 bags: per-run /tf_static
+  EXPECT_NE(ErrorOf("name: a\ninput: ros2\ncommand: x\ntrajectory: t\ncameras: [0]\n")
+                .find("sys.yaml: cameras: input ros2: a bag holds every camera"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("name: a\ninput: ros2\ncommand: x\ntrajectory: t\nlens: ds\n").find("sys.yaml: lens: input ros2"),
             std::string::npos);
   EXPECT_NE(ErrorOf("name: a\ninput: euroc\ncommand: \"x {calib}\"\ntrajectory: t\n")
                 .find("sys.yaml: command: unknown placeholder {calib}"),
