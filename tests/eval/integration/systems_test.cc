@@ -1,7 +1,8 @@
 // Other systems in the suites (docs/systems.md), end to end with the real `rovo` binary: a reference
 // system whose scores are computed here independently (Eigen's umeyama, not rovo's), systems that
-// crash, hang, write nothing or write garbage, resuming, and bad descriptions refused before any
-// rendering. The COLMAP test runs the real COLMAP on a short quick dataset.
+// crash, hang, write nothing or write garbage, resuming, every run's recorded cost, bad descriptions
+// refused before any rendering, a system that needs the IMU (the suite renders one) and a system
+// reading ROS 2 bags (each run's /tf_static). The COLMAP test runs the real COLMAP on a short quick dataset.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -15,6 +16,10 @@
 #include <string>
 
 #include "datasets/dataset.h"
+#include "datasets/exchange/exchange.h"
+#include "datasets/exchange/mcap_reader.h"
+#include "datasets/exchange/ros2_bag.h"
+#include "datasets/exchange/ros2_messages.h"
 #include "datasets/io.h"
 #include "datasets/rig_json.h"
 #include "datasets/trajectory.h"
@@ -190,6 +195,39 @@ TEST_F(SystemsSuiteTest, FailuresAreRecordedWithTheirCause) {
   EXPECT_EQ(ok["calibration"], RunDir("reference", "gt") + "/calibration.json");
 }
 
+TEST_F(SystemsSuiteTest, EveryRunRecordsItsCostAndTheTableSumsItPerSystem) {
+  ASSERT_EQ(first_.status, 0) << first_.output;
+  // rovo's own run, in-process: wall time, the process's CPU delta, the process's maxrss.
+  const nlohmann::json own = ReadJsonFile(suite_dir_ + "/runs/cloudy_urban/gt/system_run.json");
+  EXPECT_EQ(own["system"], "rovo");
+  EXPECT_EQ(own["status"], "ok");
+  for (const char* field : {"wall_s", "user_cpu_s", "cpu_s", "process_maxrss_mb"}) {
+    EXPECT_GT(own.at(field).get<double>(), 0.0) << field << "\n" << own.dump(2);
+  }
+  EXPECT_FALSE(own["cpu_overlapped"].get<bool>());  // --jobs 1: no other run shared the process
+  EXPECT_FALSE(own.contains("peak_rss_mb"));        // the process's memory is never called the run's own
+  // An external run: its child's wall and CPU time and its process group's peak memory.
+  const nlohmann::json external = Record("reference", "gt");
+  for (const char* field : {"wall_s", "user_cpu_s", "cpu_s", "peak_rss_mb"}) {
+    EXPECT_GT(external.at(field).get<double>(), 0.0) << field << "\n" << external.dump(2);
+  }
+  const nlohmann::json suite = ReadJsonFile(suite_dir_ + "/suite.json");
+  const nlohmann::json& rovo = suite["systems"]["rovo"]["cost_per_run"];
+  EXPECT_EQ(rovo["runs"], 5);
+  EXPECT_GT(rovo["wall_s"].get<double>(), 0.0);
+  EXPECT_GT(rovo["cpu_s"].get<double>(), 0.0);
+  EXPECT_GT(rovo["process_maxrss_mb"].get<double>(), 0.0);
+  const nlohmann::json& reference = suite["systems"]["reference"]["presets"]["cloudy_urban"]["cost_per_run"];
+  EXPECT_EQ(reference["runs"], 3);
+  EXPECT_GT(reference["cpu_s"].get<double>(), 0.0);
+  EXPECT_GT(reference["peak_rss_mb"].get<double>(), 0.0);
+  const std::string table = ReadFile(suite_dir_ + "/table.md");
+  EXPECT_NE(table.find("## Cost per system"), std::string::npos) << table;
+  EXPECT_NE(table.find("| `cloudy_urban` | rovo | 5 | "), std::string::npos) << table;
+  EXPECT_NE(table.find(" (process maxrss) |"), std::string::npos) << table;
+  EXPECT_NE(table.find("| `cloudy_urban` | reference | 3 | "), std::string::npos) << table;
+}
+
 TEST_F(SystemsSuiteTest, RerunReusesFinishedRuns) {
   ASSERT_EQ(first_.status, 0) << first_.output;
   const std::string before = ReadFile(RunDir("reference", "noisy_0") + "/system_run.json");
@@ -218,6 +256,84 @@ TEST(SystemsBadInput, RefusedBeforeAnyRendering) {
       << b.output;
   EXPECT_FALSE(fs::exists(dir / "data"));  // nothing was rendered
   fs::remove_all(dir);
+}
+
+Rigid3 TransformOf(const RosTransform& t) { return Rigid3(t.rotation, t.translation); }
+
+// The /tf_static transforms of a rosbag2 folder's MCAP file, read with rovo's own MCAP reader.
+std::vector<RosTransform> BagTfStatic(const std::string& bag_dir) {
+  std::vector<RosTransform> out;
+  for (const auto& entry : fs::directory_iterator(bag_dir)) {
+    if (entry.path().extension() != ".mcap") continue;
+    const std::string bytes = ReadFile(entry.path().string());
+    ReadMcap(bytes, entry.path().string(), [&](const McapSchema*, const McapChannel& channel, const McapMessage& m) {
+      if (channel.topic != kRos2TfStaticTopic) return;
+      const std::vector<RosTransform> tf = DecodeRosTfMessage(m.data, m.where);
+      out.insert(out.end(), tf.begin(), tf.end());
+    });
+  }
+  return out;
+}
+
+// A system with needs_imu makes the suite render its dataset with an IMU, in a folder of its own (an IMU-less
+// dataset of the same preset and seed in the same data folder is not reused), and its EuRoC export carries
+// imu0, in the shared export and in each run's view, with the run's calibration relative to the IMU. A system
+// reading ROS 2 bags gets a bag per run whose /tf_static carries that run's extrinsics.
+TEST(SystemsImuAndBags, ImuDatasetsAndPerRunTfStatic) {
+  const std::string data = CacheDir("eval_systems_imu_cache");
+  const std::string plain = data + "/cloudy_urban_quick_s0", with_imu = plain + "_imu";
+  const std::string rovo = ROVO_BINARY;
+  if (!fs::exists(DatasetJsonPath(plain))) {  // an IMU-less dataset of the same preset, cached first
+    const CommandResult render =
+        RunShell(rovo + " render --preset cloudy_urban --quick --frames 0:4 --threads 2 --out " + plain);
+    ASSERT_EQ(render.status, 0) << render.output;
+  }
+  const std::string suite_dir =
+      (fs::temp_directory_path() / ("rovo_systems_imu_" + std::to_string(::getpid()))).string();
+  const CommandResult r = RunShell("ROVO_BIN=" + rovo + " " + rovo +
+                                   " suite --presets cloudy_urban --quick --frames 4 --seeds 1 --no-plots "
+                                   "--vo-threads 1 --threads 2 --out " +
+                                   suite_dir + " --data " + data + " --system " + kFixtures +
+                                   "reference_imu.yaml --system " + kFixtures + "reference_ros2.yaml");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("| reference_imu | 2 ok |"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("| reference_ros2 | 2 ok |"), std::string::npos) << r.output;
+  EXPECT_FALSE(ReadDatasetInfo(plain).imu.has_value());
+  const DatasetInfo info = ReadDatasetInfo(with_imu);
+  ASSERT_TRUE(info.imu.has_value());
+  ASSERT_TRUE(info.rig.imu_from_rig.has_value());
+  EXPECT_GT(ReadFile(with_imu + ".exports/euroc/mav0/imu0/data.csv").size(), 100u);
+  const std::string runs = suite_dir + "/runs/cloudy_urban/systems/";
+  EXPECT_TRUE(fs::exists(runs + "reference_imu/noisy_0/input/mav0/imu0/data.csv"));
+  // The EuRoC body is the IMU: sensor.yaml's cam_from_imu of the noisy run, against the gt run's, is the
+  // perturbed set's cam0 against the true one, seen from the IMU (the export's own turn of the frame cancels).
+  const Rigid3 rig_from_imu = info.rig.imu_from_rig->Inverse();
+  const Rigid3 true_cam = info.rig.cameras[0].cam_from_rig, given_cam = info.perturbed[0].cam_from_rig[0];
+  const auto sensor = [&](const std::string& run) {
+    return ReadEurocSensorYaml(runs + "reference_imu/" + run + "/input/mav0/cam0/sensor.yaml", "cam0").cam_from_rig;
+  };
+  const Rigid3 moved = sensor("gt").Inverse() * sensor("noisy_0");
+  const Rigid3 expected = rig_from_imu.Inverse() * true_cam.Inverse() * given_cam * rig_from_imu;
+  EXPECT_LT(moved.rotation.angularDistance(expected.rotation), 1e-9);
+  EXPECT_LT((moved.translation - expected.translation).norm(), 1e-9);
+  EXPECT_GT(moved.rotation.angularDistance(Eigen::Quaterniond::Identity()), 1e-4);  // the runs differ
+  // ROS 2: each run's bag has its own /tf_static (rig -> camK = rig_from_cam of the given extrinsics).
+  const std::vector<RosTransform> gt_tf = BagTfStatic(runs + "reference_ros2/gt/input");
+  const std::vector<RosTransform> noisy_tf = BagTfStatic(runs + "reference_ros2/noisy_0/input");
+  ASSERT_EQ(gt_tf.size(), info.rig.cameras.size() + 1);  // the cameras and the IMU
+  ASSERT_EQ(noisy_tf.size(), gt_tf.size());
+  for (size_t c = 0; c < info.rig.cameras.size(); ++c) {
+    ASSERT_EQ(gt_tf[c].child_frame_id, info.rig.cameras[c].name);
+    ASSERT_EQ(noisy_tf[c].child_frame_id, info.rig.cameras[c].name);
+    // gt's rig_from_cam times noisy's cam_from_rig = true rig_from_cam times given cam_from_rig (turn cancels).
+    const Rigid3 change = TransformOf(gt_tf[c]) * TransformOf(noisy_tf[c]).Inverse();
+    const Rigid3 want = info.rig.cameras[c].cam_from_rig.Inverse() * info.perturbed[0].cam_from_rig[c];
+    EXPECT_LT(change.rotation.angularDistance(want.rotation), 1e-9) << c;
+    EXPECT_LT((change.translation - want.translation).norm(), 1e-9) << c;
+    EXPECT_GT(TransformOf(gt_tf[c]).rotation.angularDistance(TransformOf(noisy_tf[c]).rotation), 1e-4) << c;
+  }
+  EXPECT_EQ(gt_tf.back().child_frame_id, "imu");
+  fs::remove_all(suite_dir);
 }
 
 // The real COLMAP (Debian package colmap) on the first 20 frames of the quick cloudy_urban, one noise set (its own
