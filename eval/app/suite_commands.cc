@@ -80,7 +80,10 @@ void AddSuiteOptions(CLI::App* cmd, SuiteCliArgs* args) {
   cmd->add_option("--system", options->systems,
                   "Description file of another odometry system to run through the same plan beside rovo's pipeline "
                   "(repeatable; docs/systems.md): GTExt with the true calibration, NoisyExt with each noise set or "
-                  "draw written into the calibration it reads, OnlineExt when it calibrates online")
+                  "draw written into the calibration it reads, OnlineExt when it calibrates online. A system with "
+                  "needs_imu makes the suite render its datasets with an IMU (as rovo render --imu, in "
+                  "<preset>..._imu folders). Every run records its wall and CPU time (system_run.json); the table's "
+                  "\"Cost per system\" gives their means per system")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--no-plots", args->no_plots, "Skip plots and report.html");
   cmd->add_option("--out", options->out_dir, "Suite output folder")->required();
