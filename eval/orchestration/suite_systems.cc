@@ -194,7 +194,7 @@ RunCalibration MakeRunCalibration(const SystemDescription& system, const std::st
                                   const std::vector<Rigid3>& given) {
   RunCalibration out;
   const std::vector<int> cameras = ExportCameras(system, info.rig.NumCameras());
-  if (system.input == "rovo" || system.input == "ros2") {  // ros2: the run's bag is written beside it (RunBag)
+  if (system.input == "rovo" || system.input == "ros2") {  // ros2: the run's bag is written beside it (WriteRunBag)
     nlohmann::json rig;
     rig["schema_version"] = kRigSchemaVersion;
     rig["source"] = "rovo suite: the extrinsics of this run";
