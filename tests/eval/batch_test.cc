@@ -102,6 +102,24 @@ TEST(SuitePlan, ListsEveryRunOnceWithItsSettings) {
   EXPECT_THROW(PlanSuite(bad), std::invalid_argument);
 }
 
+// A system that needs the IMU makes the plan render with one, into a dataset folder of its own: the folder is
+// the reuse key, so an IMU-less dataset of the same preset and seed is never taken for it.
+TEST(SuitePlan, ASystemThatNeedsTheImuGetsDatasetsWithOne) {
+  const fs::path out = TempDir("imu_plan");
+  const SuitePlan plain = PlanSuite(SmallSuite(out));
+  EXPECT_FALSE(plain.imu);
+  const std::string description = (out / "vio.yaml").string();
+  WriteFileAtomic(description,
+                  "name: vio\ninput: euroc\ncommand: \"true\"\ntrajectory: \"{out}/t.txt\"\nneeds_imu: true\n");
+  SuiteOptions options = SmallSuite(out);
+  options.systems = {description};
+  const SuitePlan with_imu = PlanSuite(options);
+  EXPECT_TRUE(with_imu.imu);
+  ASSERT_EQ(with_imu.dataset_dirs.size(), 1u);
+  EXPECT_EQ(with_imu.dataset_dirs[0], plain.dataset_dirs[0] + "_imu");
+  fs::remove_all(out);
+}
+
 // Preset entries with a render variant ("cloudy_urban+blur") plan their own dataset and runs; an unknown
 // variant is an error naming the entry; --robustness lists every variant and the harder worlds.
 // A variant's dataset made with other effects (an earlier definition of the variant) is not taken as
