@@ -13,6 +13,13 @@ else
   ROVO_BUILD_UNIT_TESTS=OFF bash ci/build.sh   # the unit tests are built and run in build-asan below
 fi
 bash ci/lint.sh     # clang-format and clang-tidy (bugprone-*, performance-*): any finding fails
+# ctest starts the longest tests first when it knows their times: tests/ctest-costs.txt (seconds per
+# GoogleTest suite, from a run on this kind of machine) seeds its record on a fresh checkout.
+for tree in build build-asan; do
+  if [ ! -f $tree/Testing/Temporary/CTestCostData.txt ]; then
+    mkdir -p $tree/Testing/Temporary && cp tests/ctest-costs.txt $tree/Testing/Temporary/CTestCostData.txt
+  fi
+done
 ctest --test-dir build -LE unit --output-on-failure -j2 --timeout 1500
 
 if [ "${ROVO_SKIP_SANITIZERS:-0}" = "1" ]; then
@@ -24,9 +31,10 @@ echo "== unit tests under ASan + UBSan =="
 launcher=()
 if command -v ccache >/dev/null 2>&1; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
 # -O1 -g1: the optimisation ASan's documentation recommends, with line tables for the reports; half the
-# compile time of -O2 -g with both sanitizers.
+# compile time of -O2 -g with both sanitizers. Warnings are errors in the Release build above; here they
+# are only shown (-O1 changes which of GCC's flow-based warnings fire, not what the code does).
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
-  -DROVO_SANITIZE=ON -DROVO_WERROR=ON -DROVO_BUILD_BENCHMARKS=OFF "${launcher[@]}" >/dev/null
+  -DROVO_SANITIZE=ON -DROVO_WERROR=OFF -DROVO_BUILD_BENCHMARKS=OFF "${launcher[@]}" >/dev/null
 cmake --build build-asan -j"$(nproc)"
 ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-asan -L unit --output-on-failure -j2 --timeout 1500
