@@ -24,7 +24,6 @@
 #include "eval/report.h"
 #include "render/render.h"
 #include "render/timing.h"
-#include "rovo/version.h"
 #include "scenes/city.h"
 #include "scenes/rng.h"
 #include "vo/pipeline.h"
@@ -245,16 +244,8 @@ void WriteRovoRunRecord(const SuitePlan& plan, const SuiteRun& run, int threads,
                         const rusage& after, bool overlapped) {
   const double user = Seconds(after.ru_utime) - Seconds(before.ru_utime);
   const double system = Seconds(after.ru_stime) - Seconds(before.ru_stime);
-  const nlohmann::json record = {
-      {"generator", "rovo suite"},
-      {"generator_version", ROVO_VERSION},
-      {"system", kBuiltInSystem},
-      {"run", run.name},
-      {"mode", SuiteModeName(run.settings.mode)},
-      {"noise_set", run.settings.mode == ExtrinsicsMode::kGroundTruth ? -1 : run.settings.noise_set},
-      {"draw_seed", run.settings.draw_seed},
-      {"seed", plan.options.vo_seed},
-      {"threads", threads},
+  nlohmann::json record = SystemRunRecordHead(plan, run, kBuiltInSystem, threads);
+  record.update(nlohmann::json{
       {"status", "ok"},
       {"in_process", true},
       {"wall_s", wall_s},
@@ -266,7 +257,7 @@ void WriteRovoRunRecord(const SuitePlan& plan, const SuiteRun& run, int threads,
       {"process_maxrss_mb", static_cast<double>(after.ru_maxrss) / 1024.0},
       {"memory_source",
        "ru_maxrss of the rovo process at the run's end: its peak since it started (rendering and earlier runs "
-       "included), not the run's own"}};
+       "included), not the run's own"}});
   WriteJsonFileAtomic((fs::path(run.run_dir) / kSystemRunFile).string(), record);
 }
 

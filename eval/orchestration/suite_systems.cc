@@ -35,6 +35,18 @@ const char* SuiteModeName(ExtrinsicsMode mode) {
   return "?";
 }
 
+nlohmann::json SystemRunRecordHead(const SuitePlan& plan, const SuiteRun& run, const std::string& system, int threads) {
+  return {{"generator", "rovo suite"},
+          {"generator_version", ROVO_VERSION},
+          {"system", system},
+          {"run", run.name},
+          {"mode", SuiteModeName(run.settings.mode)},
+          {"noise_set", run.settings.mode == ExtrinsicsMode::kGroundTruth ? -1 : run.settings.noise_set},
+          {"draw_seed", run.settings.draw_seed},
+          {"seed", plan.options.vo_seed},
+          {"threads", threads}};
+}
+
 namespace {
 
 const SystemDescription& SystemOf(const SuitePlan& plan, const SuiteRun& run) {
@@ -376,32 +388,23 @@ bool RunSystemRun(const SuitePlan& plan, const SuiteRun& run, int threads, bool 
   if (!quiet) std::fprintf(stderr, "rovo suite: %s: %s\n", system.name.c_str(), ShellQuoteWords(argv).c_str());
   ChildSpec spec{argv, env, run_dir + "/stdout.log", run_dir + "/stderr.log", run_dir + "/out", system.timeout_s};
   const ChildResult child = RunChild(spec);
-  nlohmann::json record = {
-      {"generator", "rovo suite"},
-      {"generator_version", ROVO_VERSION},
-      {"system", system.name},
-      {"description", fs::absolute(system.file).lexically_normal().string()},
-      {"run", run.name},
-      {"mode", SuiteModeName(run.settings.mode)},
-      {"noise_set", run.settings.mode == ExtrinsicsMode::kGroundTruth ? -1 : run.settings.noise_set},
-      {"draw_seed", run.settings.draw_seed},
-      {"seed", plan.options.vo_seed},
-      {"threads", threads},
-      {"command", argv},
-      {"command_line", ShellQuoteWords(argv)},
-      {"env", EnvJson(env)},
-      {"input", calibration.input},
-      {"calibration", calibration.calibration},
-      {"calibration_sha", calibration.hash},
-      {"timeout_s", system.timeout_s},
-      {"exit_code", child.exit_code},
-      {"signal", child.signal},
-      {"timed_out", child.timed_out},
-      {"wall_s", child.wall_s},
-      {"user_cpu_s", child.user_cpu_s},
-      {"system_cpu_s", child.system_cpu_s},
-      {"cpu_s", child.user_cpu_s + child.system_cpu_s},
-      {"peak_rss_mb", child.peak_rss_mb}};
+  nlohmann::json record = SystemRunRecordHead(plan, run, system.name, threads);
+  record.update(nlohmann::json{{"description", fs::absolute(system.file).lexically_normal().string()},
+                               {"command", argv},
+                               {"command_line", ShellQuoteWords(argv)},
+                               {"env", EnvJson(env)},
+                               {"input", calibration.input},
+                               {"calibration", calibration.calibration},
+                               {"calibration_sha", calibration.hash},
+                               {"timeout_s", system.timeout_s},
+                               {"exit_code", child.exit_code},
+                               {"signal", child.signal},
+                               {"timed_out", child.timed_out},
+                               {"wall_s", child.wall_s},
+                               {"user_cpu_s", child.user_cpu_s},
+                               {"system_cpu_s", child.system_cpu_s},
+                               {"cpu_s", child.user_cpu_s + child.system_cpu_s},
+                               {"peak_rss_mb", child.peak_rss_mb}});
   const std::string trajectory = ExpandPlaceholders(system.trajectory, values, system.file, "trajectory");
   record["trajectory"] = trajectory;
   ReadBackTrajectory(child, trajectory, ReadTum(GroundTruthPath(dataset_dir)), run_dir, &record);

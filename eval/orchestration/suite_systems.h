@@ -12,6 +12,7 @@
 //                                               and by systems of the same input and lens; --frames N:
 //                                               of the first N frames, from the view frames_<N>/)
 
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,6 +36,10 @@ bool RunSystemRun(const SuitePlan& plan, const SuiteRun& run, int threads, bool 
 
 // gt | noisy | online: a run's mode in system_run.json.
 const char* SuiteModeName(ExtrinsicsMode mode);
+
+// The fields every system_run.json starts with (rovo's runs and external ones): generator, system, run,
+// mode, noise set, draw seed, seed and threads.
+nlohmann::json SystemRunRecordHead(const SuitePlan& plan, const SuiteRun& run, const std::string& system, int threads);
 
 // What a finished external run's system_run.json says.
 struct ExternalRunRecord {
