@@ -198,6 +198,7 @@ void RunVoFloorBenchmark(VoOptions options) {
   Frontend frontend(info.rig, options.frontend);
   frontend.SetStaticMasks(LoadStaticMasks(options.io.dataset_dir, info.rig, info.has_static_masks));
   std::vector<HybridProjection> projections;
+  projections.reserve(static_cast<size_t>(info.rig.NumCameras()));
   for (int i = 0; i < info.rig.NumCameras(); ++i) projections.push_back(frontend.projection(i));
   const std::vector<std::pair<int, int>> pairs = NeighbourPairs(ComputeHybridLayouts(info.rig));
   Floor floor(projections, pairs, options.frontend);
