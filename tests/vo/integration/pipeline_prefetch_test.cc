@@ -26,15 +26,27 @@ std::string ReadText(const fs::path& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-TEST(PipelinePrefetch, PngReplayEqualsPreloadedImagesByteForByte) {
-  const fs::path root = fs::temp_directory_path() / "rovo_vo_prefetch_test";
-  fs::remove_all(root);
-  const std::string dataset = (root / "dataset").string();
-  const int frames = 12;
-  ASSERT_EQ(std::system((std::string(ROVO_BINARY) + " render --preset cloudy_urban --quick --frames 0:" +
-                         std::to_string(frames) + " --quiet --out " + dataset)
-                            .c_str()),
-            0);
+constexpr int kFrames = 12;
+
+// One rendered quick cloudy_urban sequence for the tests below.
+class PipelinePrefetch : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    fs::remove_all(Root());
+    ASSERT_EQ(std::system((std::string(ROVO_BINARY) + " render --preset cloudy_urban --quick --frames 0:" +
+                           std::to_string(kFrames) + " --quiet --out " + Dataset())
+                              .c_str()),
+              0);
+  }
+  static void TearDownTestSuite() { fs::remove_all(Root()); }
+  static fs::path Root() { return fs::temp_directory_path() / "rovo_vo_prefetch_test"; }
+  static std::string Dataset() { return (Root() / "dataset").string(); }
+};
+
+TEST_F(PipelinePrefetch, PngReplayEqualsPreloadedImagesByteForByte) {
+  const fs::path root = Root();
+  const std::string dataset = Dataset();
+  const int frames = kFrames;
   const DatasetInfo info = ReadDatasetInfo(dataset);
   for (int frame = 0; frame < frames; ++frame) {
     for (const RigCamera& cam : info.rig.cameras) {
@@ -67,7 +79,25 @@ TEST(PipelinePrefetch, PngReplayEqualsPreloadedImagesByteForByte) {
     ASSERT_FALSE(preloaded.empty()) << file;
     EXPECT_EQ(preloaded, ReadText(fs::path(runs[1]) / file)) << file;
   }
-  fs::remove_all(root);
+}
+
+// `rovo bench vo --floor` prints its table and a ratio of two measured CPU times.
+TEST_F(PipelinePrefetch, FloorBenchmarkPrintsTheFrontEndAgainstTheFloor) {
+  const std::string out = (Root() / "floor.txt").string();
+  ASSERT_EQ(std::system((std::string(ROVO_BINARY) + " bench vo " + Dataset() +
+                         " --floor --frames 0:4 --threads 1 --quiet > " + out)
+                            .c_str()),
+            0);
+  const std::string text = ReadText(out);
+  for (const char* row : {"| warp ", "| track (pyramid + LK) ", "| detect + describe ", "| match ", "| total "}) {
+    EXPECT_NE(text.find(row), std::string::npos) << row << " missing from:\n" << text;
+  }
+  const size_t at = text.find("front-end / floor: ");
+  ASSERT_NE(at, std::string::npos) << text;
+  const double ratio = std::stod(text.substr(at + std::string("front-end / floor: ").size()));
+  EXPECT_GT(ratio, 0.5) << text;  // both sides measured, the same work
+  EXPECT_LT(ratio, 3.0) << text;
+  EXPECT_NE(text.find("machine reference"), std::string::npos) << text;
 }
 
 }  // namespace
