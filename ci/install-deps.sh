@@ -14,7 +14,7 @@ PACKAGES=(
   libopenimageio-dev openimageio-tools
   libopencv-dev
   libeigen3-dev libceres-dev libopengv-dev
-  nlohmann-json3-dev libyaml-cpp-dev libcli11-dev libfastcdr-dev zlib1g-dev
+  nlohmann-json3-dev libyaml-cpp-dev libcli11-dev libfastcdr-dev zlib1g-dev libdeflate-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib python3-numpy python3-yaml
 )

@@ -139,6 +139,9 @@ class HybridProjection {
   static constexpr int kMapStep = 2;
   const cv::Mat& map_x() const { return map_x_; }
   const cv::Mat& map_y() const { return map_y_; }
+  // The fixed-point maps Warp uses (cv::convertMaps: CV_16SC2 + CV_16UC1).
+  const cv::Mat& map_fixed() const { return map_fixed_; }
+  const cv::Mat& map_frac() const { return map_frac_; }
 
  private:
   void BuildMaps();

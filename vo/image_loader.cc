@@ -2,23 +2,25 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
 #include "datasets/dataset.h"
+#include "vo/png_gray.h"
 
 namespace rovo {
 
-LoadedFrame LoadFrameImages(const std::string& dataset_dir, const Rig& rig, int frame) {
+LoadedFrame LoadFrameImages(const std::string& dataset_dir, const Rig& rig, int frame, bool parallel) {
   const int n = rig.NumCameras();
   LoadedFrame loaded;
   loaded.images.resize(n);
   std::vector<std::string> missing(n), wrong_size(n);
-  tbb::parallel_for(0, n, [&](int j) {
+  const auto load_view = [&](int j) {
     const RigCamera& cam = rig.cameras[j];
     const std::string path = ImagePath(dataset_dir, cam.name, frame);
     cv::Mat& image = loaded.images[j];
-    image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    image = ReadGrayImage(path);
     if (image.empty()) {
       missing[j] = path + ": missing or unreadable";
       image = cv::Mat::zeros(cam.camera.height, cam.camera.width, CV_8UC1);
@@ -27,7 +29,12 @@ LoadedFrame LoadFrameImages(const std::string& dataset_dir, const Rig& rig, int 
                       " but dataset.json rig.cameras[" + cam.name + "] says " + std::to_string(cam.camera.width) + "x" +
                       std::to_string(cam.camera.height);
     }
-  });
+  };
+  if (parallel) {
+    tbb::parallel_for(0, n, load_view);
+  } else {
+    for (int j = 0; j < n; ++j) load_view(j);
+  }
   for (int j = 0; j < n; ++j) {
     if (!wrong_size[j].empty()) throw std::runtime_error(wrong_size[j]);
     if (missing[j].empty()) continue;
@@ -55,24 +62,57 @@ std::vector<cv::Mat> LoadStaticMasks(const std::string& dataset_dir, const Rig& 
   return masks;
 }
 
-ImagePrefetcher::ImagePrefetcher(const std::string& dataset_dir, const Rig& rig, int begin, int end)
-    : dataset_dir_(dataset_dir), rig_(rig), end_(end) {
-  Start(begin);
+ImagePrefetcher::ImagePrefetcher(const std::string& dataset_dir, const Rig& rig, int begin, int end, int depth)
+    : dataset_dir_(dataset_dir), rig_(rig), begin_(begin), end_(end), depth_(std::max(1, depth)) {
+  if (end_ > begin_) worker_ = std::thread([this] { Run(); });
 }
 
 ImagePrefetcher::~ImagePrefetcher() {
-  if (next_.valid()) next_.wait();
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  changed_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+void ImagePrefetcher::Run() {
+  for (int frame = begin_; frame < end_; ++frame) {
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      changed_.wait(lock, [this] { return stop_ || static_cast<int>(ready_.size()) < depth_; });
+      if (stop_) return;
+    }
+    Slot slot;
+    slot.frame = frame;
+    try {
+      slot.loaded = LoadFrameImages(dataset_dir_, rig_, frame, /*parallel=*/false);
+    } catch (...) {
+      slot.error = std::current_exception();
+    }
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      ready_.push_back(std::move(slot));
+    }
+    changed_.notify_all();
+  }
 }
 
 LoadedFrame ImagePrefetcher::Get(int frame) {
-  LoadedFrame loaded = next_.get();
-  Start(frame + 1);
-  return loaded;
-}
-
-void ImagePrefetcher::Start(int frame) {
-  if (frame >= end_) return;
-  next_ = std::async(std::launch::async, [this, frame] { return LoadFrameImages(dataset_dir_, rig_, frame); });
+  Slot slot;
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [this] { return !ready_.empty(); });
+    slot = std::move(ready_.front());
+    ready_.pop_front();
+  }
+  changed_.notify_all();
+  if (slot.error) std::rethrow_exception(slot.error);
+  if (slot.frame != frame) {
+    throw std::logic_error("ImagePrefetcher: frame " + std::to_string(frame) + " requested, frame " +
+                           std::to_string(slot.frame) + " is next");
+  }
+  return std::move(slot.loaded);
 }
 
 }  // namespace rovo

@@ -1,10 +1,14 @@
 #pragma once
-// Reading a dataset frame's images for the VO: one decoder call per view, in parallel, and a
-// prefetcher that decodes frame f + 1 on a second thread while frame f is processed.
+// Reading a dataset frame's images for the VO: one decoder call per view, and a prefetcher that
+// decodes the next frames on a thread of its own while the current one is processed.
 
-#include <future>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <mutex>
 #include <opencv2/core.hpp>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "datasets/rig.h"
@@ -21,31 +25,44 @@ struct LoadedFrame {
 
 // The images of one frame. A missing or unreadable file becomes a black image and is named in
 // `problems`; an image of the wrong size throws, naming the file and dataset.json's field.
-LoadedFrame LoadFrameImages(const std::string& dataset_dir, const Rig& rig, int frame);
+// PNG images take the fast path of png_gray.h. `parallel`: the views in parallel (TBB).
+LoadedFrame LoadFrameImages(const std::string& dataset_dir, const Rig& rig, int frame, bool parallel = true);
 
 // The dataset's static masks (dataset.json has_static_masks), one 8-bit image per camera, 0 =
 // invalid; empty when the dataset has none. Throws naming the file when one is unreadable or of the
 // wrong size.
 std::vector<cv::Mat> LoadStaticMasks(const std::string& dataset_dir, const Rig& rig, bool has_static_masks);
 
-// Reads frame f+1's images on a second thread while frame f is processed (PNG decoding costs about
-// 30 CPU-ms per full-size view; it overlaps the front-end's and the BA's less parallel stretches).
+// Decodes the frames ahead of the one being processed, on a thread of its own, at most `depth`
+// frames ahead (a bounded queue): the decoding fills the cycles that the front-end's and the BA's
+// less parallel stretches leave free, and a frame of slow decoding borrows from the frames before it.
+// A frame's views are decoded one after the other there (no TBB: the prefetch thread does not take
+// the pool's workers from the front-end). The images are exactly those of LoadFrameImages.
 class ImagePrefetcher {
  public:
-  // Frames [begin, end) are requested in order; end <= begin reads nothing.
-  ImagePrefetcher(const std::string& dataset_dir, const Rig& rig, int begin, int end);
+  // Frames [begin, end) are requested in order; end <= begin reads nothing. depth >= 1.
+  ImagePrefetcher(const std::string& dataset_dir, const Rig& rig, int begin, int end, int depth = 2);
   ~ImagePrefetcher();
   ImagePrefetcher(const ImagePrefetcher&) = delete;
   ImagePrefetcher& operator=(const ImagePrefetcher&) = delete;
-  // The images of `frame`; starts reading the next one. Rethrows a read error.
+  // The images of `frame` (the next in order); rethrows its read error.
   LoadedFrame Get(int frame);
 
  private:
-  void Start(int frame);
+  struct Slot {
+    int frame = 0;
+    LoadedFrame loaded;
+    std::exception_ptr error;
+  };
+  void Run();
   std::string dataset_dir_;
   const Rig& rig_;
-  int end_;
-  std::future<LoadedFrame> next_;
+  int begin_, end_, depth_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<Slot> ready_;
+  bool stop_ = false;
+  std::thread worker_;
 };
 
 }  // namespace rovo

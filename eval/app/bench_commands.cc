@@ -6,6 +6,7 @@
 #include "eval/app/vo_args.h"
 #include "eval/bench/render_bench.h"
 #include "eval/bench/vo_bench.h"
+#include "eval/bench/vo_floor.h"
 
 namespace rovo {
 namespace {
@@ -54,8 +55,17 @@ void AddBenchCommands(CommandTree& tree) {
   bench->add_flag("--preload", bench_args->options.io.preload,
                   "Decode every frame's images before timing (a live rig delivers decoded images; PNG decoding costs "
                   "about 30 CPU-ms per full-size view). Keeps all frames in memory: use --frames");
-  bench->callback([bench, bench_args] {
+  auto floor = std::make_shared<bool>(false);
+  bench->add_flag("--floor", *floor,
+                  "Instead of the pipeline: the front-end's CPU per frame against the floor, the bare OpenCV calls it "
+                  "is made of (remap, pyramid, LK with a backward pass, FAST, ORB, Hamming matching) with its "
+                  "parameters on the same images on one thread, by stage, and their ratio (eval/bench/vo_floor.h)");
+  bench->callback([bench, bench_args, floor] {
     FinaliseVoArgs(bench, bench_args.get());
+    if (*floor) {
+      RunVoFloorBenchmark(bench_args->options);
+      return;
+    }
     RunVoBenchmark(bench_args->options);
   });
 }

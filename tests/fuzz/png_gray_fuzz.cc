@@ -1,0 +1,55 @@
+// Fuzz target: a camera image read by the VO's replay (LoadFrameImages, vo/image_loader.h, with the
+// fast PNG path of vo/png_gray.h). The input becomes cam0/000000.png of a one-camera 32x31 rig.
+// Besides the error contract: whenever the fast path decodes the bytes, OpenCV's decoder must give
+// the same image (the fast path must never accept what libpng would read otherwise or refuse).
+#include <opencv2/imgcodecs.hpp>
+
+#include "datasets/dataset.h"
+#include "datasets/rig.h"
+#include "tests/fuzz/fuzz_util.h"
+#include "vo/image_loader.h"
+#include "vo/png_gray.h"
+
+namespace {
+
+rovo::Rig OneCameraRig() {
+  rovo::RigCamera camera;
+  camera.name = "cam0";
+  camera.camera.model = rovo::CameraModelId::kEquidistant;
+  camera.camera.width = 32;
+  camera.camera.height = 31;
+  camera.camera.params = {10.0, 10.0, 15.5, 15.0, 0.0, 0.0, 0.0, 0.0};
+  camera.camera.max_fov_deg = 180.0;
+  rovo::Rig rig;
+  rig.cameras.push_back(camera);
+  return rig;
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  static const rovo::fuzz::ScratchDir scratch("png_gray");
+  static const std::string dir = scratch.Fresh("dataset");
+  static const rovo::Rig rig = OneCameraRig();
+  const std::string path = rovo::ImagePath(dir, "cam0", 0);
+  rovo::fuzz::WriteBytes(path, data, size);
+  if (const auto fast = rovo::DecodePngGrayFast(data, size)) {
+    const cv::Mat expected =
+        cv::imdecode(cv::Mat(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(data)), cv::IMREAD_GRAYSCALE);
+    if (expected.size() != fast->size() || cv::countNonZero(expected != *fast) != 0) {
+      rovo::fuzz::Finding("fast PNG path differs from OpenCV", path);
+    }
+  }
+  for (const bool parallel : {false, true}) {
+    rovo::fuzz::ExpectClearError({path}, [&] {
+      const rovo::LoadedFrame loaded = rovo::LoadFrameImages(dir, rig, 0, parallel);
+      if (loaded.images.size() != 1 || loaded.images[0].rows != 31 || loaded.images[0].cols != 32) {
+        rovo::fuzz::Finding("loaded image of the wrong size", path);
+      }
+      if (!loaded.missing_cameras.empty() && loaded.problems.find(path) == std::string::npos) {
+        rovo::fuzz::Finding("missing image not named", loaded.problems);
+      }
+    });
+  }
+  return 0;
+}

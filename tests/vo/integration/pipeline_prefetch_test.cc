@@ -1,0 +1,104 @@
+// End to end: a replay from PNG files (decoded ahead on the prefetch thread, through the fast PNG
+// path) gives the same run as one from images decoded beforehand (--preload): the same trajectory
+// and extrinsics files byte for byte; and every image the renderer writes takes the fast path and
+// decodes to what cv::imread gives.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "datasets/dataset.h"
+#include "vo/pipeline.h"
+#include "vo/png_gray.h"
+
+namespace rovo {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string ReadText(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+constexpr int kFrames = 12;
+
+// One rendered quick cloudy_urban sequence for the tests below.
+class PipelinePrefetch : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    fs::remove_all(Root());
+    ASSERT_EQ(std::system((std::string(ROVO_BINARY) + " render --preset cloudy_urban --quick --frames 0:" +
+                           std::to_string(kFrames) + " --quiet --out " + Dataset())
+                              .c_str()),
+              0);
+  }
+  static void TearDownTestSuite() { fs::remove_all(Root()); }
+  static fs::path Root() { return fs::temp_directory_path() / "rovo_vo_prefetch_test"; }
+  static std::string Dataset() { return (Root() / "dataset").string(); }
+};
+
+TEST_F(PipelinePrefetch, PngReplayEqualsPreloadedImagesByteForByte) {
+  const fs::path root = Root();
+  const std::string dataset = Dataset();
+  const int frames = kFrames;
+  const DatasetInfo info = ReadDatasetInfo(dataset);
+  for (int frame = 0; frame < frames; ++frame) {
+    for (const RigCamera& cam : info.rig.cameras) {
+      const std::string path = ImagePath(dataset, cam.name, frame);
+      const std::string bytes = ReadText(path);
+      const auto fast = DecodePngGrayFast(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());
+      ASSERT_TRUE(fast.has_value()) << path << ": the renderer's PNG does not take the fast path";
+      const cv::Mat expected = cv::imread(path, cv::IMREAD_GRAYSCALE);
+      ASSERT_EQ(fast->size(), expected.size()) << path;
+      ASSERT_EQ(cv::countNonZero(*fast != expected), 0) << path;
+    }
+  }
+  std::vector<std::string> runs;
+  for (const bool preload : {true, false}) {
+    VoOptions options;
+    options.io.dataset_dir = dataset;
+    options.io.out_dir = (root / (preload ? "preloaded" : "prefetched")).string();
+    options.io.frames.begin = 0;
+    options.io.frames.end = frames;
+    options.io.threads = 2;
+    options.io.quiet = true;
+    options.io.preload = preload;
+    const VoSummary summary = RunVo(options);
+    EXPECT_EQ(summary.frames, frames);
+    EXPECT_GE(summary.frames_ok, frames - 2);
+    runs.push_back(options.io.out_dir);
+  }
+  for (const char* file : {"trajectory.tum", "extrinsics.csv"}) {
+    const std::string preloaded = ReadText(fs::path(runs[0]) / file);
+    ASSERT_FALSE(preloaded.empty()) << file;
+    EXPECT_EQ(preloaded, ReadText(fs::path(runs[1]) / file)) << file;
+  }
+}
+
+// `rovo bench vo --floor` prints its table and a ratio of two measured CPU times.
+TEST_F(PipelinePrefetch, FloorBenchmarkPrintsTheFrontEndAgainstTheFloor) {
+  const std::string out = (Root() / "floor.txt").string();
+  ASSERT_EQ(std::system((std::string(ROVO_BINARY) + " bench vo " + Dataset() +
+                         " --floor --frames 0:4 --threads 1 --quiet > " + out)
+                            .c_str()),
+            0);
+  const std::string text = ReadText(out);
+  for (const char* row : {"| warp ", "| track (pyramid + LK) ", "| detect + describe ", "| match ", "| total "}) {
+    EXPECT_NE(text.find(row), std::string::npos) << row << " missing from:\n" << text;
+  }
+  const size_t at = text.find("front-end / floor: ");
+  ASSERT_NE(at, std::string::npos) << text;
+  const double ratio = std::stod(text.substr(at + std::string("front-end / floor: ").size()));
+  EXPECT_GT(ratio, 0.5) << text;  // both sides measured, the same work
+  EXPECT_LT(ratio, 3.0) << text;
+  EXPECT_NE(text.find("machine reference"), std::string::npos) << text;
+}
+
+}  // namespace
+}  // namespace rovo
