@@ -53,8 +53,8 @@ void AddBenchCommands(CommandTree& tree) {
   bench->add_option("--out", bench_args->options.io.out_dir,
                     "Run folder to write (default: DATASET_bench_vo_run, beside the dataset)");
   bench->add_flag("--preload", bench_args->options.io.preload,
-                  "Decode every frame's images before timing (a live rig delivers decoded images; PNG decoding costs "
-                  "about 30 CPU-ms per full-size view). Keeps all frames in memory: use --frames");
+                  "Decode every frame's images before timing (a live rig delivers decoded images; without it, the "
+                  "replay decodes PNGs ahead on a thread of its own). Keeps all frames in memory: use --frames");
   auto floor = std::make_shared<bool>(false);
   bench->add_flag("--floor", *floor,
                   "Instead of the pipeline: the front-end's CPU per frame against the floor, the bare OpenCV calls it "
