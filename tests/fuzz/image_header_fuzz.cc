@@ -3,6 +3,7 @@
 // one-camera, one-frame dataset whose dataset.json is fixed.
 #include "datasets/dataset.h"
 #include "datasets/rig.h"
+#include "tests/fuzz/fuzz_rig.h"
 #include "tests/fuzz/fuzz_util.h"
 
 namespace {
@@ -14,14 +15,7 @@ rovo::DatasetInfo OneCameraInfo() {
   info.has_masks = true;
   info.has_ground_truth = false;
   info.has_static_masks = true;
-  rovo::RigCamera camera;
-  camera.name = "cam0";
-  camera.camera.model = rovo::CameraModelId::kEquidistant;
-  camera.camera.width = 32;
-  camera.camera.height = 31;
-  camera.camera.params = {10.0, 10.0, 15.5, 15.0, 0.0, 0.0, 0.0, 0.0};
-  camera.camera.max_fov_deg = 180.0;
-  info.rig.cameras.push_back(camera);
+  info.rig.cameras.push_back(rovo::fuzz::SmallFuzzCamera());
   return info;
 }
 

@@ -6,6 +6,7 @@
 
 #include "datasets/dataset.h"
 #include "datasets/rig.h"
+#include "tests/fuzz/fuzz_rig.h"
 #include "tests/fuzz/fuzz_util.h"
 #include "vo/image_loader.h"
 #include "vo/png_gray.h"
@@ -13,15 +14,8 @@
 namespace {
 
 rovo::Rig OneCameraRig() {
-  rovo::RigCamera camera;
-  camera.name = "cam0";
-  camera.camera.model = rovo::CameraModelId::kEquidistant;
-  camera.camera.width = 32;
-  camera.camera.height = 31;
-  camera.camera.params = {10.0, 10.0, 15.5, 15.0, 0.0, 0.0, 0.0, 0.0};
-  camera.camera.max_fov_deg = 180.0;
   rovo::Rig rig;
-  rig.cameras.push_back(camera);
+  rig.cameras.push_back(rovo::fuzz::SmallFuzzCamera());
   return rig;
 }
 
