@@ -18,6 +18,7 @@ import json
 import os
 import re
 import shlex
+import shutil
 import subprocess
 import sys
 
@@ -34,10 +35,14 @@ def fixed_inputs():
     return h.digest()
 
 
+# clang's driver: the metapackage's name, else the one clang-tidy-14 brings (clang-14).
+CLANG = shutil.which("clang++") or shutil.which("clang++-14")
+
+
 def preprocess_command(entry):
     """The compile command turned into clang's preprocessor, comments kept, warnings off."""
     args = shlex.split(entry["command"]) if "command" in entry else list(entry["arguments"])
-    out = ["clang++"]
+    out = [CLANG]
     skip = False
     for a in args[1:]:
         if skip:
@@ -53,6 +58,8 @@ def preprocess_command(entry):
 
 
 def key(entry, shared):
+    if CLANG is None:
+        return None  # no preprocessor: every source is checked
     result = subprocess.run(preprocess_command(entry), cwd=entry["directory"], capture_output=True)
     if result.returncode != 0:
         return None  # not preprocessable here: clang-tidy will say why
