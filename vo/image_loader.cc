@@ -5,22 +5,38 @@
 #include <algorithm>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
+#include <utility>
 
 #include "datasets/dataset.h"
 #include "vo/png_gray.h"
 
 namespace rovo {
 
-LoadedFrame LoadFrameImages(const std::string& dataset_dir, const Rig& rig, int frame, bool parallel) {
-  const int n = rig.NumCameras();
+FrameReader::FrameReader(std::string dataset_dir, const Rig& rig, LateralColour lateral_colour)
+    : dataset_dir_(std::move(dataset_dir)), rig_(rig) {
+  if (!lateral_colour.Any()) return;
+  for (const RigCamera& cam : rig.cameras) lateral_colour_.emplace_back(cam.camera, lateral_colour);
+}
+
+cv::Mat FrameReader::ReadView(int camera, const std::string& path) const {
+  if (lateral_colour_.empty()) return ReadGrayImage(path);
+  cv::Mat image = cv::imread(path, cv::IMREAD_ANYCOLOR);  // 8-bit; gray stays gray, alpha is dropped
+  if (image.channels() != 3) return image;
+  const LateralColourCorrection& correction = lateral_colour_[static_cast<size_t>(camera)];
+  if (image.cols != correction.width() || image.rows != correction.height()) return image;  // Load names it
+  return correction.ToGray(image);
+}
+
+LoadedFrame FrameReader::Load(int frame, bool parallel) const {
+  const int n = rig_.NumCameras();
   LoadedFrame loaded;
   loaded.images.resize(n);
   std::vector<std::string> missing(n), wrong_size(n);
   const auto load_view = [&](int j) {
-    const RigCamera& cam = rig.cameras[j];
-    const std::string path = ImagePath(dataset_dir, cam.name, frame);
+    const RigCamera& cam = rig_.cameras[j];
+    const std::string path = ImagePath(dataset_dir_, cam.name, frame);
     cv::Mat& image = loaded.images[j];
-    image = ReadGrayImage(path);
+    image = ReadView(j, path);
     if (image.empty()) {
       missing[j] = path + ": missing or unreadable";
       image = cv::Mat::zeros(cam.camera.height, cam.camera.width, CV_8UC1);
@@ -44,6 +60,15 @@ LoadedFrame LoadFrameImages(const std::string& dataset_dir, const Rig& rig, int 
   return loaded;
 }
 
+LateralColour DatasetLateralColour(const DatasetInfo& info) {
+  if (!info.optics) return {};
+  return {info.optics->lateral_ca_red, info.optics->lateral_ca_blue};
+}
+
+LoadedFrame LoadFrameImages(const std::string& dataset_dir, const Rig& rig, int frame, bool parallel) {
+  return FrameReader(dataset_dir, rig).Load(frame, parallel);
+}
+
 std::vector<cv::Mat> LoadStaticMasks(const std::string& dataset_dir, const Rig& rig, bool has_static_masks) {
   std::vector<cv::Mat> masks;
   if (!has_static_masks) return masks;
@@ -62,8 +87,8 @@ std::vector<cv::Mat> LoadStaticMasks(const std::string& dataset_dir, const Rig& 
   return masks;
 }
 
-ImagePrefetcher::ImagePrefetcher(const std::string& dataset_dir, const Rig& rig, int begin, int end, int depth)
-    : dataset_dir_(dataset_dir), rig_(rig), begin_(begin), end_(end), depth_(std::max(1, depth)) {
+ImagePrefetcher::ImagePrefetcher(const FrameReader& reader, int begin, int end, int depth)
+    : reader_(reader), begin_(begin), end_(end), depth_(std::max(1, depth)) {
   if (end_ > begin_) worker_ = std::thread([this] { Run(); });
 }
 
@@ -86,7 +111,7 @@ void ImagePrefetcher::Run() {
     Slot slot;
     slot.frame = frame;
     try {
-      slot.loaded = LoadFrameImages(dataset_dir_, rig_, frame, /*parallel=*/false);
+      slot.loaded = reader_.Load(frame, /*parallel=*/false);
     } catch (...) {
       slot.error = std::current_exception();
     }

@@ -1,6 +1,7 @@
 #pragma once
-// Reading a dataset frame's images for the VO: one decoder call per view, and a prefetcher that
-// decodes the next frames on a thread of its own while the current one is processed.
+// Reading a dataset frame's images for the VO: one decoder call per view (colour images made gray,
+// after undoing the lens's lateral colour when it is given), and a prefetcher that decodes the next
+// frames on a thread of its own while the current one is processed.
 
 #include <condition_variable>
 #include <deque>
@@ -11,7 +12,9 @@
 #include <thread>
 #include <vector>
 
+#include "datasets/dataset.h"
 #include "datasets/rig.h"
+#include "vo/lateral_colour.h"
 
 namespace rovo {
 
@@ -23,9 +26,27 @@ struct LoadedFrame {
   std::string problems;
 };
 
-// The images of one frame. A missing or unreadable file becomes a black image and is named in
+// Reads the frames of a dataset. A missing or unreadable file becomes a black image and is named in
 // `problems`; an image of the wrong size throws, naming the file and dataset.json's field.
-// PNG images take the fast path of png_gray.h. `parallel`: the views in parallel (TBB).
+// PNG images take the fast path of png_gray.h; with lateral colour (lateral_colour.h), colour
+// images are decoded in colour, corrected and then made gray (gray images are read as they are).
+class FrameReader {
+ public:
+  FrameReader(std::string dataset_dir, const Rig& rig, LateralColour lateral_colour = {});
+  // The images of one frame. `parallel`: the views in parallel (TBB).
+  LoadedFrame Load(int frame, bool parallel = true) const;
+
+ private:
+  cv::Mat ReadView(int camera, const std::string& path) const;
+  std::string dataset_dir_;
+  const Rig& rig_;
+  std::vector<LateralColourCorrection> lateral_colour_;  // one per camera, or none
+};
+
+// The lateral colour that dataset.json "optics" states for the dataset's lens (none without optics).
+LateralColour DatasetLateralColour(const DatasetInfo& info);
+
+// FrameReader(dataset_dir, rig).Load(frame, parallel): without lateral colour correction.
 LoadedFrame LoadFrameImages(const std::string& dataset_dir, const Rig& rig, int frame, bool parallel = true);
 
 // The dataset's static masks (dataset.json has_static_masks), one 8-bit image per camera, 0 =
@@ -40,8 +61,9 @@ std::vector<cv::Mat> LoadStaticMasks(const std::string& dataset_dir, const Rig& 
 // the pool's workers from the front-end). The images are exactly those of LoadFrameImages.
 class ImagePrefetcher {
  public:
-  // Frames [begin, end) are requested in order; end <= begin reads nothing. depth >= 1.
-  ImagePrefetcher(const std::string& dataset_dir, const Rig& rig, int begin, int end, int depth = 2);
+  // Frames [begin, end) are requested in order; end <= begin reads nothing. depth >= 1. `reader`
+  // must outlive the prefetcher.
+  ImagePrefetcher(const FrameReader& reader, int begin, int end, int depth = 2);
   ~ImagePrefetcher();
   ImagePrefetcher(const ImagePrefetcher&) = delete;
   ImagePrefetcher& operator=(const ImagePrefetcher&) = delete;
@@ -55,8 +77,7 @@ class ImagePrefetcher {
     std::exception_ptr error;
   };
   void Run();
-  std::string dataset_dir_;
-  const Rig& rig_;
+  const FrameReader& reader_;
   int begin_, end_, depth_;
   std::mutex mutex_;
   std::condition_variable changed_;

@@ -77,12 +77,13 @@ bool RunsStartupCalibration(const VoOptions& options) {
   return options.start.mode == ExtrinsicsMode::kOnline && options.startup.enabled;
 }
 
-StartupCalibrationReport RunStartupCalibration(const VoOptions& options, const DatasetInfo& info, int begin, int end,
+StartupCalibrationReport RunStartupCalibration(const VoOptions& options, const DatasetInfo& info,
+                                               const FrameReader& reader, int begin, int end,
                                                const std::vector<Rigid3>& cam_from_rig) {
   StartupCalibrationOptions sopt;
   sopt.shots = options.startup.shots;
   sopt.shot_spacing = options.startup.spacing;
-  auto load = [&](int frame) { return LoadFrameImages(options.io.dataset_dir, info.rig, frame); };
+  auto load = [&](int frame) { return reader.Load(frame); };
   StartupCalibrationReport startup = CalibrateAtStartup(
       info.rig, cam_from_rig, load, begin, end,
       LoadStaticMasks(options.io.dataset_dir, info.rig, info.has_static_masks), sopt, options.io.quiet);
@@ -144,11 +145,11 @@ void AddStageTimes(const FrontendFrame& features, const BackendFrameResult& resu
 }
 
 // --preload (bench): every frame decoded before the clock starts, as a live rig delivers images.
-std::vector<LoadedFrame> PreloadImages(const VoOptions& options, const DatasetInfo& info, int begin, int end) {
+std::vector<LoadedFrame> PreloadImages(const VoOptions& options, const FrameReader& reader, int begin, int end) {
   std::vector<LoadedFrame> preloaded;
   Progress load_progress("vo: decoding images", end - begin, "frames", options.io.quiet);
   for (int frame = begin; frame < end; ++frame) {
-    preloaded.push_back(LoadFrameImages(options.io.dataset_dir, info.rig, frame));
+    preloaded.push_back(reader.Load(frame));
     load_progress.Add();
   }
   load_progress.Finish();
@@ -237,11 +238,12 @@ nlohmann::json RunInfoJson(const VoOptions& options, const DatasetInfo& info, co
 
 // OnlineExt's start-up calibration when it runs: `cam_from_rig` becomes its result and a converged one
 // anchors the BA's extrinsics.
-StartupCalibrationReport StartUp(const VoOptions& options, const DatasetInfo& info, int begin, int end,
-                                 std::vector<Rigid3>* cam_from_rig, BackendOptions* backend_options) {
+StartupCalibrationReport StartUp(const VoOptions& options, const DatasetInfo& info, const FrameReader& reader,
+                                 int begin, int end, std::vector<Rigid3>* cam_from_rig,
+                                 BackendOptions* backend_options) {
   StartupCalibrationReport startup;
   if (!RunsStartupCalibration(options)) return startup;
-  startup = RunStartupCalibration(options, info, begin, end, *cam_from_rig);
+  startup = RunStartupCalibration(options, info, reader, begin, end, *cam_from_rig);
   *cam_from_rig = startup.cam_from_rig;
   if (startup.converged) {
     backend_options->ba.extrinsic_anchor = startup.cam_from_rig;
@@ -297,7 +299,10 @@ VoSummary RunVo(const VoOptions& options) {
 
   BackendOptions backend_options = options.backend;
   backend_options.ba.optimize_extrinsics = options.start.mode == ExtrinsicsMode::kOnline;
-  const StartupCalibrationReport startup = StartUp(options, info, begin, end, &cam_from_rig, &backend_options);
+  const FrameReader reader(options.io.dataset_dir, info.rig,
+                           options.io.undo_lateral_colour ? DatasetLateralColour(info) : LateralColour{});
+  const StartupCalibrationReport startup =
+      StartUp(options, info, reader, begin, end, &cam_from_rig, &backend_options);
   VoSummary summary;
   const Rig lenses = LensesForVo(options, info.rig, startup, &summary.lens_angle_scale);
   Frontend frontend(lenses.WithExtrinsics(cam_from_rig), options.frontend);
@@ -310,8 +315,8 @@ VoSummary RunVo(const VoOptions& options) {
   double ok_ratio_sum = 0.0, ok_error_sum = 0.0;
   Progress progress("vo " + ExtrinsicsModeName(options.start.mode), end - begin, "frames", options.io.quiet);
   std::vector<LoadedFrame> preloaded;
-  if (options.io.preload) preloaded = PreloadImages(options, info, begin, end);
-  ImagePrefetcher prefetcher(options.io.dataset_dir, info.rig, begin, options.io.preload ? begin : end);
+  if (options.io.preload) preloaded = PreloadImages(options, reader, begin, end);
+  ImagePrefetcher prefetcher(reader, begin, options.io.preload ? begin : end);
   for (int frame = begin; frame < end; ++frame) {
     const auto frame_start = Clock::now();
     const LoadedFrame loaded = options.io.preload ? std::move(preloaded[frame - begin]) : prefetcher.Get(frame);

@@ -38,6 +38,9 @@ struct VoIoOptions {
   // fisheye ring ROVO is made for, when the rig has any; else all), "all", or indices "0,1,2,3"
   // (increasing, with camera 0, the gauge of the extrinsics). run.json "vo_cameras" lists them.
   std::string cameras = "auto";
+  // Undo the lens's lateral colour that dataset.json "optics" states before colour images become
+  // gray (image_loader.h, lateral_colour.h); false: gray as decoded.
+  bool undo_lateral_colour = true;
   void Check() const;  // throws std::invalid_argument naming the flag
 };
 
@@ -138,6 +141,12 @@ void VisitIo(VoIoOptions& io, Visitor& visitor, int part) {
                        "(increasing, with camera 0)",
                        -kUnbounded, kUnbounded, true, Reuse::kYesMissingIsDefault},
             io.cameras);
+    visitor(OptionSpec{"--lateral-colour", "lateral_colour",
+                       "auto: undo the lens's lateral colour that dataset.json optics states (its red and blue planes "
+                       "magnified relative to green) before colour images become gray, as a lens profile's TCA "
+                       "correction does; off: gray as decoded (no effect on datasets without lateral colour)",
+                       -kUnbounded, kUnbounded, true, Reuse::kYesMissingIsDefault},
+            Named<bool>{&io.undo_lateral_colour, {{true, "auto"}, {false, "off"}}});
   } else {
     visitor(OptionSpec{"--quiet", nullptr, "No progress output"}, io.quiet);
   }
