@@ -1,5 +1,6 @@
 // Fuzz target: a camera image read by the VO's replay (LoadFrameImages, vo/image_loader.h, with the
-// fast PNG path of vo/png_gray.h). The input becomes cam0/000000.png of a one-camera 32x31 rig.
+// fast PNG path of vo/png_gray.h; and FrameReader with lateral colour, whose colour path decodes
+// through OpenCV and vo/lateral_colour.h). The input becomes cam0/000000.png of a one-camera 32x31 rig.
 // Besides the error contract: whenever the fast path decodes the bytes, OpenCV's decoder must give
 // the same image (the fast path must never accept what libpng would read otherwise or refuse).
 #include <opencv2/imgcodecs.hpp>
@@ -34,9 +35,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       rovo::fuzz::Finding("fast PNG path differs from OpenCV", path);
     }
   }
-  for (const bool parallel : {false, true}) {
+  static const rovo::FrameReader plain(dir, rig);
+  static const rovo::FrameReader lateral_colour(dir, rig, {0.01, -0.02});
+  for (const rovo::FrameReader* reader : {&plain, &lateral_colour}) {
     rovo::fuzz::ExpectClearError({path}, [&] {
-      const rovo::LoadedFrame loaded = rovo::LoadFrameImages(dir, rig, 0, parallel);
+      const rovo::LoadedFrame loaded = reader->Load(0, reader == &plain);
       if (loaded.images.size() != 1 || loaded.images[0].rows != 31 || loaded.images[0].cols != 32) {
         rovo::fuzz::Finding("loaded image of the wrong size", path);
       }
