@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
@@ -26,6 +27,7 @@ namespace rovo {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+double CpuMs() { return 1000.0 * static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }  // process, all threads
 double MsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
@@ -209,7 +211,11 @@ nlohmann::json RunInfoJson(const VoOptions& options, const DatasetInfo& info, co
   j["version"] = ROVO_VERSION;
   j["initial_world_from_rig"] = PoseJson(world_from_rig0);
   j["lens_angle_scale_applied"] = summary.lens_angle_scale;
-  if (RunsStartupCalibration(options)) j["startup_calibration"] = startup.ToJson();
+  if (RunsStartupCalibration(options)) {
+    j["startup_calibration"] = startup.ToJson();
+    j["startup_calibration"]["ms"] = summary.startup_ms;
+    j["startup_calibration"]["cpu_ms"] = summary.startup_cpu_ms;
+  }
   // The back-end's other settings (its user-set ones are in the registry's "backend." keys).
   nlohmann::json& backend = j["backend"];
   backend["ransac_max_iterations"] = backend_options.ransac.max_iterations;
@@ -301,9 +307,13 @@ VoSummary RunVo(const VoOptions& options) {
   backend_options.ba.optimize_extrinsics = options.start.mode == ExtrinsicsMode::kOnline;
   const FrameReader reader(options.io.dataset_dir, info.rig,
                            options.io.undo_lateral_colour ? DatasetLateralColour(info) : LateralColour{});
+  VoSummary summary;
+  const auto startup_start = Clock::now();
+  const double startup_cpu_start = CpuMs();
   const StartupCalibrationReport startup =
       StartUp(options, info, reader, begin, end, &cam_from_rig, &backend_options);
-  VoSummary summary;
+  summary.startup_ms = RunsStartupCalibration(options) ? MsSince(startup_start) : 0.0;
+  summary.startup_cpu_ms = RunsStartupCalibration(options) ? CpuMs() - startup_cpu_start : 0.0;
   const Rig lenses = LensesForVo(options, info.rig, startup, &summary.lens_angle_scale);
   Frontend frontend(lenses.WithExtrinsics(cam_from_rig), options.frontend);
   frontend.SetStaticMasks(LoadStaticMasks(options.io.dataset_dir, info.rig, info.has_static_masks));

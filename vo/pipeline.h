@@ -34,6 +34,9 @@ struct VoSummary {
   double mean_inlier_ratio = 0.0;      // over "ok" frames
   double mean_reproj_error_deg = 0.0;  // over "ok" frames
   double lens_angle_scale = 1.0;       // applied to the dataset's lenses (VoStartupOptions::apply_lens_scale)
+  // OnlineExt's start-up calibration, before the first frame: wall and process CPU time (0 without it).
+  double startup_ms = 0.0;
+  double startup_cpu_ms = 0.0;
   VoStageTimes stage_ms;
 };
 

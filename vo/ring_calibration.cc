@@ -1,9 +1,13 @@
 #include "vo/ring_calibration.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "vo/ring_model.h"
 #include "vo/ring_views.h"
@@ -70,9 +74,13 @@ JointSolution BestJointSolution(const std::vector<OverlapPair>& pairs,
                                 const std::vector<std::vector<int>>& pair_inliers, const Rig& rig,
                                 const std::vector<std::vector<Eigen::Quaterniond>>& starts,
                                 const RingCalibrationOptions& o, bool estimate_scale) {
+  // The starts are solved in parallel, the first with the most inliers wins (as in order).
+  std::vector<JointSolution> candidates(starts.size());
+  tbb::parallel_for(size_t{0}, starts.size(), [&](size_t k) {
+    candidates[k] = SolveJoint(pairs, pair_inliers, rig, starts[k], o, estimate_scale);
+  });
   JointSolution best;
-  for (const auto& start : starts) {
-    JointSolution candidate = SolveJoint(pairs, pair_inliers, rig, start, o, estimate_scale);
+  for (JointSolution& candidate : candidates) {
     if (candidate.total_inliers > best.total_inliers) best = std::move(candidate);
   }
   return best;
@@ -239,9 +247,11 @@ RingCalibrator::RingCalibrator(const Rig& rig, const std::vector<cv::Mat>& stati
   }
   impl_->rig = rig;
   impl_->options = options;
-  for (const auto& [a, b] : RingPairs(rig)) {
-    impl_->pairs.push_back(ring::MakeOverlapPair(rig, a, b, static_masks, options));
-  }
+  const std::vector<std::pair<int, int>> ring_pairs = RingPairs(rig);
+  impl_->pairs.resize(ring_pairs.size());
+  tbb::parallel_for(size_t{0}, ring_pairs.size(), [&](size_t k) {
+    impl_->pairs[k] = ring::MakeOverlapPair(rig, ring_pairs[k].first, ring_pairs[k].second, static_masks, options);
+  });
 }
 
 RingCalibrator::~RingCalibrator() = default;
@@ -259,8 +269,11 @@ void RingCalibrator::AddFrame(const std::vector<cv::Mat>& images) {
   }
   std::vector<cv::Mat> gray(images.size());
   for (size_t j = 0; j < images.size(); ++j) gray[j] = ring::Gray(images[j]);
-  auto orb = cv::ORB::create(o.orb_features, 1.2f, 8, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31, o.orb_fast_threshold);
-  for (OverlapPair& p : impl_->pairs) ring::MatchOverlap(gray, *orb, o, &p);
+  // The pairs in parallel, each with a detector of its own (each pools into its own bearings).
+  tbb::parallel_for(size_t{0}, impl_->pairs.size(), [&](size_t k) {
+    auto orb = cv::ORB::create(o.orb_features, 1.2f, 8, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31, o.orb_fast_threshold);
+    ring::MatchOverlap(gray, *orb, o, &impl_->pairs[k]);
+  });
   ++impl_->frames;
 }
 

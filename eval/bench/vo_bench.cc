@@ -57,9 +57,11 @@ void RunVoBenchmark(VoOptions options) {
   // CPU = process CPU time of all threads (FrontendFrame::cpu_ms_*); measured for the front-end only. It
   // includes the image decoder and an async BA running meanwhile: use --preload --sync-ba for the
   // front-end's own CPU time.
+  // Ratios against the mean of the two references: what stays comparable between machines and hours.
+  const double reference_ms = 0.5 * (reference_before_ms + reference_after_ms);
   std::printf(
-      "| stage                     | ms/frame | CPU ms/frame |\n"
-      "|---------------------------|---------:|-------------:|\n");
+      "| stage                     | ms/frame | machine refs | CPU ms/frame |\n"
+      "|---------------------------|---------:|-------------:|-------------:|\n");
   const double frontend_wall = t.warp + t.detect + t.track + t.match;
   const double frontend_cpu = t.cpu_warp + t.cpu_detect + t.cpu_track + t.cpu_match;
   const struct {
@@ -80,16 +82,21 @@ void RunVoBenchmark(VoOptions options) {
               {"whole frame", t.total, -1}};
   for (const auto& row : rows) {
     if (row.cpu >= 0) {
-      std::printf("| %-25s | %8.2f | %12.2f |\n", row.name, row.wall, row.cpu);
+      std::printf("| %-25s | %8.2f | %12.2f | %12.2f |\n", row.name, row.wall, row.wall / reference_ms, row.cpu);
     } else {
-      std::printf("| %-25s | %8.2f |            - |\n", row.name, row.wall);
+      std::printf("| %-25s | %8.2f | %12.2f |            - |\n", row.name, row.wall, row.wall / reference_ms);
     }
+  }
+  if (s.startup_ms > 0.0) {
+    std::printf("start-up calibration (OnlineExt, before the first frame): %.0f ms = %.1f machine refs, %.0f CPU ms\n",
+                s.startup_ms, s.startup_ms / reference_ms, s.startup_cpu_ms);
   }
   std::printf("RANSAC: %.2f us per hypothesis\n", t.ransac_us_per_hypothesis);
   std::printf("local BA: %s\n", options.backend.async_ba ? "solved on its own thread beside the next frame's front-end "
                                                            "(in-line total = wait for it + the rest)"
                                                          : "solved in line (--sync-ba)");
-  std::printf("whole pipeline: %.2f frames/s (target 10 Hz)%s\n", t.total > 0 ? 1000.0 / t.total : 0.0,
+  std::printf("whole pipeline: %.2f frames/s (target 10 Hz), %.2f machine refs per frame%s\n",
+              t.total > 0 ? 1000.0 / t.total : 0.0, t.total / reference_ms,
               options.io.preload ? ", images decoded beforehand" : ", images decoded on a second thread");
   std::printf(
       "machine reference: one full-size hybrid warp per core on %d core%s at once: %.2f ms before the run, "
