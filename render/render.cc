@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <condition_variable>
 #include <cstdio>
 #include <deque>
@@ -631,7 +632,9 @@ RenderSummary RenderDataset(const RenderOptions& options) {
 
   PrepareOutput(options, info, groundtruth, plan);
   const std::vector<int> todo = FramesToRender(options, rig, count, &summary);
+  const std::clock_t frames_start = std::clock();
   RenderFrames(options, scene, rig, begin, todo, spp, plan, arena, *tracer, &summary);
+  summary.frames_cpu_seconds = static_cast<double>(std::clock() - frames_start) / CLOCKS_PER_SEC;
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
 }

@@ -48,6 +48,9 @@ struct RenderSummary {
   int frames_rendered = 0;
   int frames_skipped = 0;  // already complete on disk (resume)
   double seconds = 0.0;
+  // Process CPU time (all threads) of rendering and writing the frames, without the scene's build and
+  // the auto-exposure meter: the figure to compare settings by, per frame.
+  double frames_cpu_seconds = 0.0;
   std::string rig;  // the rig used and where it came from (DescribeRigChoice)
 };
 

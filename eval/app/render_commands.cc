@@ -315,8 +315,11 @@ void AddRenderCommand(CLI::App& root) {
     options.optics = args->optics.Resolve();
     args->imu.Resolve(&options);
     const RenderSummary s = RenderDataset(options);
-    std::printf("rendered %d frames, skipped %d complete, %d in this shard, %.1f s\n%s\n", s.frames_rendered,
-                s.frames_skipped, s.frames_total, s.seconds, s.rig.c_str());
+    std::printf("rendered %d frames, skipped %d complete, %d in this shard, %.1f s", s.frames_rendered,
+                s.frames_skipped, s.frames_total, s.seconds);
+    if (s.frames_rendered > 0)
+      std::printf(" (%.2f CPU-s per frame, without the scene's build)", s.frames_cpu_seconds / s.frames_rendered);
+    std::printf("\n%s\n", s.rig.c_str());
   });
 }
 
