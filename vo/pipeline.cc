@@ -243,13 +243,17 @@ nlohmann::json RunInfoJson(const VoOptions& options, const DatasetInfo& info, co
 }
 
 // OnlineExt's start-up calibration when it runs: `cam_from_rig` becomes its result and a converged one
-// anchors the BA's extrinsics.
+// anchors the BA's extrinsics; its wall and CPU time go to `summary`.
 StartupCalibrationReport StartUp(const VoOptions& options, const DatasetInfo& info, const FrameReader& reader,
-                                 int begin, int end, std::vector<Rigid3>* cam_from_rig,
-                                 BackendOptions* backend_options) {
+                                 int begin, int end, std::vector<Rigid3>* cam_from_rig, BackendOptions* backend_options,
+                                 VoSummary* summary) {
   StartupCalibrationReport startup;
   if (!RunsStartupCalibration(options)) return startup;
+  const auto start = Clock::now();
+  const double cpu_start = CpuMs();
   startup = RunStartupCalibration(options, info, reader, begin, end, *cam_from_rig);
+  summary->startup_ms = MsSince(start);
+  summary->startup_cpu_ms = CpuMs() - cpu_start;
   *cam_from_rig = startup.cam_from_rig;
   if (startup.converged) {
     backend_options->ba.extrinsic_anchor = startup.cam_from_rig;
@@ -270,6 +274,12 @@ Trajectory GroundTruthIfAny(const std::string& dataset_dir) {
 std::unique_ptr<tbb::global_control> ThreadLimit(int threads) {
   if (threads <= 0) return nullptr;
   return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+}
+
+// The dataset's images as the VO reads them: with the lens's lateral colour undone unless --lateral-colour off.
+FrameReader VoFrameReader(const VoOptions& options, const DatasetInfo& info) {
+  return {options.io.dataset_dir, info.rig,
+          options.io.undo_lateral_colour ? DatasetLateralColour(info) : LateralColour{}};
 }
 
 // The dataset as the VO sees it: only the cameras of --cameras; its camera j is dataset camera
@@ -305,15 +315,10 @@ VoSummary RunVo(const VoOptions& options) {
 
   BackendOptions backend_options = options.backend;
   backend_options.ba.optimize_extrinsics = options.start.mode == ExtrinsicsMode::kOnline;
-  const FrameReader reader(options.io.dataset_dir, info.rig,
-                           options.io.undo_lateral_colour ? DatasetLateralColour(info) : LateralColour{});
+  const FrameReader reader = VoFrameReader(options, info);
   VoSummary summary;
-  const auto startup_start = Clock::now();
-  const double startup_cpu_start = CpuMs();
   const StartupCalibrationReport startup =
-      StartUp(options, info, reader, begin, end, &cam_from_rig, &backend_options);
-  summary.startup_ms = RunsStartupCalibration(options) ? MsSince(startup_start) : 0.0;
-  summary.startup_cpu_ms = RunsStartupCalibration(options) ? CpuMs() - startup_cpu_start : 0.0;
+      StartUp(options, info, reader, begin, end, &cam_from_rig, &backend_options, &summary);
   const Rig lenses = LensesForVo(options, info.rig, startup, &summary.lens_angle_scale);
   Frontend frontend(lenses.WithExtrinsics(cam_from_rig), options.frontend);
   frontend.SetStaticMasks(LoadStaticMasks(options.io.dataset_dir, info.rig, info.has_static_masks));
