@@ -5,13 +5,13 @@
 #include "vo/lateral_colour.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
-#include <unistd.h>
 
 #include "vo/image_loader.h"
 
@@ -108,9 +108,9 @@ TEST(LateralColour, FrameReaderCorrectsColourImagesAndReadsGrayOnesAsTheyAre) {
   const LoadedFrame corrected = FrameReader(dir.string(), rig, colour).Load(0);
   const LoadedFrame plain = FrameReader(dir.string(), rig).Load(0);
   ASSERT_TRUE(corrected.problems.empty()) << corrected.problems;
-  EXPECT_EQ(cv::norm(corrected.images[0], LateralColourCorrection(TestCamera(), colour).ToGray(through_lens),
-                     cv::NORM_INF),
-            0.0);
+  EXPECT_EQ(
+      cv::norm(corrected.images[0], LateralColourCorrection(TestCamera(), colour).ToGray(through_lens), cv::NORM_INF),
+      0.0);
   const cv::Mat decoded_gray = cv::imread((dir / "cam0" / "000000.png").string(), cv::IMREAD_GRAYSCALE);
   EXPECT_EQ(cv::norm(plain.images[0], decoded_gray, cv::NORM_INF), 0.0);
   EXPECT_EQ(cv::norm(corrected.images[1], Gray(through_lens), cv::NORM_INF), 0.0);  // a gray image: nothing to undo
