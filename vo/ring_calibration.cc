@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -248,10 +249,11 @@ RingCalibrator::RingCalibrator(const Rig& rig, const std::vector<cv::Mat>& stati
   impl_->rig = rig;
   impl_->options = options;
   const std::vector<std::pair<int, int>> ring_pairs = RingPairs(rig);
-  impl_->pairs.resize(ring_pairs.size());
+  std::vector<std::optional<OverlapPair>> made(ring_pairs.size());  // the pairs' views in parallel
   tbb::parallel_for(size_t{0}, ring_pairs.size(), [&](size_t k) {
-    impl_->pairs[k] = ring::MakeOverlapPair(rig, ring_pairs[k].first, ring_pairs[k].second, static_masks, options);
+    made[k].emplace(ring::MakeOverlapPair(rig, ring_pairs[k].first, ring_pairs[k].second, static_masks, options));
   });
+  for (std::optional<OverlapPair>& p : made) impl_->pairs.push_back(std::move(*p));
 }
 
 RingCalibrator::~RingCalibrator() = default;
