@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "vo/opencv_threads.h"
+
 namespace rovo {
 namespace {
 
@@ -38,6 +40,9 @@ cv::Mat LateralColourCorrection::ToGray(const cv::Mat& bgr) const {
     throw std::invalid_argument("LateralColourCorrection: expected an 8-bit BGR image of " +
                                 std::to_string(size_.width) + "x" + std::to_string(size_.height));
   }
+  // OpenCV serial while this runs: the prefetch thread calls it beside another run's front-end, and
+  // OpenCV's thread pool must not be reset under a running call (vo/opencv_threads.h).
+  const ScopedOpenCvThreads serial_opencv;
   cv::Mat planes[3];
   cv::split(bgr, planes);
   const auto resample = [&](int channel, const cv::Mat map[2]) {
