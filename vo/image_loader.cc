@@ -12,19 +12,30 @@
 
 namespace rovo {
 
-FrameReader::FrameReader(std::string dataset_dir, const Rig& rig, LateralColour lateral_colour)
+FrameReader::FrameReader(std::string dataset_dir, const Rig& rig, const LensCorrections& corrections)
     : dataset_dir_(std::move(dataset_dir)), rig_(rig) {
-  if (!lateral_colour.Any()) return;
-  for (const RigCamera& cam : rig.cameras) lateral_colour_.emplace_back(cam.camera, lateral_colour);
+  for (const RigCamera& cam : rig.cameras) {
+    if (corrections.lateral_colour.Any()) lateral_colour_.emplace_back(cam.camera, corrections.lateral_colour);
+    if (corrections.relative_illumination.Any())
+      flat_field_.emplace_back(cam.camera, corrections.relative_illumination, corrections.response);
+  }
 }
 
 cv::Mat FrameReader::ReadView(int camera, const std::string& path) const {
-  if (lateral_colour_.empty()) return ReadGrayImage(path);
-  cv::Mat image = cv::imread(path, cv::IMREAD_ANYCOLOR);  // 8-bit; gray stays gray, alpha is dropped
-  if (image.channels() != 3) return image;
-  const LateralColourCorrection& correction = lateral_colour_[static_cast<size_t>(camera)];
-  if (image.cols != correction.width() || image.rows != correction.height()) return image;  // Load names it
-  return correction.ToGray(image);
+  cv::Mat image;
+  if (lateral_colour_.empty()) {
+    image = ReadGrayImage(path);
+  } else {
+    image = cv::imread(path, cv::IMREAD_ANYCOLOR);  // 8-bit; gray stays gray, alpha is dropped
+    const LateralColourCorrection& correction = lateral_colour_[static_cast<size_t>(camera)];
+    if (image.channels() == 3 && image.cols == correction.width() && image.rows == correction.height())
+      image = correction.ToGray(image);
+  }
+  const bool right_size = image.cols == rig_.cameras[camera].camera.width &&
+                          image.rows == rig_.cameras[camera].camera.height;  // else Load names it
+  if (!flat_field_.empty() && image.type() == CV_8UC1 && right_size)
+    flat_field_[static_cast<size_t>(camera)].Apply(&image);
+  return image;
 }
 
 LoadedFrame FrameReader::Load(int frame, bool parallel) const {
@@ -60,9 +71,13 @@ LoadedFrame FrameReader::Load(int frame, bool parallel) const {
   return loaded;
 }
 
-LateralColour DatasetLateralColour(const DatasetInfo& info) {
-  if (!info.optics) return {};
-  return {info.optics->lateral_ca_red, info.optics->lateral_ca_blue};
+LensCorrections DatasetLensCorrections(const DatasetInfo& info) {
+  LensCorrections c;
+  if (!info.optics) return c;
+  c.lateral_colour = {info.optics->lateral_ca_red, info.optics->lateral_ca_blue};
+  c.relative_illumination = {info.optics->falloff_angle_scale, info.optics->rim_illumination};
+  if (info.sensor) c.response = info.sensor->response;
+  return c;
 }
 
 LoadedFrame LoadFrameImages(const std::string& dataset_dir, const Rig& rig, int frame, bool parallel) {

@@ -14,6 +14,7 @@
 
 #include "datasets/dataset.h"
 #include "datasets/rig.h"
+#include "vo/flat_field.h"
 #include "vo/lateral_colour.h"
 
 namespace rovo {
@@ -26,13 +27,21 @@ struct LoadedFrame {
   std::string problems;
 };
 
+// What the VO undoes of a lens before it tracks: none by default.
+struct LensCorrections {
+  LateralColour lateral_colour;                // lateral_colour.h
+  RelativeIllumination relative_illumination;  // flat_field.h
+  std::string response = "srgb";               // the sensor's response curve, for the flat field
+};
+
 // Reads the frames of a dataset. A missing or unreadable file becomes a black image and is named in
 // `problems`; an image of the wrong size throws, naming the file and dataset.json's field.
 // PNG images take the fast path of png_gray.h; with lateral colour (lateral_colour.h), colour
-// images are decoded in colour, corrected and then made gray (gray images are read as they are).
+// images are decoded in colour, corrected and then made gray (gray images are read as they are);
+// with relative illumination the gray image gets its flat-field correction (flat_field.h).
 class FrameReader {
  public:
-  FrameReader(std::string dataset_dir, const Rig& rig, LateralColour lateral_colour = {});
+  FrameReader(std::string dataset_dir, const Rig& rig, const LensCorrections& corrections = {});
   // The images of one frame. `parallel`: the views in parallel (TBB).
   LoadedFrame Load(int frame, bool parallel = true) const;
 
@@ -41,10 +50,12 @@ class FrameReader {
   std::string dataset_dir_;
   const Rig& rig_;
   std::vector<LateralColourCorrection> lateral_colour_;  // one per camera, or none
+  std::vector<FlatFieldCorrection> flat_field_;          // one per camera, or none
 };
 
-// The lateral colour that dataset.json "optics" states for the dataset's lens (none without optics).
-LateralColour DatasetLateralColour(const DatasetInfo& info);
+// The lateral colour and relative illumination that dataset.json "optics" states for the dataset's
+// lens, with its sensor's response curve (none without optics).
+LensCorrections DatasetLensCorrections(const DatasetInfo& info);
 
 // FrameReader(dataset_dir, rig).Load(frame, parallel): without lateral colour correction.
 LoadedFrame LoadFrameImages(const std::string& dataset_dir, const Rig& rig, int frame, bool parallel = true);

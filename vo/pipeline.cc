@@ -276,10 +276,13 @@ std::unique_ptr<tbb::global_control> ThreadLimit(int threads) {
   return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
 }
 
-// The dataset's images as the VO reads them: with the lens's lateral colour undone unless --lateral-colour off.
+// The dataset's images as the VO reads them: with the lens's lateral colour and relative illumination
+// undone unless --lateral-colour off / --flat-field off.
 FrameReader VoFrameReader(const VoOptions& options, const DatasetInfo& info) {
-  return {options.io.dataset_dir, info.rig,
-          options.io.undo_lateral_colour ? DatasetLateralColour(info) : LateralColour{}};
+  LensCorrections corrections = DatasetLensCorrections(info);
+  if (!options.io.undo_lateral_colour) corrections.lateral_colour = {};
+  if (!options.io.flat_field) corrections.relative_illumination = {};
+  return {options.io.dataset_dir, info.rig, corrections};
 }
 
 // The dataset as the VO sees it: only the cameras of --cameras; its camera j is dataset camera

@@ -41,6 +41,8 @@ struct VoIoOptions {
   // Undo the lens's lateral colour that dataset.json "optics" states before colour images become
   // gray (image_loader.h, lateral_colour.h); false: gray as decoded.
   bool undo_lateral_colour = true;
+  // Undo its relative illumination (flat_field.h); false: the images' brightness as decoded.
+  bool flat_field = true;
   void Check() const;  // throws std::invalid_argument naming the flag
 };
 
@@ -147,6 +149,12 @@ void VisitIo(VoIoOptions& io, Visitor& visitor, int part) {
                        "correction does; off: gray as decoded (no effect on datasets without lateral colour)",
                        -kUnbounded, kUnbounded, true, Reuse::kYesMissingIsDefault},
             Named<bool>{&io.undo_lateral_colour, {{true, "auto"}, {false, "off"}}});
+    visitor(OptionSpec{"--flat-field", "flat_field",
+                       "auto: undo the lens's relative illumination (vignetting) that dataset.json optics states, "
+                       "through the sensor's response curve, so that the dark rim where the views overlap gets its "
+                       "contrast back; off: the brightness as decoded (no effect on datasets without it)",
+                       -kUnbounded, kUnbounded, true, Reuse::kYesMissingIsDefault},
+            Named<bool>{&io.flat_field, {{true, "auto"}, {false, "off"}}});
   } else {
     visitor(OptionSpec{"--quiet", nullptr, "No progress output"}, io.quiet);
   }

@@ -1,8 +1,8 @@
 // Fuzz target: a camera image read by the VO's replay (LoadFrameImages, vo/image_loader.h, with the
-// fast PNG path of vo/png_gray.h; and FrameReader with lateral colour, whose colour path decodes
-// through OpenCV and vo/lateral_colour.h). The input becomes cam0/000000.png of a one-camera 32x31 rig.
-// Besides the error contract: whenever the fast path decodes the bytes, OpenCV's decoder must give
-// the same image (the fast path must never accept what libpng would read otherwise or refuse).
+// fast PNG path of vo/png_gray.h; and FrameReader with lens corrections, whose colour path decodes
+// through OpenCV and vo/lateral_colour.h, then vo/flat_field.h). The input becomes cam0/000000.png of a one-camera
+// 32x31 rig. Besides the error contract: whenever the fast path decodes the bytes, OpenCV's decoder must give the same
+// image (the fast path must never accept what libpng would read otherwise or refuse).
 #include <opencv2/imgcodecs.hpp>
 
 #include "datasets/dataset.h"
@@ -36,7 +36,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
   }
   static const rovo::FrameReader plain(dir, rig);
-  static const rovo::FrameReader lateral_colour(dir, rig, {0.01, -0.02});
+  static const rovo::FrameReader lateral_colour(dir, rig, {{0.01, -0.02}, {0.3, 0.4}, "srgb"});
   for (const rovo::FrameReader* reader : {&plain, &lateral_colour}) {
     rovo::fuzz::ExpectClearError({path}, [&] {
       const rovo::LoadedFrame loaded = reader->Load(0, reader == &plain);

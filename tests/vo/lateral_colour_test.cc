@@ -105,7 +105,7 @@ TEST(LateralColour, FrameReaderCorrectsColourImagesAndReadsGrayOnesAsTheyAre) {
   cv::imwrite((dir / "cam0" / "000000.png").string(), through_lens);
   cv::imwrite((dir / "cam1" / "000000.png").string(), Gray(through_lens));
 
-  const LoadedFrame corrected = FrameReader(dir.string(), rig, colour).Load(0);
+  const LoadedFrame corrected = FrameReader(dir.string(), rig, {colour, {}, "srgb"}).Load(0);
   const LoadedFrame plain = FrameReader(dir.string(), rig).Load(0);
   ASSERT_TRUE(corrected.problems.empty()) << corrected.problems;
   EXPECT_EQ(
