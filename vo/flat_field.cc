@@ -69,6 +69,7 @@ void FlatFieldCorrection::Apply(cv::Mat* gray) const {
     const float* gain = gain_.data() + static_cast<size_t>(y) * size_.width;
     for (int x = 0; x < size_.width; ++x) {
       const float linear = std::min(1.0f, decode_[row[x]] * gain[x]);
+      // NOLINTNEXTLINE(bugprone-incorrect-roundings): linear >= 0, where adding 0.5 rounds correctly.
       row[x] = encode_[static_cast<size_t>(linear * kEncodeSteps + 0.5f)];
     }
   }
