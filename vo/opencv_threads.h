@@ -1,8 +1,9 @@
 #pragma once
 // ScopedOpenCvThreads: OpenCV serial (cv::setNumThreads(1), process-wide) while any holder lives, the
 // caller's setting restored when the last one goes. Every vo step that calls OpenCV's parallel
-// functions (the front-end, the start-up calibration, the lateral colour correction) holds one: a set-and-restore per call races with
-// another VO run in the same process. The views already run in parallel under TBB (docs/design-notes.md).
+// functions (the front-end, the start-up calibration, the lateral colour correction) holds one: a set-and-restore per
+// call races with another VO run in the same process. The views already run in parallel under TBB
+// (docs/design-notes.md).
 
 #include <mutex>
 #include <opencv2/core.hpp>
