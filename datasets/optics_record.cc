@@ -1,10 +1,17 @@
 #include "datasets/optics_record.h"
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "datasets/json_check.h"
 
 namespace rovo {
+
+double RelativeIlluminationAt(double falloff_angle_scale, double rim_illumination, double theta, double theta_max) {
+  const double u = theta / theta_max;
+  const double c = std::cos(falloff_angle_scale * theta);
+  return c * c * c * c * (1.0 - (1.0 - rim_illumination) * u * u);
+}
 using nlohmann::json;
 
 OpticsRecord ParseOpticsRecord(JsonChecker& check, const json& oj, const std::string& p, int num_cameras) {

@@ -25,6 +25,11 @@ struct OpticsRecord {
   bool operator!=(const OpticsRecord& other) const { return !(*this == other); }
 };
 
+// The relative illumination E at `theta` radians off the axis of a lens whose field reaches
+// theta_max: cos^4(k theta) (1 - (1 - rim_illumination) u^2), u = theta / theta_max (FORMAT.md,
+// section Optics, step 3). The renderer darkens by it (render/optics.h), the VO divides by it (vo/flat_field.h).
+double RelativeIlluminationAt(double falloff_angle_scale, double rim_illumination, double theta, double theta_max);
+
 // /optics: every field present, typed and in range; problems recorded in `check`.
 OpticsRecord ParseOpticsRecord(JsonChecker& check, const nlohmann::json& oj, const std::string& pointer,
                                int num_cameras);

@@ -128,9 +128,7 @@ OpticsSettings MakeOpticsSettings(const std::string& profile, const OpticsOverri
 double GaussianSigmaFromMtf50(double mtf50) { return std::sqrt(std::log(2.0) / 2.0) / (M_PI * mtf50); }
 
 double RelativeIllumination(const OpticsSettings& s, double theta, double theta_max) {
-  const double u = theta / theta_max;
-  const double c = std::cos(s.falloff_angle_scale * theta);
-  return c * c * c * c * (1.0 - (1.0 - s.rim_illumination) * u * u);
+  return RelativeIlluminationAt(s.falloff_angle_scale, s.rim_illumination, theta, theta_max);
 }
 
 double PsfSigma(const OpticsSettings& s, double mtf50_factor, double theta, double theta_max) {

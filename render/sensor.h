@@ -25,18 +25,11 @@
 #include <vector>
 
 #include "datasets/dataset.h"
+#include "datasets/response_curve.h"
 
 namespace rovo {
 
-// Camera response curves, y = CRF(v) for v in [0, 1] (v = DN / (2^b - 1)).
-//   kSrgb:   IEC 61966-2-1: 12.92 v for v <= 0.0031308, else 1.055 v^(1/2.4) - 0.055
-//   kBt709:  ITU-R BT.709 camera OETF: 4.5 v for v < 0.018, else 1.099 v^0.45 - 0.099
-//   kLinear: v
-enum class ResponseCurve { kSrgb, kBt709, kLinear };
-std::string ResponseCurveName(ResponseCurve curve);
-// Throws std::invalid_argument listing the names (srgb, bt709, linear).
-ResponseCurve ResponseCurveFromName(const std::string& name);
-double ApplyResponseCurve(ResponseCurve curve, double v);
+// The camera response curves (ResponseCurve, ApplyResponseCurve) are datasets/response_curve.h's.
 
 // Luminance of linear RGB with Rec. 709 / sRGB primaries: the grayscale sensor's signal and the
 // auto-exposure meter's quantity.

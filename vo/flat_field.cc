@@ -7,26 +7,20 @@
 #include <optional>
 #include <stdexcept>
 
+#include "datasets/optics_record.h"
+#include "datasets/response_curve.h"
+
 namespace rovo {
 namespace {
 
 constexpr int kEncodeSteps = 65535;
 
-// The sensor's response curve y = CRF(v) of linear v in [0, 1] (render/sensor.h states the same curves).
-double Encode(const std::string& response, double v) {
-  if (response == "srgb") return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
-  if (response == "bt709") return v < 0.018 ? 4.5 * v : 1.099 * std::pow(v, 0.45) - 0.099;
-  if (response == "linear") return v;
-  throw std::invalid_argument("flat-field correction: unknown response curve '" + response +
-                              "' (dataset.json sensor.response: srgb, bt709 or linear)");
-}
-
-// Its inverse, by bisection (the curves are increasing).
-double Decode(const std::string& response, double y) {
+// The inverse of the response curve, by bisection (the curves are increasing).
+double Decode(ResponseCurve curve, double y) {
   double lo = 0.0, hi = 1.0;
   for (int i = 0; i < 60; ++i) {
     const double mid = 0.5 * (lo + hi);
-    (Encode(response, mid) < y ? lo : hi) = mid;
+    (ApplyResponseCurve(curve, mid) < y ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
 }
@@ -34,16 +28,15 @@ double Decode(const std::string& response, double y) {
 }  // namespace
 
 double RelativeIllumination::At(double theta, double theta_max) const {
-  const double u = theta / theta_max;
-  const double c = std::cos(falloff_angle_scale * theta);
-  return c * c * c * c * (1.0 - (1.0 - rim_illumination) * u * u);
+  return RelativeIlluminationAt(falloff_angle_scale, rim_illumination, theta, theta_max);
 }
 
 FlatFieldCorrection::FlatFieldCorrection(const Camera& camera, RelativeIllumination law, const std::string& response)
     : size_(camera.width, camera.height), encode_(kEncodeSteps + 1) {
-  for (int code = 0; code < 256; ++code) decode_[code] = static_cast<float>(Decode(response, code / 255.0));
+  const ResponseCurve curve = ResponseCurveFromName(response);  // throws on an unknown name
+  for (int code = 0; code < 256; ++code) decode_[code] = static_cast<float>(Decode(curve, code / 255.0));
   for (int i = 0; i <= kEncodeSteps; ++i) {
-    const double y = Encode(response, static_cast<double>(i) / kEncodeSteps);
+    const double y = ApplyResponseCurve(curve, static_cast<double>(i) / kEncodeSteps);
     encode_[i] = static_cast<uint8_t>(std::clamp(std::lround(255.0 * y), 0L, 255L));
   }
   const double theta_max = camera.max_fov_deg * M_PI / 360.0;
