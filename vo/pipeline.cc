@@ -85,6 +85,8 @@ StartupCalibrationReport RunStartupCalibration(const VoOptions& options, const D
   StartupCalibrationOptions sopt;
   sopt.shots = options.startup.shots;
   sopt.shot_spacing = options.startup.spacing;
+  sopt.max_shots = options.startup.max_shots;
+  sopt.min_pair_inliers = options.startup.min_pair_inliers;
   auto load = [&](int frame) { return reader.Load(frame); };
   StartupCalibrationReport startup = CalibrateAtStartup(
       info.rig, cam_from_rig, load, begin, end,

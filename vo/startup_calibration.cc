@@ -18,6 +18,8 @@ void StartupCalibrationOptions::Check() const {
   };
   require(shots >= 1, "shots must be >= 1");
   require(shot_spacing >= 1, "shot_spacing must be >= 1");
+  require(max_shots >= 1, "max_shots must be >= 1");
+  require(min_pair_inliers >= 0, "min_pair_inliers must be >= 0");
   require(ring_passes >= 1, "ring_passes must be >= 1");
   require(later_orb_features >= 10, "later_orb_features must be >= 10");
   require(later_orb_fast_threshold >= 0, "later_orb_fast_threshold must be >= 0");
@@ -214,6 +216,8 @@ nlohmann::json StartupCalibrationReport::ToJson() const {
   return {{"converged", converged},
           {"status", status},
           {"shots", shots},
+          {"first_shots", first_shots},
+          {"more_shots_reason", more_shots_reason},
           {"ring",
            {{"converged", ring.converged},
             {"reason", ring.reason},
@@ -233,17 +237,14 @@ nlohmann::json StartupCalibrationReport::ToJson() const {
           {"cam_from_rig", extrinsics}};
 }
 
-StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Rigid3>& cam_from_rig,
-                                            const std::function<LoadedFrame(int)>& load, int first_frame, int end_frame,
-                                            const std::vector<cv::Mat>& static_masks,
-                                            const StartupCalibrationOptions& options, bool quiet) {
-  options.Check();
-  const ScopedOpenCvThreads serial_opencv;  // another run's front-end may be in the same process
-  StartupCalibrationReport report;
-  report.cam_from_rig = cam_from_rig;
-  std::vector<std::vector<cv::Mat>> shots;
-  for (int k = 0; k < std::max(1, options.shots); ++k) {
-    const int frame = first_frame + k * std::max(1, options.shot_spacing);
+namespace {
+
+// Loads shots k_begin .. k_end - 1 (frame first_frame + k * spacing, below end_frame) into `shots`
+// and their frames into `frames`, skipping a frame without every camera's image.
+void LoadShots(const std::function<LoadedFrame(int)>& load, int first_frame, int end_frame, int spacing, int k_begin,
+               int k_end, bool quiet, std::vector<std::vector<cv::Mat>>* shots, std::vector<int>* frames) {
+  for (int k = k_begin; k < k_end; ++k) {
+    const int frame = first_frame + k * std::max(1, spacing);
     if (frame >= end_frame) break;
     LoadedFrame loaded = load(frame);
     if (!loaded.missing_cameras.empty()) {
@@ -251,13 +252,31 @@ StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Ri
         std::fprintf(stderr, "vo online: start-up calibration skips frame %d: %s\n", frame, loaded.problems.c_str());
       continue;
     }
-    shots.push_back(std::move(loaded.images));
-    report.shots.push_back(frame);
+    shots->push_back(std::move(loaded.images));
+    frames->push_back(frame);
   }
-  if (report.shots.empty()) {
-    report.status = "no shot with every camera's image";
-    return report;
+}
+
+// Why a ring stage's result asks for more shots (StartupCalibrationOptions::min_pair_inliers), or "".
+std::string PoorOverlaps(const RingCalibrationReport& ring, int min_pair_inliers) {
+  if (!ring.converged) return "the ring stage failed (" + ring.reason + ")";
+  const RingPairEstimate* weakest = nullptr;
+  for (const RingPairEstimate& p : ring.pairs) {
+    if (weakest == nullptr || p.inliers < weakest->inliers) weakest = &p;
   }
+  if (weakest == nullptr || weakest->inliers >= min_pair_inliers) return "";
+  return "pair " + std::to_string(weakest->camera_a) + "-" + std::to_string(weakest->camera_b) + " kept " +
+         std::to_string(weakest->inliers) + " inliers (< " + std::to_string(min_pair_inliers) + ")";
+}
+
+// The ring stage on `shots` (frames `frames`), written into a fresh report.
+StartupCalibrationReport RingStageReport(const Rig& rig, const std::vector<Rigid3>& cam_from_rig,
+                                         const std::vector<std::vector<cv::Mat>>& shots, std::vector<int> frames,
+                                         const std::vector<cv::Mat>& static_masks,
+                                         const StartupCalibrationOptions& options, bool quiet) {
+  StartupCalibrationReport report;
+  report.cam_from_rig = cam_from_rig;
+  report.shots = std::move(frames);
   report.ring = RunRingStage(rig, cam_from_rig, shots, static_masks, options, quiet, &report);
   if (!report.ring.converged) {
     report.status = "ring stage failed (" + report.ring.reason + "); starting extrinsics kept";
@@ -266,6 +285,41 @@ StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Ri
   report.cam_from_rig = report.ring.cam_from_rig;
   report.converged = true;
   report.status = "converged";
+  return report;
+}
+
+}  // namespace
+
+StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Rigid3>& cam_from_rig,
+                                            const std::function<LoadedFrame(int)>& load, int first_frame, int end_frame,
+                                            const std::vector<cv::Mat>& static_masks,
+                                            const StartupCalibrationOptions& options, bool quiet) {
+  options.Check();
+  const ScopedOpenCvThreads serial_opencv;  // another run's front-end may be in the same process
+  std::vector<std::vector<cv::Mat>> shots;
+  std::vector<int> frames;
+  LoadShots(load, first_frame, end_frame, options.shot_spacing, 0, options.shots, quiet, &shots, &frames);
+  if (frames.empty()) {
+    StartupCalibrationReport report;
+    report.cam_from_rig = cam_from_rig;
+    report.status = "no shot with every camera's image";
+    return report;
+  }
+  StartupCalibrationReport report = RingStageReport(rig, cam_from_rig, shots, frames, static_masks, options, quiet);
+  const std::string poor = PoorOverlaps(report.ring, options.min_pair_inliers);
+  if (poor.empty() || options.max_shots <= options.shots) return report;
+  const size_t first_count = frames.size();
+  LoadShots(load, first_frame, end_frame, options.shot_spacing, options.shots, options.max_shots, quiet, &shots,
+            &frames);
+  if (frames.size() == first_count) return report;  // no frame left for another shot
+  if (!quiet) std::fprintf(stderr, "vo online: start-up: %s; again on %zu shots\n", poor.c_str(), frames.size());
+  StartupCalibrationReport more = RingStageReport(rig, cam_from_rig, shots, frames, static_masks, options, quiet);
+  more.first_shots = report.shots;
+  more.more_shots_reason = poor;
+  if (more.converged || !report.converged) return more;
+  // The first attempt converged and the one on more shots did not: the first result stands.
+  report.more_shots_reason = poor + "; on " + std::to_string(frames.size()) + " shots the ring stage failed (" +
+                             more.ring.reason + "), so the first attempt's result stands";
   return report;
 }
 

@@ -26,6 +26,11 @@ namespace rovo {
 struct StartupCalibrationOptions {
   int shots = 1;          // synchronous shots pooled by the ring stage
   int shot_spacing = 10;  // frames between two shots
+  // More shots where the overlaps are poor: when the ring stage fails, or its weakest pair keeps
+  // fewer than min_pair_inliers inliers, it runs again on up to max_shots shots (the same spacing,
+  // fewer where the frames end) and that result stands if it converges. max_shots <= shots: never.
+  int max_shots = 6;
+  int min_pair_inliers = 300;
   RingCalibrationOptions ring;
   int ring_passes = 2;             // > 1: the ring stage again with views placed by the previous result
   bool refine_second_pass = true;  // KLT sub-pixel matches in the later passes (their views are aligned)
@@ -54,6 +59,10 @@ struct StartupCalibrationReport {
   bool converged = false;
   std::string status;      // "converged", or why not
   std::vector<int> shots;  // frames used by the ring stage
+  // Why the ring stage ran again on more shots (StartupCalibrationOptions::max_shots), or empty;
+  // first_shots: the frames of the first attempt then.
+  std::string more_shots_reason;
+  std::vector<int> first_shots;
   // The ring passes' result (of the rescue when it ran). With placements averaged, cam_from_rig (as
   // cam_j_from_cam0 behind the first placement's camera 0) and angle_scale are their average; pairs,
   // loop error and uncertainty are the first placement's.
@@ -67,7 +76,8 @@ struct StartupCalibrationReport {
 };
 
 // `rig`: lenses and names; `cam_from_rig`: the starting extrinsics. `load(frame)` returns a frame's
-// images; the shots are first_frame, first_frame + shot_spacing, ... below end_frame.
+// images; the shots are first_frame, first_frame + shot_spacing, ... below end_frame (at most
+// `shots` of them, or max_shots when the first attempt's overlaps are poor).
 StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Rigid3>& cam_from_rig,
                                             const std::function<LoadedFrame(int)>& load, int first_frame, int end_frame,
                                             const std::vector<cv::Mat>& static_masks,

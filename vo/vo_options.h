@@ -62,6 +62,10 @@ struct VoStartupOptions {
   bool enabled = true;  // false: the local BA alone (an ablation)
   int shots = 3;        // synchronous shots pooled (StartupCalibrationOptions::shots)
   int spacing = 10;     // frames between two shots
+  // Up to this many shots where the first attempt's overlaps are poor: its weakest ring pair keeps
+  // fewer than min_pair_inliers inliers, or it fails (StartupCalibrationOptions::max_shots).
+  int max_shots = 6;
+  int min_pair_inliers = 300;
   // Every keyframe BA pulls the extrinsics towards a converged result with these sigmas
   // (LocalBaOptions::extrinsic_anchor_deg, extrinsic_anchor_m); 0: not held.
   double anchor_deg = 0.02;
@@ -216,6 +220,16 @@ void VisitStartup(VoStartupOptions& startup, Visitor& visitor) {
   visitor(OptionSpec{"--online-startup-spacing", "online_startup_spacing",
                      "OnlineExt: frames between two shots of --online-startup-shots", 1, 100000},
           startup.spacing);
+  visitor(OptionSpec{"--online-startup-max-shots", "online_startup_max_shots",
+                     "OnlineExt: when the start-up's weakest camera pair keeps fewer than "
+                     "--online-startup-min-inliers inliers, or the start-up fails, it runs again on up to this many "
+                     "shots (same spacing); at most --online-startup-shots: never",
+                     1, 100},
+          startup.max_shots);
+  visitor(OptionSpec{"--online-startup-min-inliers", "online_startup_min_inliers",
+                     "OnlineExt: inliers of the weakest camera pair below which the start-up runs again on more shots",
+                     0, 1000000},
+          startup.min_pair_inliers);
 }
 
 template <typename Visitor>

@@ -94,6 +94,10 @@ void AddCalibrationStudyCommand(CLI::App* study) {
   cmd->add_option("--shot-spacing", options->shot_spacing, "Frames between two shots of --startup-shots")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
+  cmd->add_option("--max-shots", options->max_shots,
+                  "Shots where the first attempt's overlaps are poor (rovo vo --online-startup-max-shots); default: "
+                  "--startup-shots with --shot-only (none added), else rovo vo's default")
+      ->check(CLI::Range(1, 100));
   cmd->add_option("--bound", options->bound_deg,
                   "A draw converged when its error ends below this (degrees; default 0.5 with --shot-only, else 0.1)")
       ->check(CLI::PositiveNumber);

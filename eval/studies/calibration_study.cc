@@ -36,13 +36,16 @@ std::string RunDir(const CalibrationStudyOptions& o, uint64_t seed) {
 }
 
 // Whether the run folder holds a finished OnlineExt run of this draw with these settings.
-bool RunReusable(const std::string& dir, uint64_t seed, int frame_end, int startup_shots, int spacing) {
+bool RunReusable(const std::string& dir, uint64_t seed, int frame_end, const CalibrationStudyOptions& o) {
   std::error_code ec;
   if (!fs::exists(RunInfoPath(dir), ec) || !fs::exists(RunExtrinsicsPath(dir), ec)) return false;
   try {
     const nlohmann::json j = nlohmann::json::parse(ReadFile(RunInfoPath(dir)));
     return j.value("draw_seed", int64_t{-1}) == static_cast<int64_t>(seed) && j.at("frames")[1] == frame_end &&
-           j.value("online_startup_shots", -1) == startup_shots && j.value("online_startup_spacing", -1) == spacing &&
+           j.value("online_startup_shots", -1) == o.startup_shots &&
+           j.value("online_startup_spacing", -1) == o.shot_spacing &&
+           j.value("online_startup_max_shots", -1) == o.max_shots &&
+           j.value("online_startup_min_inliers", -1) == VoOptions{}.startup.min_pair_inliers &&
            j.value("online_anchor_deg", -1.0) == VoOptions{}.startup.anchor_deg &&
            j.value("online_anchor_mm", -1.0) == VoOptions{}.startup.anchor_mm &&
            j.value("version", "") == ROVO_VERSION && j.contains("startup_calibration");
@@ -75,9 +78,11 @@ CalibrationDraw RunDraw(const CalibrationStudyOptions& o, const DatasetInfo& inf
     StartupCalibrationOptions sopt;
     sopt.shots = o.startup_shots;
     sopt.shot_spacing = o.shot_spacing;
+    sopt.max_shots = o.max_shots;
     auto load = [&](int frame) { return LoadFrameImages(o.dataset_dir, info.rig, frame); };
+    const int end = std::min(info.frame_count, o.shot + (std::max(o.startup_shots, o.max_shots) - 1) * o.shot_spacing + 1);
     const StartupCalibrationReport r =
-        CalibrateAtStartup(info.rig, drawn, load, o.shot, o.shot + (o.startup_shots - 1) * o.shot_spacing + 1,
+        CalibrateAtStartup(info.rig, drawn, load, o.shot, end,
                            LoadStaticMasks(o.dataset_dir, info.rig, info.has_static_masks), sopt, true);
     d.startup_cam_from_rig = r.cam_from_rig;
     d.startup_deg = ExtrinsicErrorDeg(r.cam_from_rig, truth);
@@ -90,7 +95,7 @@ CalibrationDraw RunDraw(const CalibrationStudyOptions& o, const DatasetInfo& inf
   }
   const int frame_end = o.frames > 0 ? std::min(o.frames, info.frame_count) : info.frame_count;
   const std::string dir = RunDir(o, seed);
-  if (!RunReusable(dir, seed, frame_end, o.startup_shots, o.shot_spacing)) {
+  if (!RunReusable(dir, seed, frame_end, o)) {
     VoOptions v;
     v.io.dataset_dir = o.dataset_dir;
     v.io.out_dir = dir;
@@ -101,6 +106,7 @@ CalibrationDraw RunDraw(const CalibrationStudyOptions& o, const DatasetInfo& inf
     v.io.threads = o.threads;
     v.startup.shots = o.startup_shots;
     v.startup.spacing = o.shot_spacing;
+    v.startup.max_shots = o.max_shots;
     v.io.quiet = true;
     RunVo(v);
   }
@@ -153,6 +159,7 @@ std::string ReproduceCommand(const CalibrationStudyOptions& o) {
   if (o.shot_only) {
     s << "rovo study calibration " << o.dataset_dir << " --shot-only --shot " << o.shot;
     if (o.startup_shots != 1) s << " --startup-shots " << o.startup_shots << " --shot-spacing " << o.shot_spacing;
+    if (o.max_shots != o.startup_shots) s << " --max-shots " << o.max_shots;
     s << " --draws 1 --seed {seed} --out study_{seed}";
   } else {
     s << "rovo vo " << o.dataset_dir << " --extrinsics online --draw-seed {seed} --draw-sigma " << o.sigma_deg;
@@ -160,6 +167,7 @@ std::string ReproduceCommand(const CalibrationStudyOptions& o) {
     if (o.startup_shots != VoOptions{}.startup.shots || o.shot_spacing != VoOptions{}.startup.spacing) {
       s << " --online-startup-shots " << o.startup_shots << " --online-startup-spacing " << o.shot_spacing;
     }
+    if (o.max_shots != VoOptions{}.startup.max_shots) s << " --online-startup-max-shots " << o.max_shots;
     s << " --out run_{seed}";
   }
   return s.str();
@@ -226,6 +234,7 @@ void WriteOutputs(const CalibrationStudyOptions& o, const DatasetInfo& info, con
       {"shot", o.shot},
       {"startup_shots", o.startup_shots},
       {"shot_spacing", o.shot_spacing},
+      {"max_shots", o.max_shots},
       {"startup_converged", result.startup_converged},
       {"startup_agreement_deg", result.startup_agreement_deg},
       {"converged_below_deg", bound},
@@ -303,6 +312,7 @@ double ExtrinsicTranslationErrorM(const std::vector<Rigid3>& est, const std::vec
 CalibrationStudyResult RunCalibrationStudy(const CalibrationStudyOptions& options) {
   CalibrationStudyOptions o = options;
   if (o.startup_shots == 0) o.startup_shots = o.shot_only ? 1 : VoOptions{}.startup.shots;
+  if (o.max_shots == 0) o.max_shots = o.shot_only ? o.startup_shots : VoOptions{}.startup.max_shots;
   if (o.draws < 1) throw std::invalid_argument("study calibration: --draws must be at least 1");
   if (!(o.sigma_deg >= 0.0)) throw std::invalid_argument("study calibration: --sigma must be non-negative");
   const DatasetInfo info = ReadDatasetInfo(o.dataset_dir);

@@ -31,6 +31,9 @@ struct CalibrationStudyOptions {
   int startup_shots = 0;       // shots pooled by the start-up calibration; 0: 1 with shot_only, else
                                // VoOptions::online_startup_shots' default
   int shot_spacing = 10;       // VoOptions::online_startup_spacing (frames between two shots)
+  int max_shots = 0;           // shots where the first attempt's overlaps are poor
+                               // (VoOptions::online_startup_max_shots); 0: startup_shots with
+                               // shot_only (none added), else rovo vo's default
   int threads = 0;
   double converged_deg = 0.1;       // the run's final error below: converged
   double shot_converged_deg = 0.5;  // shot_only: the start-up error below: converged

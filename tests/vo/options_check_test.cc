@@ -56,6 +56,9 @@ TEST(OptionsCheck, InvalidFieldIsNamed) {
   StartupCalibrationOptions startup;
   startup.shots = 0;
   EXPECT_NE(CheckMessage([&] { startup.Check(); }).find("shots"), std::string::npos);
+  startup = StartupCalibrationOptions{};
+  startup.min_pair_inliers = -1;
+  EXPECT_NE(CheckMessage([&] { startup.Check(); }).find("min_pair_inliers"), std::string::npos);
   RansacLoopOptions loop;
   loop.confidence = 0.0;
   EXPECT_NE(CheckMessage([&] { loop.Check(); }).find("confidence"), std::string::npos);

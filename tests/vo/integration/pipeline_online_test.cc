@@ -92,6 +92,25 @@ TEST(PipelineIntegration, OnlineCalibrationIsDeterministicAndConverges) {
           << "camera " << j << " at frame " << frame << " (started " << worst << " deg off at worst)";
     }
   }
+
+  // Poor overlaps ask for more shots: with one shot and an inlier floor no pair reaches, the start-up
+  // runs again on every shot the frames allow (--online-startup-max-shots) and says why; at the
+  // default floor this scene's overlaps are rich, so the default run above kept its three shots.
+  const std::string more = (root / "more_shots").string();
+  ASSERT_EQ(RunCommand(std::string(ROVO_BINARY) + " vo " + dataset + " --extrinsics online --noise-set " +
+                       std::to_string(noise_set) +
+                       " --frames 0:5 --online-startup-shots 1 --online-startup-spacing 2 --online-startup-max-shots 3"
+                       " --online-startup-min-inliers 1000000 --threads 2 --quiet --out " +
+                       more),
+            0);
+  const nlohmann::json more_startup = ReadRun(more).info.at("startup_calibration");
+  EXPECT_EQ(more_startup.at("first_shots"), nlohmann::json({0}));
+  EXPECT_EQ(more_startup.at("shots"), nlohmann::json({0, 2, 4}));
+  EXPECT_NE(more_startup.at("more_shots_reason").get<std::string>().find("(< 1000000)"), std::string::npos);
+  EXPECT_TRUE(more_startup.at("converged").get<bool>());
+  const nlohmann::json default_startup = run.info.at("startup_calibration");
+  EXPECT_EQ(default_startup.at("shots"), nlohmann::json({0, 10, 20}));
+  EXPECT_EQ(default_startup.at("more_shots_reason"), "");
   fs::remove_all(root);
 }
 
