@@ -19,11 +19,11 @@ namespace {
 // A stored texel as linear (r, g, b, 0): each 10-bit code c masked in place, scaled to c / 1023 (the
 // powers of two of the places are exact) and squared.
 inline __m128 DecodeTexel(uint32_t texel) {
-  const __m128i in_place = _mm_and_si128(_mm_set1_epi32(static_cast<int>(texel)),
-                                         _mm_setr_epi32(0x3ff, 0x3ff << 10, 0x3ff << 20, 0));
+  const __m128i in_place =
+      _mm_and_si128(_mm_set1_epi32(static_cast<int>(texel)), _mm_setr_epi32(0x3ff, 0x3ff << 10, 0x3ff << 20, 0));
   constexpr float kCode = 1.0f / 1023.0f;
-  const __m128 s = _mm_mul_ps(_mm_cvtepi32_ps(in_place),
-                              _mm_setr_ps(kCode, kCode / 1024.0f, kCode / (1024.0f * 1024.0f), 0.0f));
+  const __m128 s =
+      _mm_mul_ps(_mm_cvtepi32_ps(in_place), _mm_setr_ps(kCode, kCode / 1024.0f, kCode / (1024.0f * 1024.0f), 0.0f));
   return _mm_mul_ps(s, s);
 }
 

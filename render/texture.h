@@ -15,9 +15,8 @@
 // v = 0 is the top row of the image file.
 
 #include <emmintrin.h>
-#include <xmmintrin.h>
-
 #include <tbb/cache_aligned_allocator.h>
+#include <xmmintrin.h>
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -63,7 +62,7 @@ class MipTexture {
     float fwidth = 0.0f, fheight = 0.0f;
     int32_t width = 0;
     int32_t height = 0;
-    int32_t blocks_x = 0;          // ceil(width / 4)
+    int32_t blocks_x = 0;  // ceil(width / 4)
     // r | g << 10 | b << 20, each round(1023 sqrt(linear)), in 4x4-texel blocks (cache-line aligned).
     std::vector<uint32_t, tbb::cache_aligned_allocator<uint32_t>> texels;
     // Texel (x, y) lives at Index(x, y): blocks row-major, texels row-major inside a block.

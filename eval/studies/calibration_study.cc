@@ -80,7 +80,8 @@ CalibrationDraw RunDraw(const CalibrationStudyOptions& o, const DatasetInfo& inf
     sopt.shot_spacing = o.shot_spacing;
     sopt.max_shots = o.max_shots;
     auto load = [&](int frame) { return LoadFrameImages(o.dataset_dir, info.rig, frame); };
-    const int end = std::min(info.frame_count, o.shot + (std::max(o.startup_shots, o.max_shots) - 1) * o.shot_spacing + 1);
+    const int end =
+        std::min(info.frame_count, o.shot + (std::max(o.startup_shots, o.max_shots) - 1) * o.shot_spacing + 1);
     const StartupCalibrationReport r =
         CalibrateAtStartup(info.rig, drawn, load, o.shot, end,
                            LoadStaticMasks(o.dataset_dir, info.rig, info.has_static_masks), sopt, true);
