@@ -139,6 +139,17 @@ ImageStatistics ComputeImageStatistics(const cv::Mat& image, const ImageStatisti
   ImageStatistics stats;
   SpectrumStatistics(gray, options.crop, &stats);
   stats.noise_sigma = ImmerkaerSigma(gray, options.circle_fraction * short_side);
+  stats.noise_sigma_per_channel = stats.noise_sigma;
+  if (image.channels() >= 3) {
+    std::vector<cv::Mat> planes;
+    cv::split(image, planes);
+    stats.noise_sigma_per_channel = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      cv::Mat plane;
+      planes[c].convertTo(plane, CV_32F);
+      stats.noise_sigma_per_channel += ImmerkaerSigma(plane, options.circle_fraction * short_side) / 3.0;
+    }
+  }
   stats.rim_over_centre = RimOverCentre(gray, options.ring_inner * short_side, options.ring_outer * short_side,
                                         options.centre_fraction * short_side);
   return stats;
@@ -180,12 +191,13 @@ std::vector<std::string> ListImageFiles(const std::string& path) {
 
 std::string ImageStatisticsTable(const std::vector<std::string>& paths, const std::vector<ImageStatistics>& stats) {
   std::ostringstream out;
-  out << "| image | share of spectral power above 1/4 Nyquist | spectrum slope | noise sigma (8-bit) | rim / centre "
-         "brightness |\n|---|---|---|---|---|\n";
+  out << "| image | share of spectral power above 1/4 Nyquist | spectrum slope | noise sigma (8-bit) | noise sigma "
+         "per channel | rim / centre brightness |\n|---|---|---|---|---|---|\n";
   char line[256];
   auto row = [&](const std::string& name, const ImageStatistics& s) {
-    std::snprintf(line, sizeof(line), "| %s | %.1f %% | %.2f | %.2f | %.2f |\n", name.c_str(),
-                  100.0 * s.high_frequency_share, s.spectrum_slope, s.noise_sigma, s.rim_over_centre);
+    std::snprintf(line, sizeof(line), "| %s | %.1f %% | %.2f | %.2f | %.2f | %.2f |\n", name.c_str(),
+                  100.0 * s.high_frequency_share, s.spectrum_slope, s.noise_sigma, s.noise_sigma_per_channel,
+                  s.rim_over_centre);
     out << line;
   };
   for (size_t i = 0; i < stats.size(); ++i) row(paths[i], stats[i]);
@@ -195,14 +207,17 @@ std::string ImageStatisticsTable(const std::vector<std::string>& paths, const st
     mean.high_frequency_share += s.high_frequency_share / stats.size();
     mean.spectrum_slope += s.spectrum_slope / stats.size();
     mean.noise_sigma += s.noise_sigma / stats.size();
+    mean.noise_sigma_per_channel += s.noise_sigma_per_channel / stats.size();
     mean.rim_over_centre += s.rim_over_centre / stats.size();
     lo.high_frequency_share = std::min(lo.high_frequency_share, s.high_frequency_share);
     lo.spectrum_slope = std::min(lo.spectrum_slope, s.spectrum_slope);
     lo.noise_sigma = std::min(lo.noise_sigma, s.noise_sigma);
+    lo.noise_sigma_per_channel = std::min(lo.noise_sigma_per_channel, s.noise_sigma_per_channel);
     lo.rim_over_centre = std::min(lo.rim_over_centre, s.rim_over_centre);
     hi.high_frequency_share = std::max(hi.high_frequency_share, s.high_frequency_share);
     hi.spectrum_slope = std::max(hi.spectrum_slope, s.spectrum_slope);
     hi.noise_sigma = std::max(hi.noise_sigma, s.noise_sigma);
+    hi.noise_sigma_per_channel = std::max(hi.noise_sigma_per_channel, s.noise_sigma_per_channel);
     hi.rim_over_centre = std::max(hi.rim_over_centre, s.rim_over_centre);
   }
   row("**mean** (" + std::to_string(stats.size()) + " images)", mean);

@@ -11,6 +11,9 @@
 //   noise sigma           Immerkaer's estimator (Fast noise variance estimation, CVIU 64(2), 1996):
 //                         sqrt(pi/2) / 6 * mean |I * N|, N = [1 -2 1; -2 4 -2; 1 -2 1], over the pixels
 //                         within circle_fraction * s of c (8-bit units)
+//   noise per channel     the same estimator on each colour channel, averaged: the noise of one
+//                         photosite, which is what a monochrome camera's pixel holds (the luminance of
+//                         three independent channels averages their noise down); = noise sigma for gray
 //   rim / centre          mean brightness of the ring ring_inner..ring_outer * s from c over the mean of
 //                         the disc within centre_fraction * s
 //
@@ -36,7 +39,8 @@ struct ImageStatisticsOptions {
 struct ImageStatistics {
   double high_frequency_share = 0.0;  // in [0, 1]
   double spectrum_slope = 0.0;
-  double noise_sigma = 0.0;  // 8-bit units
+  double noise_sigma = 0.0;              // 8-bit units, of the luminance
+  double noise_sigma_per_channel = 0.0;  // 8-bit units, mean over the colour channels
   double rim_over_centre = 0.0;
 };
 

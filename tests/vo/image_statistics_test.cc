@@ -29,7 +29,20 @@ TEST(ImageStatisticsTest, WhiteNoiseHasAFlatSpectrumAndItsSigma) {
   EXPECT_NEAR(s.spectrum_slope, 0.0, 0.08);
   // Rounding to 8 bits adds 1/12 to the variance.
   EXPECT_NEAR(s.noise_sigma, std::sqrt(36.0 + 1.0 / 12.0), 0.15);
+  EXPECT_EQ(s.noise_sigma_per_channel, s.noise_sigma);
   EXPECT_NEAR(s.rim_over_centre, 1.0, 0.01);
+}
+
+// Three independent noise planes: each channel keeps its sigma, the luminance (OpenCV's weights 0.299,
+// 0.587, 0.114) averages it down to sqrt(0.299^2 + 0.587^2 + 0.114^2) = 0.668 of it.
+TEST(ImageStatisticsTest, ColourNoisePerChannelAndOfTheLuminance) {
+  cv::Mat colour;
+  cv::merge(
+      std::vector<cv::Mat>{WhiteNoise(600, 560, 6.0, 1), WhiteNoise(600, 560, 6.0, 2), WhiteNoise(600, 560, 6.0, 3)},
+      colour);
+  const ImageStatistics s = ComputeImageStatistics(colour, ImageStatisticsOptions{});
+  EXPECT_NEAR(s.noise_sigma_per_channel, std::sqrt(36.0 + 1.0 / 12.0), 0.15);
+  EXPECT_NEAR(s.noise_sigma, 0.668 * 6.0, 0.25);
 }
 
 TEST(ImageStatisticsTest, BlurMovesPowerToLowFrequencies) {
