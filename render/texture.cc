@@ -14,21 +14,6 @@ float LinearToSrgb(float linear) {
   return linear <= 0.0031308f ? 12.92f * linear : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
 }
 
-namespace {
-
-// A stored texel as linear (r, g, b, 0): each 10-bit code c masked in place, scaled to c / 1023 (the
-// powers of two of the places are exact) and squared.
-inline __m128 DecodeTexel(uint32_t texel) {
-  const __m128i in_place =
-      _mm_and_si128(_mm_set1_epi32(static_cast<int>(texel)), _mm_setr_epi32(0x3ff, 0x3ff << 10, 0x3ff << 20, 0));
-  constexpr float kCode = 1.0f / 1023.0f;
-  const __m128 s =
-      _mm_mul_ps(_mm_cvtepi32_ps(in_place), _mm_setr_ps(kCode, kCode / 1024.0f, kCode / (1024.0f * 1024.0f), 0.0f));
-  return _mm_mul_ps(s, s);
-}
-
-}  // namespace
-
 MipTexture::MipTexture(const Texture& texture) {
   if (texture.width <= 0 || texture.height <= 0 ||
       texture.rgb.size() != static_cast<size_t>(texture.width) * texture.height * 3) {
@@ -40,9 +25,9 @@ MipTexture::MipTexture(const Texture& texture) {
     throw std::invalid_argument("texture '" + texture.name + "': more than 2^31 texels (lookups use 32-bit indices)");
   float to_linear[256];
   for (int i = 0; i < 256; ++i) to_linear[i] = SrgbToLinear(i / 255.0f);
-  auto pack = [](float r, float g, float b) -> uint32_t {
-    auto q = [](float x) { return static_cast<uint32_t>(std::lround(std::sqrt(std::clamp(x, 0.0f, 1.0f)) * 1023.0f)); };
-    return q(r) | (q(g) << 10) | (q(b) << 20);
+  auto pack = [](float r, float g, float b) -> uint64_t {
+    auto q = [](float x) { return static_cast<uint64_t>(std::lround(std::clamp(x, 0.0f, 1.0f) * 65535.0f)); };
+    return q(r) | (q(g) << 16) | (q(b) << 32);
   };
 
   Level base;
@@ -95,9 +80,9 @@ Eigen::Vector3f MipTexture::Texel(int level, int x, int y) const {
   if (x < 0) x += l.width;
   y %= l.height;
   if (y < 0) y += l.height;
-  alignas(16) float out[4];
-  _mm_store_ps(out, DecodeTexel(l.texels[l.Index(x, y)]));
-  return Eigen::Vector3f(out[0], out[1], out[2]);
+  const uint64_t t = l.texels[l.Index(x, y)];
+  constexpr float kScale = 1.0f / 65535.0f;
+  return Eigen::Vector3f((t & 0xffffu) * kScale, ((t >> 16) & 0xffffu) * kScale, ((t >> 32) & 0xffffu) * kScale);
 }
 
 namespace {
@@ -132,14 +117,18 @@ __m128 MipTexture::SampleWrapped(float u01, float v01, int level) const {
   const int yb = ya + 1 == l.height ? 0 : ya + 1;
   // Index(x, y) = RowOffset(y) + ColumnOffset(x): the two parts never share a bit below 16 and add.
   const size_t col_a = l.ColumnOffset(xa), col_b = l.ColumnOffset(xb);
-  const uint32_t* row_a = l.texels.data() + l.RowOffset(ya);
-  const uint32_t* row_b = l.texels.data() + l.RowOffset(yb);
-  const __m128 t00 = DecodeTexel(row_a[col_a]), t10 = DecodeTexel(row_a[col_b]);
-  const __m128 t01 = DecodeTexel(row_b[col_a]), t11 = DecodeTexel(row_b[col_b]);
+  const uint64_t* row_a = l.texels.data() + l.RowOffset(ya);
+  const uint64_t* row_b = l.texels.data() + l.RowOffset(yb);
+  const __m128i zero = _mm_setzero_si128();
+  auto load = [&](const uint64_t* p) {
+    return _mm_cvtepi32_ps(_mm_unpacklo_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)), zero));
+  };
+  const __m128 t00 = load(row_a + col_a), t10 = load(row_a + col_b);
+  const __m128 t01 = load(row_b + col_a), t11 = load(row_b + col_b);
   const __m128 vax = _mm_set1_ps(ax), vay = _mm_set1_ps(ay);
   const __m128 top = _mm_add_ps(t00, _mm_mul_ps(vax, _mm_sub_ps(t10, t00)));
   const __m128 bottom = _mm_add_ps(t01, _mm_mul_ps(vax, _mm_sub_ps(t11, t01)));
-  return _mm_add_ps(top, _mm_mul_ps(vay, _mm_sub_ps(bottom, top)));
+  return _mm_mul_ps(_mm_add_ps(top, _mm_mul_ps(vay, _mm_sub_ps(bottom, top))), _mm_set1_ps(1.0f / 65535.0f));
 }
 
 __m128 MipTexture::SampleLevel4(float u, float v, int level) const {
@@ -196,7 +185,7 @@ inline __m128i Select(__m128i a, __m128i b, __m128i c) {
 // Where the bilinear lookups of four lanes read: per lane the level's texels, the four texel
 // indices (00, 10, 01, 11) and the weights ax, ay.
 struct MipTexture::Footprint4 {
-  const uint32_t* texels[4];
+  const uint64_t* texels[4];
   alignas(16) uint32_t index[4][4];  // [corner][lane]
   alignas(16) float ax[4], ay[4];
 };
@@ -242,9 +231,9 @@ __attribute__((always_inline)) inline void MipTexture::Address4(const Level* con
 
 namespace {
 
-// Requests the cache lines of a footprint's texels 00 and 11 (a 4x4 block is one line: the two cover
-// the 2x2 neighbourhood unless it straddles blocks both ways).
-inline void Prefetch(const uint32_t* texels, const uint32_t* const index[4], int lane) {
+// Requests the cache lines of a footprint's texels 00 and 11 (a 4x4 block is two lines, texel rows
+// 0-1 and 2-3: the two cover the 2x2 neighbourhood unless it straddles blocks both ways).
+inline void Prefetch(const uint64_t* texels, const uint32_t* const index[4], int lane) {
   _mm_prefetch(reinterpret_cast<const char*>(texels + index[0][lane]), _MM_HINT_T0);
   _mm_prefetch(reinterpret_cast<const char*>(texels + index[3][lane]), _MM_HINT_T0);
 }
@@ -252,13 +241,17 @@ inline void Prefetch(const uint32_t* texels, const uint32_t* const index[4], int
 }  // namespace
 
 __attribute__((always_inline)) inline __m128 MipTexture::Filter(const Footprint4& fp, int lane) {
-  const uint32_t* texels = fp.texels[lane];
-  auto load = [&](int corner) { return DecodeTexel(texels[fp.index[corner][lane]]); };
+  const uint64_t* texels = fp.texels[lane];
+  const __m128i zero = _mm_setzero_si128();
+  auto load = [&](int corner) {
+    return _mm_cvtepi32_ps(
+        _mm_unpacklo_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(texels + fp.index[corner][lane])), zero));
+  };
   const __m128 t00 = load(0), t10 = load(1), t01 = load(2), t11 = load(3);
   const __m128 vax = _mm_set1_ps(fp.ax[lane]), vay = _mm_set1_ps(fp.ay[lane]);
   const __m128 top = _mm_add_ps(t00, _mm_mul_ps(vax, _mm_sub_ps(t10, t00)));
   const __m128 bottom = _mm_add_ps(t01, _mm_mul_ps(vax, _mm_sub_ps(t11, t01)));
-  return _mm_add_ps(top, _mm_mul_ps(vay, _mm_sub_ps(bottom, top)));
+  return _mm_mul_ps(_mm_add_ps(top, _mm_mul_ps(vay, _mm_sub_ps(bottom, top))), _mm_set1_ps(1.0f / 65535.0f));
 }
 
 namespace {

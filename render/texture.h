@@ -3,11 +3,10 @@
 //
 // The 8-bit sRGB texels of a scenes/ Texture are decoded to linear float RGB and reduced into a
 // box-filtered pyramid in float (level k+1 texel = mean of the 2x2 level-k texels; odd sizes clamp
-// the last row/column). Every level is stored as 32-bit texels of three 10-bit codes c = round(1023
-// sqrt(linear)) (a gamma-2 encoding: a step is at most 0.36 of an 8-bit sRGB code, and level 0 keeps
-// the file's values within 0.16 codes), in 4x4-texel blocks of one 64-byte cache line each, so
-// a bilinear 2x2 usually falls inside one line; a lookup decodes four texels to linear in SSE
-// registers (mask, convert, square) and blends them. Lookups are bilinear within a level and
+// the last row/column). Every level is stored as 16-bit linear RGBA (8 bytes per texel, 1/65535
+// steps: finer than 8-bit sRGB everywhere) in 4x4-texel blocks, so a bilinear 2x2 usually falls
+// inside one block; lookups are four 8-byte loads widened and blended in SSE registers (half the
+// memory of float texels, no per-lookup table decode). Lookups are bilinear within a level and
 // linear between the two levels around a fractional level of detail (trilinear filtering):
 //   lod = log2(footprint_in_texels),  footprint_in_texels = footprint_m * texels_per_m,
 // where the caller estimates footprint_m from the ray cone (distance * pixel angle / cos) and
@@ -15,7 +14,6 @@
 // v = 0 is the top row of the image file.
 
 #include <emmintrin.h>
-#include <tbb/cache_aligned_allocator.h>
 #include <xmmintrin.h>
 
 #include <Eigen/Core>
@@ -62,9 +60,8 @@ class MipTexture {
     float fwidth = 0.0f, fheight = 0.0f;
     int32_t width = 0;
     int32_t height = 0;
-    int32_t blocks_x = 0;  // ceil(width / 4)
-    // r | g << 10 | b << 20, each round(1023 sqrt(linear)), in 4x4-texel blocks (cache-line aligned).
-    std::vector<uint32_t, tbb::cache_aligned_allocator<uint32_t>> texels;
+    int32_t blocks_x = 0;          // ceil(width / 4)
+    std::vector<uint64_t> texels;  // linear r, g, b, 0 as uint16 (x 1/65535), in 4x4-texel blocks
     // Texel (x, y) lives at Index(x, y): blocks row-major, texels row-major inside a block.
     size_t Index(int x, int y) const { return RowOffset(y) + ColumnOffset(x); }
     size_t RowOffset(int y) const {
@@ -75,7 +72,7 @@ class MipTexture {
       width = w;
       height = h;
       blocks_x = (w + 3) / 4;
-      texels.assign(static_cast<size_t>(blocks_x) * ((h + 3) / 4) * 16, 0u);
+      texels.assign(static_cast<size_t>(blocks_x) * ((h + 3) / 4) * 16, 0ull);
     }
   };
   // Bilinear lookups in four levels (one per lane) at coordinates already wrapped into [0, 1):
