@@ -311,7 +311,10 @@ StartupCalibrationReport CalibrateAtStartup(const Rig& rig, const std::vector<Ri
   const size_t first_count = frames.size();
   LoadShots(load, first_frame, end_frame, options.shot_spacing, options.shots, options.max_shots, quiet, &shots,
             &frames);
-  if (frames.size() == first_count) return report;  // no frame left for another shot
+  if (frames.size() == first_count) {
+    report.more_shots_reason = poor + "; no frame left for another shot";
+    return report;
+  }
   if (!quiet) std::fprintf(stderr, "vo online: start-up: %s; again on %zu shots\n", poor.c_str(), frames.size());
   StartupCalibrationReport more = RingStageReport(rig, cam_from_rig, shots, frames, static_masks, options, quiet);
   more.first_shots = report.shots;

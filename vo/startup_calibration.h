@@ -59,8 +59,9 @@ struct StartupCalibrationReport {
   bool converged = false;
   std::string status;      // "converged", or why not
   std::vector<int> shots;  // frames used by the ring stage
-  // Why the ring stage ran again on more shots (StartupCalibrationOptions::max_shots), or empty;
-  // first_shots: the frames of the first attempt then.
+  // Why the ring stage asked for more shots (StartupCalibrationOptions::max_shots; also when no frame
+  // was left for one, or the attempt on them failed), or empty; first_shots: the frames of the first
+  // attempt when the result is the second's.
   std::string more_shots_reason;
   std::vector<int> first_shots;
   // The ring passes' result (of the rescue when it ran). With placements averaged, cam_from_rig (as

@@ -223,7 +223,7 @@ void VisitStartup(VoStartupOptions& startup, Visitor& visitor) {
   visitor(OptionSpec{"--online-startup-max-shots", "online_startup_max_shots",
                      "OnlineExt: when the start-up's weakest camera pair keeps fewer than "
                      "--online-startup-min-inliers inliers, or the start-up fails, it runs again on up to this many "
-                     "shots (same spacing); at most --online-startup-shots: never",
+                     "shots (same spacing); a value of at most --online-startup-shots turns this off",
                      1, 100},
           startup.max_shots);
   visitor(OptionSpec{"--online-startup-min-inliers", "online_startup_min_inliers",

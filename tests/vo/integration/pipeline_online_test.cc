@@ -108,6 +108,18 @@ TEST(PipelineIntegration, OnlineCalibrationIsDeterministicAndConverges) {
   EXPECT_EQ(more_startup.at("shots"), nlohmann::json({0, 2, 4}));
   EXPECT_NE(more_startup.at("more_shots_reason").get<std::string>().find("(< 1000000)"), std::string::npos);
   EXPECT_TRUE(more_startup.at("converged").get<bool>());
+  // Without a frame for another shot the first attempt stands and says so.
+  const std::string last = (root / "no_frame_left").string();
+  ASSERT_EQ(RunCommand(std::string(ROVO_BINARY) + " vo " + dataset + " --extrinsics online --noise-set " +
+                       std::to_string(noise_set) +
+                       " --frames 0:2 --online-startup-shots 1 --online-startup-min-inliers 1000000 --threads 2 "
+                       "--quiet --out " +
+                       last),
+            0);
+  const nlohmann::json last_startup = ReadRun(last).info.at("startup_calibration");
+  EXPECT_EQ(last_startup.at("shots"), nlohmann::json({0}));
+  EXPECT_TRUE(last_startup.at("first_shots").empty());
+  EXPECT_NE(last_startup.at("more_shots_reason").get<std::string>().find("no frame left"), std::string::npos);
   const nlohmann::json default_startup = run.info.at("startup_calibration");
   EXPECT_EQ(default_startup.at("shots"), nlohmann::json({0, 10, 20}));
   EXPECT_EQ(default_startup.at("more_shots_reason"), "");
