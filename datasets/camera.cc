@@ -11,7 +11,6 @@
 namespace rovo {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
 // Unproject rejects ocam pixels whose bearing does not project back within this distance: beyond
 // the FOV edge the forward polynomial may fold back, and the inverse fit is only valid inside.
 constexpr double kOcamRoundTripTolerancePx = 0.1;
@@ -82,24 +81,17 @@ bool ProjectWithJacobian(const std::vector<double>& params, const Eigen::Vector3
   return true;
 }
 
-std::string Fmt(double value) {
-  std::ostringstream out;
-  out.precision(10);
-  out << value;
-  return out.str();
-}
-
 [[noreturn]] void Fail(const std::string& what, const std::string& field, const std::string& message) {
   throw std::invalid_argument(what + ": " + field + ": " + message);
 }
 
 void CheckEquidistant(const Camera& camera, const std::string& what) {
   const double* p = camera.params.data();
-  if (!(p[0] > 0)) Fail(what, "params[0] (fx)", "must be positive, got " + Fmt(p[0]));
-  if (!(p[1] > 0)) Fail(what, "params[1] (fy)", "must be positive, got " + Fmt(p[1]));
+  if (!(p[0] > 0)) Fail(what, "params[0] (fx)", "must be positive, got " + FormatParam(p[0], 10));
+  if (!(p[1] > 0)) Fail(what, "params[1] (fy)", "must be positive, got " + FormatParam(p[1], 10));
   const double half_fov = 0.5 * camera.max_fov_deg * kDegToRad;
   if (!(half_fov < M_PI)) {
-    Fail(what, "max_fov_deg", "equidistant needs a FOV below 360 degrees, got " + Fmt(camera.max_fov_deg));
+    Fail(what, "max_fov_deg", "equidistant needs a FOV below 360 degrees, got " + FormatParam(camera.max_fov_deg, 10));
   }
   // r(theta) must increase over the FOV so that every pixel has one bearing.
   constexpr int kSteps = 2000;
@@ -109,8 +101,8 @@ void CheckEquidistant(const Camera& camera, const std::string& what) {
     const double r = EquidistantModel::Distort(p, theta);
     if (!(r > previous)) {
       Fail(what, "params[4..7] (k1..k4)",
-           "r(theta) is not increasing at theta = " + Fmt(theta / kDegToRad) + " deg, inside the FOV of " +
-               Fmt(camera.max_fov_deg) + " deg");
+           "r(theta) is not increasing at theta = " + FormatParam(theta / kDegToRad, 10) + " deg, inside the FOV of " +
+               FormatParam(camera.max_fov_deg, 10) + " deg");
     }
     previous = r;
   }
@@ -118,38 +110,38 @@ void CheckEquidistant(const Camera& camera, const std::string& what) {
 
 void CheckDoubleSphere(const Camera& camera, const std::string& what) {
   const double* p = camera.params.data();
-  if (!(p[0] > 0)) Fail(what, "params[0] (fx)", "must be positive, got " + Fmt(p[0]));
-  if (!(p[1] > 0)) Fail(what, "params[1] (fy)", "must be positive, got " + Fmt(p[1]));
-  if (!(p[4] >= -1 && p[4] <= 1)) Fail(what, "params[4] (xi)", "must be in [-1, 1], got " + Fmt(p[4]));
-  if (!(p[5] >= 0 && p[5] <= 1)) Fail(what, "params[5] (alpha)", "must be in [0, 1], got " + Fmt(p[5]));
+  if (!(p[0] > 0)) Fail(what, "params[0] (fx)", "must be positive, got " + FormatParam(p[0], 10));
+  if (!(p[1] > 0)) Fail(what, "params[1] (fy)", "must be positive, got " + FormatParam(p[1], 10));
+  if (!(p[4] >= -1 && p[4] <= 1)) Fail(what, "params[4] (xi)", "must be in [-1, 1], got " + FormatParam(p[4], 10));
+  if (!(p[5] >= 0 && p[5] <= 1)) Fail(what, "params[5] (alpha)", "must be in [0, 1], got " + FormatParam(p[5], 10));
   const double max_angle_deg = std::acos(-DoubleSphereModel::ValidW2(p)) / kDegToRad;
   if (!(0.5 * camera.max_fov_deg < max_angle_deg)) {
     Fail(what, "max_fov_deg",
-         Fmt(camera.max_fov_deg) + " deg exceeds the valid set of these double-sphere parameters (" +
-             Fmt(2 * max_angle_deg) + " deg)");
+         FormatParam(camera.max_fov_deg, 10) + " deg exceeds the valid set of these double-sphere parameters (" +
+             FormatParam(2 * max_angle_deg, 10) + " deg)");
   }
 }
 
 void CheckExtendedUnified(const Camera& camera, const std::string& what) {
   const double* p = camera.params.data();
-  if (!(p[0] > 0)) Fail(what, "params[0] (fx)", "must be positive, got " + Fmt(p[0]));
-  if (!(p[1] > 0)) Fail(what, "params[1] (fy)", "must be positive, got " + Fmt(p[1]));
-  if (!(p[4] >= 0 && p[4] <= 1)) Fail(what, "params[4] (alpha)", "must be in [0, 1], got " + Fmt(p[4]));
-  if (!(p[5] > 0)) Fail(what, "params[5] (beta)", "must be positive, got " + Fmt(p[5]));
+  if (!(p[0] > 0)) Fail(what, "params[0] (fx)", "must be positive, got " + FormatParam(p[0], 10));
+  if (!(p[1] > 0)) Fail(what, "params[1] (fy)", "must be positive, got " + FormatParam(p[1], 10));
+  if (!(p[4] >= 0 && p[4] <= 1)) Fail(what, "params[4] (alpha)", "must be in [0, 1], got " + FormatParam(p[4], 10));
+  if (!(p[5] > 0)) Fail(what, "params[5] (beta)", "must be positive, got " + FormatParam(p[5], 10));
   // The FOV edge direction (sin a, 0, cos a) must satisfy cos a > -w sqrt(beta sin^2 a + cos^2 a).
   const double half_fov = 0.5 * camera.max_fov_deg * kDegToRad;
   const double s = std::sin(half_fov), c = std::cos(half_fov);
   if (!(c > -ExtendedUnifiedModel::ValidW(p) * std::sqrt(p[5] * s * s + c * c))) {
     Fail(what, "max_fov_deg",
-         Fmt(camera.max_fov_deg) + " deg exceeds the valid set of these extended-unified parameters");
+         FormatParam(camera.max_fov_deg, 10) + " deg exceeds the valid set of these extended-unified parameters");
   }
 }
 
 void CheckOcam(const Camera& camera, const std::string& what) {
   const double* p = camera.params.data();
-  if (!(p[2] > 0)) Fail(what, "params[2] (c)", "must be positive, got " + Fmt(p[2]));
+  if (!(p[2] > 0)) Fail(what, "params[2] (c)", "must be positive, got " + FormatParam(p[2], 10));
   if (!(std::abs(p[2] - p[3] * p[4]) > 1e-9)) Fail(what, "params[2..4] (c, d, e)", "the affine is singular");
-  if (!(p[5] < 0)) Fail(what, "params[5] (a0)", "must be negative (z forward), got " + Fmt(p[5]));
+  if (!(p[5] < 0)) Fail(what, "params[5] (a0)", "must be negative (z forward), got " + FormatParam(p[5], 10));
   std::string problem;
   if (!OcamForwardMonotonic(camera.params, camera.max_fov_deg, nullptr, &problem)) {
     Fail(what, "params[5..9] (a0..a4)", problem);
@@ -157,12 +149,19 @@ void CheckOcam(const Camera& camera, const std::string& what) {
   const double error_px = OcamInverseMaxErrorPx(camera.params, camera.max_fov_deg);
   if (!(error_px <= kOcamCheckInverseTolerancePx)) {
     Fail(what, "params[10..] (inverse polynomial b)",
-         "disagrees with the forward polynomial by " + Fmt(error_px) + " px over the FOV (more than " +
-             Fmt(kOcamCheckInverseTolerancePx) + " px); refit it with FitOcamInversePolynomial");
+         "disagrees with the forward polynomial by " + FormatParam(error_px, 10) + " px over the FOV (more than " +
+             FormatParam(kOcamCheckInverseTolerancePx, 10) + " px); refit it with FitOcamInversePolynomial");
   }
 }
 
 }  // namespace
+
+std::string FormatParam(double value, int significant_digits) {
+  std::ostringstream out;
+  out.precision(significant_digits);
+  out << value;
+  return out.str();
+}
 
 CameraModelId CameraModelFromName(const std::string& name) {
 #define ROVO_CAMERA_FROM_NAME(enum_id, Model, model_name) \
@@ -240,7 +239,7 @@ void Camera::Check(const std::string& what) const {
   if (width <= 0) Fail(what, "width", "must be positive, got " + std::to_string(width));
   if (height <= 0) Fail(what, "height", "must be positive, got " + std::to_string(height));
   if (!(max_fov_deg > 0 && max_fov_deg <= 360)) {
-    Fail(what, "max_fov_deg", "must be in (0, 360], got " + Fmt(max_fov_deg));
+    Fail(what, "max_fov_deg", "must be in (0, 360], got " + FormatParam(max_fov_deg, 10));
   }
   for (size_t i = 0; i < params.size(); ++i) {
     if (!std::isfinite(params[i])) Fail(what, "params[" + std::to_string(i) + "]", "is not finite");

@@ -14,6 +14,8 @@ enum class CameraModelId { kEquidistant = 0, kDoubleSphere = 1, kOcam = 2, kExte
 // "equidistant", "double_sphere", "ocam", "extended_unified". Throws std::invalid_argument for an unknown name.
 CameraModelId CameraModelFromName(const std::string& name);
 std::string CameraModelName(CameraModelId id);
+// `value` with `significant_digits` digits, for the messages that name a bad parameter.
+std::string FormatParam(double value, int significant_digits);
 
 struct Camera {
   CameraModelId model = CameraModelId::kEquidistant;

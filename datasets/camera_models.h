@@ -20,6 +20,9 @@
 
 namespace rovo {
 
+// Degrees at the interfaces, radians inside.
+inline constexpr double kDegToRad = M_PI / 180.0;
+
 // The X-macro list of models: (enum id, struct, name on disk).
 #define ROVO_CAMERA_MODELS(X)                          \
   X(kEquidistant, EquidistantModel, "equidistant")     \

@@ -12,19 +12,11 @@
 namespace rovo {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
 constexpr double kAxisElevation = -M_PI / 2;  // theta on the optical axis
 constexpr double kMarchStepPx = 0.25;         // resolution of the monotonicity scan
 constexpr double kMaxSensorRadiusPx = 1e5;    // give up beyond this radius
 constexpr int kErrorGridSize = 4001;          // theta samples for the error measure
 constexpr int kFitSamples = 1200;             // Chebyshev-Lobatto nodes for the least squares
-
-std::string Fmt(double value) {
-  std::ostringstream out;
-  out.precision(8);
-  out << value;
-  return out.str();
-}
 
 // Elevation of the forward ray at sensor radius rho: atan2(f(rho), rho).
 double Elevation(const double* params, double rho) { return std::atan2(OcamModel::ForwardPoly(params, rho), rho); }
@@ -49,12 +41,13 @@ void CheckBasics(const std::vector<double>& params, double max_fov_deg, const ch
     if (!std::isfinite(params[i]))
       throw std::invalid_argument(where + "params[" + std::to_string(i) + "] is not finite");
   }
-  if (!(params[5] < 0)) throw std::invalid_argument(where + "params[5] (a0): must be negative, got " + Fmt(params[5]));
+  if (!(params[5] < 0))
+    throw std::invalid_argument(where + "params[5] (a0): must be negative, got " + FormatParam(params[5], 8));
   if (!(std::abs(params[2] - params[3] * params[4]) > 1e-9)) {
     throw std::invalid_argument(where + "params[2..4] (c, d, e): the affine is singular");
   }
   if (!(max_fov_deg > 0 && max_fov_deg < 360)) {
-    throw std::invalid_argument(where + "max_fov_deg: must be in (0, 360), got " + Fmt(max_fov_deg));
+    throw std::invalid_argument(where + "max_fov_deg: must be in (0, 360), got " + FormatParam(max_fov_deg, 8));
   }
 }
 
@@ -67,9 +60,9 @@ bool MarchToElevation(const double* params, double theta_target, double* rho_out
     const double theta = Elevation(params, rho);
     if (!(theta > previous)) {
       if (problem) {
-        *problem = "the elevation atan2(poly(rho), rho) stops increasing at rho = " + Fmt(rho) + " px (" +
-                   Fmt(previous / kDegToRad + 90) + " deg from the axis), before reaching " +
-                   Fmt(theta_target / kDegToRad + 90) + " deg";
+        *problem = "the elevation atan2(poly(rho), rho) stops increasing at rho = " + FormatParam(rho, 8) + " px (" +
+                   FormatParam(previous / kDegToRad + 90, 8) + " deg from the axis), before reaching " +
+                   FormatParam(theta_target / kDegToRad + 90, 8) + " deg";
       }
       return false;
     }
@@ -84,8 +77,8 @@ bool MarchToElevation(const double* params, double theta_target, double* rho_out
     }
     if (rho > kMaxSensorRadiusPx) {
       if (problem) {
-        *problem = "the elevation does not reach " + Fmt(theta_target / kDegToRad + 90) + " deg from the axis within " +
-                   Fmt(kMaxSensorRadiusPx) + " px";
+        *problem = "the elevation does not reach " + FormatParam(theta_target / kDegToRad + 90, 8) +
+                   " deg from the axis within " + FormatParam(kMaxSensorRadiusPx, 8) + " px";
       }
       return false;
     }
@@ -274,8 +267,9 @@ Camera MakeOcamCamera(int width, int height, double cx, double cy, double c, dou
   const OcamInverseFit fit = FitOcamInversePolynomial(camera.params, max_fov_deg, tolerance_px);
   if (!(fit.max_error_px < tolerance_px)) {
     throw std::invalid_argument("MakeOcamCamera: inverse polynomial: the best fit (degree " +
-                                std::to_string(fit.inverse_poly.size() - 1) + ") is off by " + Fmt(fit.max_error_px) +
-                                " px, more than the tolerance " + Fmt(tolerance_px) + " px");
+                                std::to_string(fit.inverse_poly.size() - 1) + ") is off by " +
+                                FormatParam(fit.max_error_px, 8) + " px, more than the tolerance " +
+                                FormatParam(tolerance_px, 8) + " px");
   }
   camera.params.insert(camera.params.end(), fit.inverse_poly.begin(), fit.inverse_poly.end());
   camera.Check("MakeOcamCamera");

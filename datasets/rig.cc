@@ -5,13 +5,12 @@
 #include <set>
 #include <stdexcept>
 
+#include "datasets/camera_models.h"
 #include "datasets/ocam.h"
 #include "datasets/omnimvs_rig.h"
 
 namespace rovo {
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 // Pixel coordinate under a change of image size by `scale`, with pixel centres at integers:
 // the image edge -0.5 stays at the edge, so u' = (u + 0.5) * scale - 0.5.

@@ -4,17 +4,12 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "eval/format.h"
 #include "eval/suite_summary.h"
 
 namespace rovo {
 
 namespace {
-
-std::string Fmt(double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), "%.4g", value);
-  return buffer;
-}
 
 // The suite's mean of a metric (suite.json /presets/<preset>/modes/<mode>/<metric>, with n > 0 runs),
 // or none when any part is missing or not of the expected type.
@@ -96,8 +91,8 @@ std::string GateTableMarkdown(const std::vector<GateCheck>& checks) {
   std::string md = "| preset | mode | metric | value (mean) | bound | result |\n|---|---|---|---|---|---|\n";
   for (const GateCheck& c : checks) {
     md += "| " + c.preset + (c.system != "rovo" ? " (" + c.system + ")" : "") + " | " + c.mode + " | " + c.metric +
-          " | " + (c.value ? Fmt(*c.value) : "missing") + " | " + (c.is_max ? "<= " : ">= ") + Fmt(c.bound) + " | " +
-          (c.pass ? "pass" : "**FAIL**") + " |\n";
+          " | " + (c.value ? Fmt("%.4g", *c.value) : "missing") + " | " + (c.is_max ? "<= " : ">= ") +
+          Fmt("%.4g", c.bound) + " | " + (c.pass ? "pass" : "**FAIL**") + " |\n";
   }
   return md;
 }

@@ -127,7 +127,7 @@ OpticsSettings MakeOpticsSettings(const std::string& profile, const OpticsOverri
 
 double GaussianSigmaFromMtf50(double mtf50) { return std::sqrt(std::log(2.0) / 2.0) / (M_PI * mtf50); }
 
-double RelativeIllumination(const OpticsSettings& s, double theta, double theta_max) {
+double LensRelativeIllumination(const OpticsSettings& s, double theta, double theta_max) {
   return RelativeIlluminationAt(s.falloff_angle_scale, s.rim_illumination, theta, theta_max);
 }
 
@@ -161,7 +161,7 @@ LensOptics::LensOptics(const OpticsSettings& settings, const Camera& camera,
   for (size_t i = 0; i < n; ++i) {
     if (!valid_[i]) continue;
     const double theta = BearingAngle(bearing[i]);
-    illumination_[i] = static_cast<float>(RelativeIllumination(settings_, theta, theta_max));
+    illumination_[i] = static_cast<float>(LensRelativeIllumination(settings_, theta, theta_max));
     const double sigma = PsfSigma(settings_, mtf50_factor, theta, theta_max);
     sigma_index_[i] = static_cast<uint16_t>(std::clamp(std::lround(sigma * kSigmaSteps), 1L, 65535L));
   }

@@ -71,7 +71,7 @@ OpticsSettings MakeOpticsSettings(const std::string& profile, const OpticsOverri
 // sqrt(ln 2 / 2) / (pi * mtf50): the Gaussian sigma (pixels) whose MTF is 1/2 at mtf50 (cycles/pixel).
 double GaussianSigmaFromMtf50(double mtf50);
 // E(theta) of the header comment.
-double RelativeIllumination(const OpticsSettings& settings, double theta, double theta_max);
+double LensRelativeIllumination(const OpticsSettings& settings, double theta, double theta_max);
 // The PSF sigma (pixels) at theta of a camera with MTF50 factor m_c; 0 without blur.
 double PsfSigma(const OpticsSettings& settings, double mtf50_factor, double theta, double theta_max);
 // m_c = exp(mtf50_spread * z_c), z_c = NormalQuantile of the low 16 bits of

@@ -289,7 +289,7 @@ void ApplyIllumination(const OpticsSettings& optics, const CameraRays& rays, std
     if (!rays.valid[i]) continue;
     const Eigen::Vector3f& b = rays.bearing[i];
     const auto e = static_cast<float>(
-        RelativeIllumination(optics, std::atan2(std::hypot(b.x(), b.y()), static_cast<double>(b.z())), theta_max));
+        LensRelativeIllumination(optics, std::atan2(std::hypot(b.x(), b.y()), static_cast<double>(b.z())), theta_max));
     for (int k = 0; k < 3; ++k) (*linear)[i * 3 + k] *= e;
   }
 }

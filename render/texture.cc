@@ -94,7 +94,7 @@ inline int FloorInt(float x) {
 }
 
 // x - floor(x) in [0, 1) (one repeat of a wrapping texture coordinate); non-finite -> 0.
-inline float Wrap01(float x) {
+inline float WrapFinite01(float x) {
   if (!(std::abs(x) < 1e9f)) return 0.0f;
   const float w = x - static_cast<float>(FloorInt(x));
   return w < 1.0f ? w : 0.0f;
@@ -132,7 +132,7 @@ __m128 MipTexture::SampleWrapped(float u01, float v01, int level) const {
 }
 
 __m128 MipTexture::SampleLevel4(float u, float v, int level) const {
-  return SampleWrapped(Wrap01(u), Wrap01(v), level);
+  return SampleWrapped(WrapFinite01(u), WrapFinite01(v), level);
 }
 
 Eigen::Vector3f MipTexture::SampleLevel(float u, float v, int level) const {
@@ -143,7 +143,7 @@ Eigen::Vector3f MipTexture::SampleLevel(float u, float v, int level) const {
 
 __m128 MipTexture::Sample4(float u, float v, float lod) const {
   const int last = NumLevels() - 1;
-  const float u01 = Wrap01(u), v01 = Wrap01(v);
+  const float u01 = WrapFinite01(u), v01 = WrapFinite01(v);
   if (!(lod > 0.0f)) return SampleWrapped(u01, v01, 0);  // also catches NaN
   if (lod >= static_cast<float>(last)) return SampleWrapped(u01, v01, last);
   const int l0 = static_cast<int>(lod);
@@ -155,7 +155,7 @@ __m128 MipTexture::Sample4(float u, float v, float lod) const {
 
 namespace {
 
-// FloorInt and Wrap01 on four lanes, with the scalar versions' exact arithmetic.
+// FloorInt and WrapFinite01 on four lanes, with the scalar versions' exact arithmetic.
 inline __m128i FloorInt4(__m128 x) {
   const __m128i i = _mm_cvttps_epi32(x);
   return _mm_add_epi32(i, _mm_castps_si128(_mm_cmplt_ps(x, _mm_cvtepi32_ps(i))));

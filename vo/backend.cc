@@ -8,13 +8,12 @@
 #include <stdexcept>
 #include <string>
 
+#include "vo/stopwatch.h"
+
 namespace rovo {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double MsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // Rigid motion scaled along its screw-free approximation: rotation angle and translation times s.
 Rigid3 ScaleMotion(const Rigid3& motion, double s) {

@@ -16,6 +16,7 @@
 #include <unordered_map>
 
 #include "vo/opencv_threads.h"
+#include "vo/stopwatch.h"
 
 namespace rovo {
 
@@ -37,13 +38,6 @@ void FrontendOptions::Check() const {
   matching.Check();
 }
 namespace {
-
-double MsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
-
-// Process CPU time (all threads), milliseconds.
-double CpuMs() { return 1000.0 * static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
 
 cv::Mat ToGray(const cv::Mat& image, int camera) {
   if (image.depth() != CV_8U) {

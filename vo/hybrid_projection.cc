@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "datasets/camera_models.h"
+
 namespace rovo {
 
 void HybridProjectionOptions::Check() const {
@@ -24,8 +26,6 @@ void HybridProjectionOptions::Check() const {
   require(rebuild_threshold_deg >= 0.0, "rebuild_threshold_deg must be >= 0");
 }
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 Eigen::Vector3d CameraCentreInRig(const Rigid3& cam_from_rig) { return cam_from_rig.Inverse().translation; }
 

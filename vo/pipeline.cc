@@ -21,16 +21,13 @@
 #include "rovo/version.h"
 #include "vo/image_loader.h"
 #include "vo/startup_calibration.h"
+#include "vo/stopwatch.h"
 
 namespace rovo {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double CpuMs() { return 1000.0 * static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }  // process, all threads
-double MsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 nlohmann::json PoseJson(const Rigid3& x) {
   return {{"translation", {x.translation.x(), x.translation.y(), x.translation.z()}},

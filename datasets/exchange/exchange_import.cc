@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "datasets/camera_models.h"
 #include "datasets/exchange/exchange.h"
 #include "datasets/exchange/exchange_imu.h"
 #include "datasets/io.h"
@@ -14,8 +15,6 @@
 namespace rovo {
 namespace fs = std::filesystem;
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 // Cameras mav0/cam0, cam1, ... (consecutive from 0).
 std::vector<std::string> CameraFolders(const std::string& in_dir) {

@@ -11,7 +11,6 @@
 namespace rovo {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
 constexpr int kMaxParams = 9;
 constexpr double kAngleStepDeg = 0.5;
 constexpr double kAzimuthStepDeg = 5.0;

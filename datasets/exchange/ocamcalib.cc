@@ -15,13 +15,6 @@
 namespace rovo {
 namespace {
 
-std::string Fmt(double value) {
-  std::ostringstream out;
-  out.precision(8);
-  out << value;
-  return out.str();
-}
-
 // The five data lines of an OCamCalib file (comments and blank lines skipped), with the parse
 // errors of each: "<path>:<line>: <field>: <message>".
 class OcamTxtLines {
@@ -113,7 +106,7 @@ OcamTxtFields ParseOcamTxtFields(const OcamTxtLines& lines) {
     }
   }
   const double c = f.affine[0], d = f.affine[1], e = f.affine[2];
-  if (!(c > 0)) throw lines.Error(3, "c must be positive, got " + Fmt(c));
+  if (!(c > 0)) throw lines.Error(3, "c must be positive, got " + FormatParam(c, 8));
   if (!(std::abs(c - d * e) > 1e-9)) throw lines.Error(3, "the affine [c d; e 1] is singular");
   for (int k = 0; k < 2; ++k) {
     if (!(f.size[k] >= 1 && f.size[k] == std::floor(f.size[k]) && f.size[k] < 1e6)) {
@@ -137,8 +130,8 @@ void AttachInversePolynomial(const OcamTxtLines& lines, const std::vector<double
   if (camera->params.size() == static_cast<size_t>(OcamModel::kNumFixedParams)) {
     const OcamInverseFit fit = FitOcamInversePolynomial(camera->params, max_fov_deg);
     if (!(fit.max_error_px < 0.01)) {
-      throw lines.Error(0, "no inverse polynomial within 0.01 px over " + Fmt(max_fov_deg) + " deg (best " +
-                               Fmt(fit.max_error_px) + " px)");
+      throw lines.Error(0, "no inverse polynomial within 0.01 px over " + FormatParam(max_fov_deg, 8) + " deg (best " +
+                               FormatParam(fit.max_error_px, 8) + " px)");
     }
     camera->params.insert(camera->params.end(), fit.inverse_poly.begin(), fit.inverse_poly.end());
   }

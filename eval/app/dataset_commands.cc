@@ -62,7 +62,7 @@ void PrintImu(const DatasetInfo& info) {
   }
 }
 
-void RunInfo(const std::string& dir) {
+void RunDatasetInfo(const std::string& dir) {
   const DatasetInfo info = ReadDatasetInfo(dir);
   std::printf("dataset    %s\n", dir.c_str());
   std::printf("generator  %s %s (schema %d)\n", info.generator.c_str(), info.generator_version.c_str(),
@@ -129,7 +129,7 @@ void AddDatasetCommands(CommandTree& tree) {
       "Summary of a dataset: generator, seed, preset, frames, duration, path length, rig table, IMU, perturbed "
       "sets");
   info->add_option("dir", *info_dir, "Dataset folder")->required();
-  info->callback([info_dir] { RunInfo(*info_dir); });
+  info->callback([info_dir] { RunDatasetInfo(*info_dir); });
 
   struct RigOptions {
     std::string name, out;

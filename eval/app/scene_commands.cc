@@ -87,7 +87,7 @@ void RunGenerate(const GenerateOptions& o) {
   std::printf("time         %.2f s generate, %.2f s save\n", generate_seconds, save_seconds);
 }
 
-void RunInfo(const std::string& dir) {
+void RunSceneInfo(const std::string& dir) {
   const auto t0 = std::chrono::steady_clock::now();
   const Scene scene = LoadScene(dir);
   const double load_seconds = SecondsSince(t0);
@@ -167,7 +167,7 @@ void AddSceneCommands(CommandTree& tree) {
   CLI::App* info =
       tree.scene->add_subcommand("info", "Load a scene folder and print its size, path, lighting and load time");
   info->add_option("dir", *info_dir, "Scene folder (scenes/FORMAT.md)")->required();
-  info->callback([info_dir] { RunInfo(*info_dir); });
+  info->callback([info_dir] { RunSceneInfo(*info_dir); });
 
   CLI::App* list = tree.scene->add_subcommand(
       "list", "List the scene presets (the paper's Table I sequences, then the harder worlds)");

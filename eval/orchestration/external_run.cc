@@ -111,8 +111,6 @@ void SampleGroupMemory(pid_t group, double* peak_kb) {
   *peak_kb = std::max(*peak_kb, sum_kb);
 }
 
-double Seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); }
-
 // Waits for `pid`, killing its group at the deadline; fills the status and resource use.
 void WaitWithTimeout(pid_t pid, const ChildSpec& spec, Clock::time_point start, ChildResult* result) {
   const auto deadline =

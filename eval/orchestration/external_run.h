@@ -3,11 +3,18 @@
 // and stderr to files, a timeout that kills the whole group, the child's CPU time from wait4 and its
 // memory from /proc.
 
+#include <sys/time.h>
+
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace rovo {
+
+// A struct timeval (getrusage's and wait4's CPU times) in seconds.
+inline double Seconds(const timeval& t) {
+  return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
+}
 
 struct ChildSpec {
   std::vector<std::string> argv;                         // argv[0]: the program's path

@@ -18,6 +18,7 @@
 #include "datasets/progress.h"
 #include "datasets/run.h"
 #include "eval/format.h"
+#include "eval/orchestration/external_run.h"
 #include "eval/orchestration/suite.h"
 #include "eval/orchestration/suite_systems.h"
 #include "eval/plots.h"
@@ -226,8 +227,6 @@ class RunOverlap {
   uint64_t started_before_;
   bool alone_at_start_;
 };
-
-double Seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); }
 
 rusage ProcessUsage() {
   rusage usage{};

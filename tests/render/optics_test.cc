@@ -132,7 +132,7 @@ TEST(OpticsTest, VignettingFollowsTheFallOffLaw) {
     EXPECT_NEAR(flat[(y * kSize + x) * 3] / 2.0, expected, 1e-5) << x << "," << y;
   }
   // The rim over the centre: cos^4(0.3 theta_max) * 0.6 at the edge of the field.
-  EXPECT_NEAR(RelativeIllumination(s, theta_max, theta_max), std::pow(std::cos(0.3 * theta_max), 4) * 0.6, 1e-12);
+  EXPECT_NEAR(LensRelativeIllumination(s, theta_max, theta_max), std::pow(std::cos(0.3 * theta_max), 4) * 0.6, 1e-12);
   EXPECT_LT(flat[(100 * kSize + 199) * 3] / flat[(100 * kSize + 100) * 3], 0.45);
 }
 
