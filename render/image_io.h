@@ -1,7 +1,7 @@
 #pragma once
-// Atomic image writers for the render outputs (OpenImageIO writes a temporary sibling with an
-// explicit format, then it is renamed onto the final name, so a killed process never leaves a
-// partial file under the final name).
+// Atomic image writers for the render outputs (a temporary sibling is written, then renamed onto the
+// final name, so a killed process never leaves a partial file under the final name). PNGs are encoded
+// by render/png_encode.h, EXR by OpenImageIO.
 
 #include <cstdint>
 #include <string>
@@ -9,8 +9,8 @@
 
 namespace rovo {
 
-// 8-bit RGB PNG (zlib level 1: the DESIGN.md measurement shows higher levels cost more than tracing;
-// the "Up" row filter only: half the encoding time of libpng's adaptive filter choice).
+// 8-bit RGB PNG (deflate level 1: higher levels cost more than tracing; the "Up" row filter only:
+// half the encoding time of an adaptive filter choice per row).
 void WritePngRgb8(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
 // 8-bit single-channel PNG (a grayscale sensor's images), same settings as WritePngRgb8.
 void WritePngGray8(const std::string& path, int width, int height, const std::vector<uint8_t>& gray);

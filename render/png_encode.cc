@@ -1,0 +1,99 @@
+#include "render/png_encode.h"
+
+#include <libdeflate.h>
+
+#include <cstring>
+#include <memory>
+#include <stdexcept>
+#include <vector>
+
+namespace rovo {
+namespace {
+
+void PutU32(uint32_t v, std::string* out) {
+  const char bytes[4] = {static_cast<char>(v >> 24), static_cast<char>(v >> 16), static_cast<char>(v >> 8),
+                         static_cast<char>(v)};
+  out->append(bytes, 4);
+}
+
+// One chunk: length, type, data, CRC-32 of type and data.
+void PutChunk(const char type[4], const void* data, size_t size, std::string* out) {
+  PutU32(static_cast<uint32_t>(size), out);
+  const size_t type_at = out->size();
+  out->append(type, 4);
+  if (size > 0) out->append(static_cast<const char*>(data), size);
+  PutU32(static_cast<uint32_t>(libdeflate_crc32(0, out->data() + type_at, size + 4)), out);
+}
+
+// The filtered scanlines: per row the filter byte 2 ("Up": each byte minus the byte above it), then
+// the row's bytes (16-bit samples big-endian).
+std::vector<uint8_t> UpFiltered(int width, int height, int channels, int bit_depth, const void* pixels) {
+  const size_t row_bytes = static_cast<size_t>(width) * channels * (bit_depth / 8);
+  std::vector<uint8_t> big_endian;
+  const uint8_t* bytes = static_cast<const uint8_t*>(pixels);
+  if (bit_depth == 16) {
+    const uint16_t* in = static_cast<const uint16_t*>(pixels);
+    big_endian.resize(static_cast<size_t>(height) * row_bytes);
+    for (size_t i = 0; i < big_endian.size() / 2; ++i) {
+      big_endian[2 * i] = static_cast<uint8_t>(in[i] >> 8);
+      big_endian[2 * i + 1] = static_cast<uint8_t>(in[i]);
+    }
+    bytes = big_endian.data();
+  }
+  std::vector<uint8_t> filtered(static_cast<size_t>(height) * (row_bytes + 1));
+  for (int y = 0; y < height; ++y) {
+    const uint8_t* row = bytes + y * row_bytes;
+    uint8_t* out = filtered.data() + y * (row_bytes + 1);
+    out[0] = 2;
+    if (y == 0) {
+      std::memcpy(out + 1, row, row_bytes);
+      continue;
+    }
+    const uint8_t* above = row - row_bytes;
+    for (size_t x = 0; x < row_bytes; ++x) out[1 + x] = static_cast<uint8_t>(row[x] - above[x]);
+  }
+  return filtered;
+}
+
+struct CompressorDeleter {
+  void operator()(libdeflate_compressor* c) const { libdeflate_free_compressor(c); }
+};
+
+}  // namespace
+
+std::string EncodePng(int width, int height, int channels, int bit_depth, const void* pixels,
+                      const std::string& software) {
+  if (width <= 0 || height <= 0 || !(channels == 1 || channels == 3) ||
+      !(bit_depth == 8 || (bit_depth == 16 && channels == 1))) {
+    throw std::invalid_argument("EncodePng: unsupported layout " + std::to_string(width) + "x" +
+                                std::to_string(height) + ", " + std::to_string(channels) + " channel(s) of " +
+                                std::to_string(bit_depth) + " bits");
+  }
+  const std::vector<uint8_t> filtered = UpFiltered(width, height, channels, bit_depth, pixels);
+  // One compressor per thread: its tables are allocated once.
+  static thread_local std::unique_ptr<libdeflate_compressor, CompressorDeleter> compressor(
+      libdeflate_alloc_compressor(1));
+  if (!compressor) throw std::runtime_error("EncodePng: libdeflate cannot allocate a compressor");
+  std::vector<uint8_t> zlib(libdeflate_zlib_compress_bound(compressor.get(), filtered.size()));
+  const size_t zlib_size =
+      libdeflate_zlib_compress(compressor.get(), filtered.data(), filtered.size(), zlib.data(), zlib.size());
+  if (zlib_size == 0) throw std::runtime_error("EncodePng: libdeflate's output exceeded its own bound");
+
+  std::string png("\x89PNG\r\n\x1a\n", 8);
+  png.reserve(zlib_size + software.size() + 128);
+  uint8_t header[13];
+  const uint32_t size[2] = {static_cast<uint32_t>(width), static_cast<uint32_t>(height)};
+  for (int k = 0; k < 2; ++k)
+    for (int b = 0; b < 4; ++b) header[4 * k + b] = static_cast<uint8_t>(size[k] >> (24 - 8 * b));
+  header[8] = static_cast<uint8_t>(bit_depth);
+  header[9] = channels == 3 ? 2 : 0;  // colour type: truecolour or greyscale
+  header[10] = header[11] = header[12] = 0;  // deflate, adaptive filtering, no interlace
+  PutChunk("IHDR", header, sizeof(header), &png);
+  const std::string text = "Software" + std::string(1, '\0') + software;
+  PutChunk("tEXt", text.data(), text.size(), &png);
+  PutChunk("IDAT", zlib.data(), zlib_size, &png);
+  PutChunk("IEND", nullptr, 0, &png);
+  return png;
+}
+
+}  // namespace rovo
