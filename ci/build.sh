@@ -4,9 +4,10 @@
 # ROVO_BUILD_UNIT_TESTS=OFF leaves the unit tests and fuzz replays out (ci/test.sh runs them in its
 # sanitizer build); every other call builds them again.
 # ROVO_UNITY_BUILD=ON compiles each library's sources in batches of 16 (CMake's unity build): the
-# headers (Eigen, OpenCV, Ceres, CLI11) are parsed once per batch instead of once per source, which
-# halves the build of the `rovo` executable (ci/demo.sh). Off by default: clang-tidy (ci/lint.sh)
-# needs a compile command per source, which a unity build does not write.
+# headers (Eigen, OpenCV, Ceres, CLI11) are parsed, and their shared templates compiled, once per batch
+# instead of once per source, which cuts the clean build of the `rovo` executable (ci/demo.sh) 2.4×
+# (docs/design-notes.md, section CI time). Off by default: clang-tidy (ci/lint.sh) needs a compile
+# command per source, which a unity build does not write.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 launcher=()

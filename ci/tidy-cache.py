@@ -69,7 +69,12 @@ def key(entry, shared):
 
 def keys(build_dir, regex):
     with open(os.path.join(build_dir, "compile_commands.json")) as f:
-        entries = [e for e in json.load(f) if re.match(regex, e["file"])]
+        all_entries = json.load(f)
+    if any("/Unity/" in e["file"] for e in all_entries):
+        # A unity build (ci/demo.sh) has no compile command per source: checking it would pass nothing.
+        sys.exit("tidy-cache: %s is a unity build (ci/demo.sh); run ci/build.sh to configure it one source per "
+                 "compile first" % build_dir)
+    entries = [e for e in all_entries if re.match(regex, e["file"])]
     shared = fixed_inputs()
     with concurrent.futures.ThreadPoolExecutor(max_workers=os.cpu_count() or 2) as pool:
         found = list(pool.map(lambda e: key(e, shared), entries))

@@ -30,18 +30,29 @@ void WriteImage(const std::string& path, const char* format, const OIIO::ImageSp
   CommitTempFile(tmp, path);
 }
 
+// Encodes `pixels` (width x height x channels samples) as PNG and writes it atomically.
+template <typename T>
+void WritePng(const std::string& path, int width, int height, int channels, const std::vector<T>& pixels) {
+  if (width <= 0 || height <= 0 || pixels.size() != static_cast<size_t>(width) * height * channels) {
+    throw std::invalid_argument(path + ": " + std::to_string(pixels.size()) + " samples for a " +
+                                std::to_string(width) + "x" + std::to_string(height) + " image of " +
+                                std::to_string(channels) + " channel(s)");
+  }
+  WriteFileAtomic(path, EncodePng(width, height, channels, 8 * sizeof(T), pixels.data(), "rovo " ROVO_VERSION));
+}
+
 }  // namespace
 
 void WritePngRgb8(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {
-  WriteFileAtomic(path, EncodePng(width, height, 3, 8, rgb.data(), "rovo " ROVO_VERSION));
+  WritePng(path, width, height, 3, rgb);
 }
 
 void WritePngGray8(const std::string& path, int width, int height, const std::vector<uint8_t>& gray) {
-  WriteFileAtomic(path, EncodePng(width, height, 1, 8, gray.data(), "rovo " ROVO_VERSION));
+  WritePng(path, width, height, 1, gray);
 }
 
 void WritePngGray16(const std::string& path, int width, int height, const std::vector<uint16_t>& values) {
-  WriteFileAtomic(path, EncodePng(width, height, 1, 16, values.data(), "rovo " ROVO_VERSION));
+  WritePng(path, width, height, 1, values);
 }
 
 void WriteExrFloat(const std::string& path, int width, int height, const std::vector<float>& values) {

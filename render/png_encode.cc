@@ -78,6 +78,8 @@ std::string EncodePng(int width, int height, int channels, int bit_depth, const 
   const size_t zlib_size =
       libdeflate_zlib_compress(compressor.get(), filtered.data(), filtered.size(), zlib.data(), zlib.size());
   if (zlib_size == 0) throw std::runtime_error("EncodePng: libdeflate's output exceeded its own bound");
+  if (zlib_size > 0x7fffffffu)
+    throw std::length_error("EncodePng: image data over PNG's chunk limit of 2^31 - 1 bytes");
 
   std::string png("\x89PNG\r\n\x1a\n", 8);
   png.reserve(zlib_size + software.size() + 128);
@@ -86,7 +88,7 @@ std::string EncodePng(int width, int height, int channels, int bit_depth, const 
   for (int k = 0; k < 2; ++k)
     for (int b = 0; b < 4; ++b) header[4 * k + b] = static_cast<uint8_t>(size[k] >> (24 - 8 * b));
   header[8] = static_cast<uint8_t>(bit_depth);
-  header[9] = channels == 3 ? 2 : 0;  // colour type: truecolour or greyscale
+  header[9] = channels == 3 ? 2 : 0;         // colour type: truecolour or greyscale
   header[10] = header[11] = header[12] = 0;  // deflate, adaptive filtering, no interlace
   PutChunk("IHDR", header, sizeof(header), &png);
   const std::string text = "Software" + std::string(1, '\0') + software;

@@ -3,7 +3,7 @@
 // vo/png_gray.h): non-interlaced 8-bit gray or RGB and 16-bit gray, each row with the "Up" filter,
 // the whole zlib stream (libdeflate level 1) in one IDAT chunk, and a tEXt "Software" chunk. A
 // full-size rendered view compresses in about 40 ms where libpng with zlib at level 1 (OpenImageIO)
-// takes 63 ms, to a file 1-2 % smaller (docs/design-notes.md, section Speed).
+// takes 63 ms, to a smaller file (docs/results.md, section "Speed of the renderer").
 
 #include <cstdint>
 #include <string>

@@ -17,7 +17,7 @@ namespace rovo {
 namespace fs = std::filesystem;
 namespace {
 
-constexpr const char* kImuCsvHeader =
+constexpr const char* kEurocImuCsvHeader =
     "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],"
     "a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n";
 
@@ -29,7 +29,7 @@ std::string GroundTruthCsv(const std::string& dir) {
 }
 
 std::string ImuCsv(const std::vector<ImuSample>& samples) {
-  std::string out = kImuCsvHeader;
+  std::string out = kEurocImuCsvHeader;
   for (const ImuSample& s : samples) {
     out += std::to_string(SecondsToNs(s.timestamp));
     for (int i = 0; i < 3; ++i) out += "," + YamlNumber(s.angular_velocity[i]);

@@ -1,8 +1,9 @@
 #include "render/png_encode.h"
 
-#include <gtest/gtest.h>
-
 #include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -46,9 +47,9 @@ TEST(PngEncode, LibpngReadsBackEveryLayoutExactly) {
   const int width = 37, height = 23;  // odd sizes: no row padding assumed
   const auto rgb = Noise<uint8_t>(width * height * 3, 1);
   OIIO::ImageSpec spec;
-  EXPECT_EQ(DecodeWithLibpng<uint8_t>(EncodePng(width, height, 3, 8, rgb.data(), "rovo test"), OIIO::TypeDesc::UINT8,
-                                      &spec),
-            rgb);
+  EXPECT_EQ(
+      DecodeWithLibpng<uint8_t>(EncodePng(width, height, 3, 8, rgb.data(), "rovo test"), OIIO::TypeDesc::UINT8, &spec),
+      rgb);
   EXPECT_EQ(spec.width, width);
   EXPECT_EQ(spec.height, height);
   EXPECT_EQ(spec.nchannels, 3);
@@ -60,8 +61,8 @@ TEST(PngEncode, LibpngReadsBackEveryLayoutExactly) {
   EXPECT_EQ(spec.nchannels, 1);
 
   const auto ids = Noise<uint16_t>(width * height, 3);
-  EXPECT_EQ(
-      DecodeWithLibpng<uint16_t>(EncodePng(width, height, 1, 16, ids.data(), "x"), OIIO::TypeDesc::UINT16, &spec), ids);
+  EXPECT_EQ(DecodeWithLibpng<uint16_t>(EncodePng(width, height, 1, 16, ids.data(), "x"), OIIO::TypeDesc::UINT16, &spec),
+            ids);
   EXPECT_EQ(spec.format, OIIO::TypeDesc::UINT16);
 }
 
