@@ -96,27 +96,25 @@ TEST(PipelineIntegration, OnlineCalibrationIsDeterministicAndConverges) {
   // Poor overlaps ask for more shots: with one shot and an inlier floor no pair reaches, the start-up
   // runs again on every shot the frames allow (--online-startup-max-shots) and says why; at the
   // default floor this scene's overlaps are rich, so the default run above kept its three shots.
-  const std::string more = (root / "more_shots").string();
-  ASSERT_EQ(RunCommand(std::string(ROVO_BINARY) + " vo " + dataset + " --extrinsics online --noise-set " +
-                       std::to_string(noise_set) +
-                       " --frames 0:5 --online-startup-shots 1 --online-startup-spacing 2 --online-startup-max-shots 3"
-                       " --online-startup-min-inliers 1000000 --threads 2 --quiet --out " +
-                       more),
-            0);
-  const nlohmann::json more_startup = ReadRun(more).info.at("startup_calibration");
+  // The start-up record of a `rovo vo` run of this dataset with `flags`, into root/name.
+  const auto startup_of = [&](const std::string& name, const std::string& flags) {
+    const std::string out = (root / name).string();
+    EXPECT_EQ(RunCommand(std::string(ROVO_BINARY) + " vo " + dataset + " --extrinsics online --noise-set " +
+                         std::to_string(noise_set) + " " + flags + " --threads 2 --quiet --out " + out),
+              0);
+    return ReadRun(out).info.at("startup_calibration");
+  };
+  const nlohmann::json more_startup =
+      startup_of("more_shots",
+                 "--frames 0:5 --online-startup-shots 1 --online-startup-spacing 2 --online-startup-max-shots 3"
+                 " --online-startup-min-inliers 1000000");
   EXPECT_EQ(more_startup.at("first_shots"), nlohmann::json({0}));
   EXPECT_EQ(more_startup.at("shots"), nlohmann::json({0, 2, 4}));
   EXPECT_NE(more_startup.at("more_shots_reason").get<std::string>().find("(< 1000000)"), std::string::npos);
   EXPECT_TRUE(more_startup.at("converged").get<bool>());
   // Without a frame for another shot the first attempt stands and says so.
-  const std::string last = (root / "no_frame_left").string();
-  ASSERT_EQ(RunCommand(std::string(ROVO_BINARY) + " vo " + dataset + " --extrinsics online --noise-set " +
-                       std::to_string(noise_set) +
-                       " --frames 0:2 --online-startup-shots 1 --online-startup-min-inliers 1000000 --threads 2 "
-                       "--quiet --out " +
-                       last),
-            0);
-  const nlohmann::json last_startup = ReadRun(last).info.at("startup_calibration");
+  const nlohmann::json last_startup =
+      startup_of("no_frame_left", "--frames 0:2 --online-startup-shots 1 --online-startup-min-inliers 1000000");
   EXPECT_EQ(last_startup.at("shots"), nlohmann::json({0}));
   EXPECT_TRUE(last_startup.at("first_shots").empty());
   EXPECT_NE(last_startup.at("more_shots_reason").get<std::string>().find("no frame left"), std::string::npos);
