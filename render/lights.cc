@@ -1,7 +1,10 @@
-// Point and spot lights: per-material emission and specular tables, the lights' world placement
-// at a frame, the 2-D light grid, and their contribution at a hit (formula: render/tracer.h).
+// Point and spot lights at a hit (formula and light choice: render/tracer.h): the SSE loop over the
+// light grid's blocks, then shadow rays to the strongest lights or to one drawn light.
+#include <emmintrin.h>
+
 #include <algorithm>
 
+#include "render/sse_math.h"
 #include "render/tracer_internal.h"
 
 namespace rovo {
@@ -9,200 +12,247 @@ namespace tracer_internal {
 
 namespace {
 
-// The lights that may reach world point x: the grid cell's list (empty outside the grid), then the
-// lights without a range.
+using LightBlock = Tracer::Impl::LightBlock;
+
+// Calls visit(block) for the blocks of lights that may reach world point x: the grid cell's blocks
+// (none outside the grid), then the blocks of the lights without a range.
 template <typename F>
-void ForEachLightNear(const Tracer::Impl::LightGrid& g, const Eigen::Vector3f& x, F&& visit) {
+void ForEachBlockNear(const Tracer::Impl::LightGrid& g, const Eigen::Vector3f& x, F&& visit) {
   if (g.nx > 0) {
-    const float fx = (x.x() - g.x0) * g.inv_cell, fy = (x.y() - g.y0) * g.inv_cell;
-    if (fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(g.nx) && fy < static_cast<float>(g.ny)) {
-      const size_t c = static_cast<size_t>(static_cast<int>(fy)) * g.nx + static_cast<int>(fx);
-      for (uint32_t k = g.cell_begin[c]; k < g.cell_begin[c + 1]; ++k) visit(g.items[k]);
+    const float fx = (x.x() - g.x0) * g.inv_cell, fy = (x.y() - g.y0) * g.inv_cell, fz = (x.z() - g.z0) * g.inv_cell;
+    if (fx >= 0.0f && fy >= 0.0f && fz >= 0.0f && fx < static_cast<float>(g.nx) && fy < static_cast<float>(g.ny) &&
+        fz < static_cast<float>(g.nz)) {
+      const size_t c =
+          (static_cast<size_t>(static_cast<int>(fz)) * g.ny + static_cast<int>(fy)) * g.nx + static_cast<int>(fx);
+      for (uint32_t k = g.cell_begin[c]; k < g.cell_begin[c + 1]; ++k) visit(g.blocks[k]);
     }
   }
-  for (uint32_t i : g.unbounded) visit(i);
+  for (const LightBlock& b : g.unbounded) visit(b);
+}
+
+// What the lights' formula reads of one hit.
+struct LitHit {
+  Eigen::Vector3f x, n, view;
+  __m128 diffuse;  // albedo / pi
+  float ks, shininess;
+  float highlight_floor;  // max(0, n.h) below which max(0, n.h)^m < kNegligibleHighlight
+};
+
+// The hit in SSE lanes, for four lights at once.
+struct LitHitX4 {
+  explicit LitHitX4(const LitHit& h)
+      : x(_mm_set1_ps(h.x.x())),
+        y(_mm_set1_ps(h.x.y())),
+        z(_mm_set1_ps(h.x.z())),
+        nx(_mm_set1_ps(h.n.x())),
+        ny(_mm_set1_ps(h.n.y())),
+        nz(_mm_set1_ps(h.n.z())),
+        vx(_mm_set1_ps(h.view.x())),
+        vy(_mm_set1_ps(h.view.y())),
+        vz(_mm_set1_ps(h.view.z())),
+        dr(_mm_shuffle_ps(h.diffuse, h.diffuse, _MM_SHUFFLE(0, 0, 0, 0))),
+        dg(_mm_shuffle_ps(h.diffuse, h.diffuse, _MM_SHUFFLE(1, 1, 1, 1))),
+        db(_mm_shuffle_ps(h.diffuse, h.diffuse, _MM_SHUFFLE(2, 2, 2, 2))),
+        glossy(h.ks > 0.0f),
+        spec_scale(_mm_set1_ps(h.ks * (h.shininess + 8.0f) * (kInvPi / 8.0f))),
+        shininess(_mm_set1_ps(h.shininess)),
+        highlight_floor(_mm_set1_ps(h.highlight_floor)) {}
+  __m128 x, y, z, nx, ny, nz, vx, vy, vz, dr, dg, db;
+  bool glossy;
+  __m128 spec_scale, shininess, highlight_floor;
+};
+
+inline __m128 Dot3(__m128 ax, __m128 ay, __m128 az, __m128 bx, __m128 by, __m128 bz) {
+  return _mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, bx), _mm_mul_ps(ay, by)), _mm_mul_ps(az, bz));
+}
+
+// The unshadowed light of a block's four lights at the hit (LightAtHit, four lanes at a time, pow by
+// Log2x4 / Exp2x4): the geometric factor A * W * cos / d^2 into *geometry and the Blinn-Phong term
+// ks * (m + 8) / (8 pi) * max(0, n.h)^m into *specular; returns r + g + b of the light, 0 where a
+// light does not reach the hit.
+inline __m128 BlockWeights(const LightBlock& b, const LitHitX4& h, __m128* geometry, __m128* specular) {
+  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+  const __m128 tx = _mm_sub_ps(_mm_load_ps(b.px), h.x), ty = _mm_sub_ps(_mm_load_ps(b.py), h.y),
+               tz = _mm_sub_ps(_mm_load_ps(b.pz), h.z);
+  const __m128 d2 = Dot3(tx, ty, tz, tx, ty, tz);
+  const __m128 q = _mm_mul_ps(d2, _mm_load_ps(b.inv_range2));
+  const __m128 n_dot_to = Dot3(h.nx, h.ny, h.nz, tx, ty, tz);
+  const __m128 inv_d = RsqrtNewton(d2);
+  const __m128 lx = _mm_mul_ps(tx, inv_d), ly = _mm_mul_ps(ty, inv_d), lz = _mm_mul_ps(tz, inv_d);
+  // Spot: c = -l.a > cos(angle / 2), A = c * smoothstep(min((c - c0) / s, 1)); point lights A = 1.
+  const __m128 c = _mm_sub_ps(zero, Dot3(lx, ly, lz, _mm_load_ps(b.ax), _mm_load_ps(b.ay), _mm_load_ps(b.az)));
+  const __m128 c0 = _mm_load_ps(b.spot_cos);
+  const __m128 lit = _mm_and_ps(_mm_and_ps(_mm_cmplt_ps(q, one), _mm_cmpgt_ps(n_dot_to, zero)),
+                                _mm_and_ps(_mm_cmpgt_ps(d2, _mm_set1_ps(1e-12f)), _mm_cmpgt_ps(c, c0)));
+  const __m128 u = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(c, c0), _mm_load_ps(b.inv_smooth)), one);
+  const __m128 smooth = _mm_mul_ps(_mm_mul_ps(u, u), _mm_sub_ps(_mm_set1_ps(3.0f), _mm_add_ps(u, u)));
+  const __m128 is_spot = _mm_load_ps(b.is_spot);
+  const __m128 a = _mm_or_ps(_mm_and_ps(is_spot, _mm_mul_ps(c, smooth)), _mm_andnot_ps(is_spot, one));
+  const __m128 window = _mm_mul_ps(_mm_sub_ps(one, _mm_mul_ps(q, q)), _mm_sub_ps(one, _mm_mul_ps(q, q)));
+  const __m128 inv_d3 = _mm_mul_ps(inv_d, _mm_mul_ps(inv_d, inv_d));
+  *geometry = _mm_and_ps(lit, _mm_mul_ps(_mm_mul_ps(window, a), _mm_mul_ps(n_dot_to, inv_d3)));
+  const __m128 ir = _mm_load_ps(b.ir), ig = _mm_load_ps(b.ig), ib = _mm_load_ps(b.ib);
+  __m128 w = Dot3(h.dr, h.dg, h.db, ir, ig, ib);
+  *specular = zero;
+  if (h.glossy) {
+    const __m128 hx = _mm_add_ps(lx, h.vx), hy = _mm_add_ps(ly, h.vy), hz = _mm_add_ps(lz, h.vz);
+    const __m128 len2 = _mm_max_ps(Dot3(hx, hy, hz, hx, hy, hz), _mm_set1_ps(1e-30f));
+    const __m128 nh = _mm_max_ps(_mm_mul_ps(Dot3(h.nx, h.ny, h.nz, hx, hy, hz), RsqrtNewton(len2)),
+                                 _mm_set1_ps(1e-30f));
+    const __m128 bright = _mm_cmpgt_ps(nh, h.highlight_floor);
+    if (_mm_movemask_ps(bright) != 0) {
+      *specular = _mm_and_ps(bright, _mm_mul_ps(h.spec_scale, Exp2x4(_mm_mul_ps(h.shininess, Log2x4(nh)))));
+      w = _mm_add_ps(w, _mm_mul_ps(*specular, _mm_add_ps(_mm_add_ps(ir, ig), ib)));
+    }
+  }
+  return _mm_mul_ps(w, *geometry);
+}
+
+// The unshadowed light of lane `lane` of block b: (albedo / pi + specular) * I * geometry.
+inline __m128 LaneDirect(const LightBlock& b, int lane, const LitHit& hit, float geometry, float specular) {
+  const __m128 intensity = _mm_setr_ps(b.ir[lane], b.ig[lane], b.ib[lane], 0.0f);
+  return _mm_mul_ps(_mm_mul_ps(_mm_add_ps(hit.diffuse, _mm_set1_ps(specular)), intensity), _mm_set1_ps(geometry));
+}
+
+// The lights that reach a hit, as lanes of their blocks (unlit lanes weigh 0).
+struct LitLights {
+  alignas(16) float weight[kMaxSampledLights];  // r + g + b of the unshadowed light
+  alignas(16) float geometry[kMaxSampledLights];
+  alignas(16) float specular[kMaxSampledLights];
+  const LightBlock* block[kMaxSampledLights / 4];
+  int num_lanes = 0;
+  float total = 0.0f;
+  __m128 Direct(int j, const LitHit& hit) const {
+    return LaneDirect(*block[j / 4], j % 4, hit, geometry[j], specular[j]);
+  }
+};
+
+// Evaluates the blocks near the hit without branches into `lit`; lights beyond its capacity are
+// added to the pixel at once (V = 1).
+void GatherLitLights(const RenderJob& job, const LitHit& hit, int local, TileBuffers& tb, LitLights* lit) {
+  __m128 total4 = _mm_setzero_ps();
+  const LitHitX4 hit4(hit);
+  ForEachBlockNear(job.d.light_grid, hit.x, [&](const LightBlock& b) {
+    __m128 g, spec;
+    const __m128 w = BlockWeights(b, hit4, &g, &spec);
+    if (lit->num_lanes == kMaxSampledLights) {
+      alignas(16) float gl[4], sl[4];
+      _mm_store_ps(gl, g);
+      _mm_store_ps(sl, spec);
+      for (int k = 0; k < 4; ++k)
+        if (gl[k] > 0.0f) tb.sum[local] = _mm_add_ps(tb.sum[local], LaneDirect(b, k, hit, gl[k], sl[k]));
+      return;
+    }
+    _mm_store_ps(lit->weight + lit->num_lanes, w);
+    _mm_store_ps(lit->geometry + lit->num_lanes, g);
+    _mm_store_ps(lit->specular + lit->num_lanes, spec);
+    lit->block[lit->num_lanes / 4] = &b;
+    lit->num_lanes += 4;
+    total4 = _mm_add_ps(total4, w);
+  });
+  alignas(16) float lanes[4];
+  _mm_store_ps(lanes, total4);
+  lit->total = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+}
+
+// A shadow ray from `origin` to lane j's light carrying `light`, unless the light is closer than the
+// ray's start.
+void PushLightShadowRay(const LitLights& lit, int j, const Eigen::Vector3f& origin, float offset, int local,
+                        __m128 light, TileBuffers& tb, int* num_shadow) {
+  const LightBlock& b = *lit.block[j / 4];
+  const int lane = j % 4;
+  const Eigen::Vector3f to = Eigen::Vector3f(b.px[lane], b.py[lane], b.pz[lane]) - origin;
+  const float dist = to.norm();
+  if (!(dist > offset + 1e-3f)) return;
+  PushShadowRay(tb, num_shadow, origin, to / dist, offset, dist - 1e-3f, local, light, b.light[lane] + 1);
+}
+
+// Lights below the share floor (ShadeSettings::min_shadowed_share of the hit's total) are added at once
+// (V = 1) and leave the lanes; returns the weight left.
+float AddLightsBelowFloor(const RenderJob& job, const LitHit& hit, int local, TileBuffers& tb, LitLights* lit) {
+  const float floor_weight = job.settings.min_shadowed_share * lit->total;
+  float left = 0.0f;
+  for (int j = 0; j < lit->num_lanes; ++j) {
+    if (!(lit->weight[j] > 0.0f)) continue;
+    if (lit->weight[j] >= floor_weight) {
+      left += lit->weight[j];
+      continue;
+    }
+    tb.sum[local] = _mm_add_ps(tb.sum[local], lit->Direct(j, hit));
+    lit->weight[j] = 0.0f;
+  }
+  return left;
+}
+
+// The ShadeSettings::max_shadowed_lights strongest lights above the floor get a shadow ray each; the
+// others are added at once (V = 1).
+void AddStrongestLights(const RenderJob& job, const LitHit& hit, const Eigen::Vector3f& shadow_origin, float offset,
+                        int local, LitLights& lit, TileBuffers& tb, int* num_shadow) {
+  const int k_max = job.settings.shadows ? std::clamp(job.settings.max_shadowed_lights, 0, kMaxShadowedLights) : 0;
+  if (k_max > 0) AddLightsBelowFloor(job, hit, local, tb, &lit);
+  int best[kMaxShadowedLights];
+  int num_best = 0;
+  for (int j = 0; j < lit.num_lanes; ++j) {
+    if (!(lit.weight[j] > 0.0f)) continue;
+    int c = j;
+    if (num_best < k_max) {
+      best[num_best++] = c;
+      continue;
+    }
+    int weakest = -1;
+    for (int b = 0; b < num_best; ++b)
+      if (lit.weight[best[b]] < (weakest < 0 ? lit.weight[c] : lit.weight[best[weakest]])) weakest = b;
+    if (weakest >= 0) std::swap(c, best[weakest]);
+    tb.sum[local] = _mm_add_ps(tb.sum[local], lit.Direct(c, hit));  // beyond the shadowed ones: V = 1
+  }
+  for (int b = 0; b < num_best; ++b)
+    PushLightShadowRay(lit, best[b], shadow_origin, offset, local, lit.Direct(best[b], hit), tb, num_shadow);
+}
+
+// ShadeSettings::sample_lights: of the lights above the floor, one drawn with probability p_i = w_i /
+// sum(w) by the inverse CDF at `u`; its shadow ray carries direct_i / p_i.
+void AddSampledLight(const RenderJob& job, const LitHit& hit, const Eigen::Vector3f& shadow_origin, float offset,
+                     float u, int local, LitLights& lit, TileBuffers& tb, int* num_shadow) {
+  const float drawn_total = AddLightsBelowFloor(job, hit, local, tb, &lit);
+  if (!(drawn_total > 0.0f)) return;
+  // Inverse CDF; rounding may run past the last drawn lane, so it falls back to the last one.
+  const float target = u * drawn_total;
+  float below = 0.0f;
+  int k = -1;
+  for (int j = 0; j < lit.num_lanes; ++j) {
+    if (!(lit.weight[j] > 0.0f)) continue;
+    k = j;
+    below += lit.weight[j];
+    if (below > target) break;
+  }
+  const __m128 direct = lit.Direct(k, hit);
+  const __m128 estimate =
+      lit.weight[k] == drawn_total ? direct : _mm_mul_ps(direct, _mm_set1_ps(drawn_total / lit.weight[k]));
+  PushLightShadowRay(lit, k, shadow_origin, offset, local, estimate, tb, num_shadow);
 }
 
 }  // namespace
 
 void AddPointLights(const RenderJob& job, int h, const Eigen::Vector3f& x, const Eigen::Vector3f& view,
-                    const Eigen::Vector3f& shadow_origin, float offset, int local, TileBuffers& tb, int* num_shadow) {
+                    const Eigen::Vector3f& shadow_origin, float offset, float u, int local, TileBuffers& tb,
+                    int* num_shadow) {
   const Tracer::Impl& d = job.d;
-  const Eigen::Vector3f& n = tb.normal[h];
   const int material = tb.material[h];
-  const float ks = d.material_specular[material], shininess = d.material_shininess[material];
-  const __m128 diffuse = _mm_mul_ps(tb.albedo[h], _mm_set1_ps(kInvPi));
-  const int k_max = job.settings.shadows ? std::clamp(job.settings.max_shadowed_lights, 0, kMaxShadowedLights) : 0;
-  struct Candidate {
-    float rank;
-    uint32_t light;
-    __m128 direct;
-  };
-  Candidate best[kMaxShadowedLights];
-  int num_best = 0;
-  ForEachLightNear(d.light_grid, x, [&](uint32_t i) {
-    const Tracer::Impl::ShadeLight& l = d.lights[i];
-    const Eigen::Vector3f to = l.position - x;
-    const float d2 = to.squaredNorm();
-    float weight = 1.0f;  // A * W
-    if (l.inv_range2 > 0.0f) {
-      const float q = d2 * l.inv_range2;
-      if (q >= 1.0f) return;
-      weight = (1.0f - q * q) * (1.0f - q * q);
-    }
-    const float n_dot_to = n.dot(to);
-    if (n_dot_to <= 0.0f || !(d2 > 1e-12f)) return;  // behind the surface: no square root needed
-    const float inv_d = 1.0f / std::sqrt(d2);
-    const Eigen::Vector3f to_light = to * inv_d;
-    const float cos_light = n_dot_to * inv_d;
-    if (l.spot) {
-      const float c = -to_light.dot(l.spot_axis);
-      if (c <= l.spot_cos) return;
-      const float t = c - l.spot_cos;
-      float a = c;
-      if (t < l.spot_smooth) {
-        const float u = t / l.spot_smooth;
-        a *= u * u * (3.0f - 2.0f * u);
-      }
-      weight *= a;
-    }
-    const float geometry = weight * cos_light / d2;
-    __m128 brdf = diffuse;
-    if (ks > 0.0f) {
-      const float nh = std::max(0.0f, n.dot((to_light + view).normalized()));
-      brdf = _mm_add_ps(brdf, _mm_set1_ps(ks * (shininess + 8.0f) * (kInvPi / 8.0f) * std::pow(nh, shininess)));
-    }
-    Candidate c{l.rank_intensity * geometry, i,
-                _mm_mul_ps(brdf, _mm_mul_ps(Load3(l.intensity), _mm_set1_ps(geometry)))};
-    if (num_best < k_max) {
-      best[num_best++] = c;
-      return;
-    }
-    int weakest = -1;
-    for (int b = 0; b < num_best; ++b)
-      if (best[b].rank < (weakest < 0 ? c.rank : best[weakest].rank)) weakest = b;
-    if (weakest >= 0) std::swap(c, best[weakest]);
-    tb.sum[local] = _mm_add_ps(tb.sum[local], c.direct);  // beyond the shadowed ones: V = 1
-  });
-  for (int b = 0; b < num_best; ++b) {
-    const Eigen::Vector3f to = d.lights[best[b].light].position - shadow_origin;
-    const float dist = to.norm();
-    if (!(dist > offset + 1e-3f)) continue;
-    PushShadowRay(tb, num_shadow, shadow_origin, to / dist, offset, dist - 1e-3f, local, best[b].direct);
-  }
+  const LitHit hit{x,
+                   tb.normal[h],
+                   view,
+                   _mm_mul_ps(tb.albedo[h], _mm_set1_ps(kInvPi)),
+                   d.material_specular[material],
+                   d.material_shininess[material],
+                   d.material_highlight_floor[material]};
+  LitLights lit;
+  GatherLitLights(job, hit, local, tb, &lit);
+  if (!(lit.total > 0.0f)) return;
+  if (job.settings.shadows && job.settings.sample_lights)
+    AddSampledLight(job, hit, shadow_origin, offset, u, local, lit, tb, num_shadow);
+  else
+    AddStrongestLights(job, hit, shadow_origin, offset, local, lit, tb, num_shadow);
 }
 
 }  // namespace tracer_internal
-
-// Per-material emission and specular tables; the lights' constant parts (world-fixed lights are
-// placed here, lights on objects by PlaceLights).
-void Tracer::Impl::SetUpLights() {
-  material_emission.assign(scene.materials.size(), {0.0f, 0.0f, 0.0f, 0.0f});
-  material_specular.assign(scene.materials.size(), 0.0f);
-  material_shininess.assign(scene.materials.size(), 0.0f);
-  for (size_t m = 0; m < scene.materials.size(); ++m) {
-    const Material& mat = scene.materials[m];
-    if (mat.IsEmissive()) any_emission = true;
-    material_emission[m] = {mat.emission.x(), mat.emission.y(), mat.emission.z(), 0.0f};
-    material_specular[m] = mat.specular;
-    material_shininess[m] = mat.shininess;
-  }
-  lights.resize(scene.lights.size());
-  for (size_t i = 0; i < scene.lights.size(); ++i) {
-    const Light& in = scene.lights[i];
-    if (in.object >= static_cast<int>(scene.objects.size()))
-      throw std::invalid_argument("light '" + in.name + "': object index " + std::to_string(in.object) +
-                                  " out of range");
-    ShadeLight& l = lights[i];
-    l.intensity = in.intensity;
-    l.rank_intensity = in.intensity.sum();
-    l.inv_range2 = in.range > 0.0 ? static_cast<float>(1.0 / (in.range * in.range)) : 0.0f;
-    l.spot = in.spot;
-    if (in.spot) {
-      const double c0 = std::cos(0.5 * in.spot_angle_deg * M_PI / 180.0);
-      l.spot_cos = static_cast<float>(c0);
-      l.spot_smooth = static_cast<float>((1.0 - c0) * in.spot_blend);
-    }
-    if (in.object >= 0 && scene.objects[in.object].IsDynamic()) lights_move = true;
-  }
-  if (!lights.empty()) PlaceLights(0);
-}
-
-// World positions and spot axes of the lights at `frame` (objects that move: their pose at the
-// frame), then the light grid.
-void Tracer::Impl::PlaceLights(int frame) {
-  for (size_t i = 0; i < scene.lights.size(); ++i) {
-    const Light& in = scene.lights[i];
-    Rigid3 world_from_light_frame = Rigid3::Identity();
-    if (in.object >= 0) {
-      const Object& obj = scene.objects[in.object];
-      if (!obj.IsDynamic()) {
-        world_from_light_frame = obj.world_from_object;
-      } else if (frame >= 0 && frame < static_cast<int>(obj.world_from_object_per_frame.size())) {
-        world_from_light_frame = obj.world_from_object_per_frame[frame];
-      }
-    }
-    ShadeLight& l = lights[i];
-    l.position = (world_from_light_frame * in.position).cast<float>();
-    if (in.spot) l.spot_axis = (world_from_light_frame.rotation * in.spot_direction).normalized().cast<float>();
-  }
-  BuildLightGrid();
-}
-
-// Cells of about half the median range (at least 1 m, at most 1024 x 1024 cells) over the range
-// discs of the lights that have a range.
-void Tracer::Impl::BuildLightGrid() {
-  LightGrid& g = light_grid;
-  g = LightGrid();
-  std::vector<float> ranges;
-  Eigen::Vector2f lo(std::numeric_limits<float>::max(), std::numeric_limits<float>::max()), hi = -lo;
-  for (uint32_t i = 0; i < lights.size(); ++i) {
-    const ShadeLight& l = lights[i];
-    if (l.inv_range2 <= 0.0f) {
-      g.unbounded.push_back(i);
-      continue;
-    }
-    const float r = 1.0f / std::sqrt(l.inv_range2);
-    ranges.push_back(r);
-    lo = lo.cwiseMin(l.position.head<2>() - Eigen::Vector2f::Constant(r));
-    hi = hi.cwiseMax(l.position.head<2>() + Eigen::Vector2f::Constant(r));
-  }
-  if (ranges.empty()) return;
-  std::nth_element(ranges.begin(), ranges.begin() + ranges.size() / 2, ranges.end());
-  float cell = std::max(1.0f, 0.5f * ranges[ranges.size() / 2]);
-  cell = std::max(cell, std::max(hi.x() - lo.x(), hi.y() - lo.y()) / 1024.0f);
-  g.x0 = lo.x();
-  g.y0 = lo.y();
-  g.inv_cell = 1.0f / cell;
-  g.nx = std::max(1, static_cast<int>(std::ceil((hi.x() - lo.x()) * g.inv_cell)));
-  g.ny = std::max(1, static_cast<int>(std::ceil((hi.y() - lo.y()) * g.inv_cell)));
-  // Two passes over the lights' cell rectangles: count, then fill.
-  std::vector<uint32_t> count(static_cast<size_t>(g.nx) * g.ny + 1, 0);
-  for (int pass = 0; pass < 2; ++pass) {
-    for (uint32_t i = 0; i < lights.size(); ++i) {
-      const ShadeLight& l = lights[i];
-      if (l.inv_range2 <= 0.0f) continue;
-      const float r = 1.0f / std::sqrt(l.inv_range2);
-      const int cx0 = std::clamp(static_cast<int>((l.position.x() - r - g.x0) * g.inv_cell), 0, g.nx - 1);
-      const int cx1 = std::clamp(static_cast<int>((l.position.x() + r - g.x0) * g.inv_cell), 0, g.nx - 1);
-      const int cy0 = std::clamp(static_cast<int>((l.position.y() - r - g.y0) * g.inv_cell), 0, g.ny - 1);
-      const int cy1 = std::clamp(static_cast<int>((l.position.y() + r - g.y0) * g.inv_cell), 0, g.ny - 1);
-      for (int cy = cy0; cy <= cy1; ++cy)
-        for (int cx = cx0; cx <= cx1; ++cx) {
-          const size_t c = static_cast<size_t>(cy) * g.nx + cx;
-          if (pass == 0)
-            ++count[c + 1];
-          else
-            g.items[g.cell_begin[c] + count[c]++] = i;
-        }
-    }
-    if (pass == 0) {
-      for (size_t c = 1; c < count.size(); ++c) count[c] += count[c - 1];
-      g.cell_begin = count;
-      g.items.resize(count.back());
-      std::fill(count.begin(), count.end(), 0);
-    }
-  }
-}
-
 }  // namespace rovo

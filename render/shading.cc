@@ -129,7 +129,11 @@ int AmbientAndShadowRays(const RenderJob& job, const TileRect& t, int s, int num
         tb.sum[local] = _mm_add_ps(tb.sum[local], _mm_loadu_ps(d.material_emission[tb.material[h]].data()));
       if (!d.lights.empty()) {
         const Eigen::Vector3f x = origin + tfar * dir;
-        AddPointLights(job, h, x, -dir, x + offset * normal, offset, local, tb, &num_shadow);
+        // The light choice's uniform: a hashed per-pixel rotation of (s + 1/2) / spp, stratified over
+        // the pixel's samples.
+        const float u = Wrap01((static_cast<float>(s) + 0.5f) * job.inv_spp +
+                               UnitFloat(Mix64(t.Pixel(job, local) * 0xa0761d6478bd642full + 5)));
+        AddPointLights(job, h, x, -dir, x + offset * normal, offset, u, local, tb, &num_shadow);
       }
     }
     if (!d.sun_on) continue;
@@ -150,7 +154,7 @@ int AmbientAndShadowRays(const RenderJob& job, const TileRect& t, int s, int num
     }
     const Eigen::Vector3f shadow_origin = origin + tfar * dir + offset * normal;
     PushShadowRay(tb, &num_shadow, shadow_origin, *to_sun, offset, std::numeric_limits<float>::infinity(), local,
-                  direct);
+                  direct, 0);
   }
   return num_shadow;
 }

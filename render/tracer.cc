@@ -32,6 +32,78 @@ void WriteDepthAndMask(const RenderJob& job, const TileRect& t, int n, const Til
   }
 }
 
+// Shadow rays towards one point light in a tile's packets: at least this many go as an 8-wide packet.
+constexpr int kMinPacket = 4;
+
+// Casts rays[group[0, n)] (n <= 8) as one 8-wide packet; occluded rays get tfar = -inf.
+void Occlude8(const Tracer::Impl& d, RTCIntersectContext* context, const int* group, int n, TileBuffers& tb) {
+  alignas(32) RTCRay8 packet;
+  alignas(32) int valid[8];
+  for (int l = 0; l < 8; ++l) {
+    const RTCRay& r = tb.shadow[group[std::min(l, n - 1)]];
+    valid[l] = l < n ? -1 : 0;
+    packet.org_x[l] = r.org_x;
+    packet.org_y[l] = r.org_y;
+    packet.org_z[l] = r.org_z;
+    packet.dir_x[l] = r.dir_x;
+    packet.dir_y[l] = r.dir_y;
+    packet.dir_z[l] = r.dir_z;
+    packet.tnear[l] = r.tnear;
+    packet.tfar[l] = r.tfar;
+    packet.time[l] = r.time;
+    packet.mask[l] = r.mask;
+    packet.id[l] = 0;
+    packet.flags[l] = 0;
+  }
+  rtcOccluded8(valid, d.trace_scene, context, &packet);
+  for (int l = 0; l < n; ++l) tb.shadow[group[l]].tfar = packet.tfar[l];
+}
+
+// The tile's shadow rays; occluded rays get tfar = -inf. Rays towards the same light start close
+// together and end at one point: runs of kMinPacket to 8 of them go to Embree as 8-wide packets
+// (rtcOccluded8). The sun's rays (spread over its disc) and the rest go through rtcOccluded1Mp.
+void OccludeShadowRays(const RenderJob& job, RTCIntersectContext* context, int num_shadow, TileBuffers& tb) {
+  if (job.d.lights.empty()) {
+    rtcOccluded1M(job.d.trace_scene, context, tb.shadow, static_cast<unsigned>(num_shadow), sizeof(RTCRay));
+    return;
+  }
+  // Open groups of rays towards one light; a full group goes out at once. Rays to the sun, to a light
+  // beyond the first kMaxGroups, and groups left smaller than kMinPacket are cast one by one.
+  constexpr int kMaxGroups = 16;
+  uint32_t group_target[kMaxGroups];
+  int group_size[kMaxGroups], group[kMaxGroups][8];
+  int num_groups = 0, single[kMaxShadowRays], num_single = 0;
+  for (int k = 0; k < num_shadow; ++k) {
+    const uint32_t target = tb.shadow_target[k];
+    int g = 0;
+    while (g < num_groups && group_target[g] != target) ++g;
+    if (target == 0 || g == kMaxGroups) {
+      single[num_single++] = k;
+      continue;
+    }
+    if (g == num_groups) {
+      group_target[num_groups] = target;
+      group_size[num_groups++] = 0;
+    }
+    group[g][group_size[g]++] = k;
+    if (group_size[g] == 8) {
+      Occlude8(job.d, context, group[g], 8, tb);
+      group_size[g] = 0;
+    }
+  }
+  for (int g = 0; g < num_groups; ++g) {
+    if (group_size[g] >= kMinPacket)
+      Occlude8(job.d, context, group[g], group_size[g], tb);
+    else
+      for (int k = 0; k < group_size[g]; ++k) single[num_single++] = group[g][k];
+  }
+  if (num_single == 0) return;
+  // Contiguous, as rtcOccluded1M's streams are faster than rtcOccluded1Mp's pointers.
+  for (int k = 0; k < num_single; ++k) tb.shadow_scratch[k] = tb.shadow[single[k]];
+  rtcOccluded1M(job.d.trace_scene, context, tb.shadow_scratch, static_cast<unsigned>(num_single), sizeof(RTCRay));
+  for (int k = 0; k < num_single; ++k) tb.shadow[single[k]].tfar = tb.shadow_scratch[k].tfar;
+}
+
 // One tile: a pixel-centre pass for depth and masks (shared with the only sample when spp == 1),
 // then per sample the camera rays, the three shading passes and the shadow rays; then the resolve.
 // The raw cast computes the same shadow rays (it needs the normal and the sun sample) but no
@@ -78,7 +150,7 @@ void RenderTile(const RenderJob& job, int tile, TileBuffers& tb) {
       for (int k = 0; k < num_shadow; ++k)
         tb.shadow[k].time = job.moving ? tb.pixel_time[tb.shadow_pixel[k]] : job.motion->time_mid;
     }
-    rtcOccluded1M(d.trace_scene, &shadow_context, tb.shadow, static_cast<unsigned>(num_shadow), sizeof(RTCRay));
+    OccludeShadowRays(job, &shadow_context, num_shadow, tb);
     if (raw) continue;
     for (int k = 0; k < num_shadow; ++k) {
       // Embree sets tfar to -inf for occluded rays.
@@ -121,6 +193,7 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
     throw std::invalid_argument("CameraMotion: a moving camera needs at least two poses");
   job.row_time_scale = job.moving && height > 1 ? motion->readout / static_cast<float>(height - 1) : 0.0f;
   job.spp = spp;
+  job.inv_spp = 1.0f / static_cast<float>(spp);
   job.inv_sqrt_spp = 1.0f / std::sqrt(static_cast<float>(spp));
   job.theta_max = static_cast<float>(0.5 * rays.camera.max_fov_deg * M_PI / 180.0);
   job.precomputed_samples = !settings.rotate_pattern && rays.sample_spp == spp;

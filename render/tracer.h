@@ -28,18 +28,26 @@
 // the frame, for objects that move: world_from_object(frame) * position) add, at a hit x with unit
 // normal n facing the viewer, view direction v (towards the camera), l = (p - x) / d, d = |p - x|:
 //   L += (albedo / pi + ks * (m + 8) / (8 pi) * max(0, n.h)^m) * I * max(0, n.l) / d^2 * A * W * V,
-//   h = normalize(l + v), ks = Material::specular, m = Material::shininess (Blinn-Phong, normalized),
+//   h = normalize(l + v), ks = Material::specular, m = Material::shininess (Blinn-Phong, normalized;
+//   max(0, n.h)^m is taken as 0 below 1e-7),
 //   A = 1 for a point light; for a spot with axis a, c = -l.a, c0 = cos(angle / 2),
 //       s = (1 - c0) * blend: A = 0 if c <= c0, else c * smoothstep((c - c0) / s) if c - c0 < s,
 //       else c (Cycles 3.4's spot_light_attenuation, so Blender spots keep their look),
 //   W = (1 - (d / range)^4)^2 for d < range, 0 beyond (W = 1 when range = 0),
 //   V = shadow-ray visibility towards p (stopped 1 mm short of it).
-// Per hit, the ShadeSettings::max_shadowed_lights lights with the largest (I.r + I.g + I.b) * A * W
-// * max(0, n.l) / d^2 get a shadow ray each; further lights in range are added without one (V = 1),
-// which keeps the image continuous where the ranking changes. Lights are found through a 2-D grid
-// over x, y of the lights' range discs (lights without a range are tested at every hit). A
-// material's emission (radiance) is added to every hit on it. The sun term is skipped when
-// sun_radiance is zero. A Blender point or spot lamp of power P watts is I = colour * P / (4 pi).
+// Light choice: the lights that reach a hit are those with w_i > 0, w_i = r + g + b of the term above
+// without V. Per hit, the ShadeSettings::max_shadowed_lights (default 2) with the largest w_i whose
+// share w_i / sum_j w_j is at least ShadeSettings::min_shadowed_share (default 0) get a shadow ray
+// each; the others are added without one (V = 1), which keeps the image continuous where the
+// ranking changes. With ShadeSettings::sample_lights (a study setting: noisier at equal spp, see
+// render/README.md) each sample casts one shadow ray instead, to a light drawn among those at or above
+// the share with probability p_i = w_i / sum w (inverse CDF in grid order at u = frac((s + 1/2) / spp
+// + r_p), r_p a hashed per-pixel offset: stratified over the pixel's samples), adding its term / p_i.
+// A hit reached by more than 64 lights adds the further ones without a shadow ray. Lights are found
+// through a 3-D grid of cubes listing the lights that may reach each cube (range sphere, spot cone);
+// lights without a range are tested at every hit. A material's emission (radiance) is added to every
+// hit on it. The sun term is skipped when sun_radiance is zero. A Blender point or spot lamp of power
+// P watts is I = colour * P / (4 pi).
 // The raw-cast benchmark (ShadeSettings::raw_cast_only) casts no light shadow rays.
 // Rays that miss see the sky: mix(horizon, zenith, sqrt(d.z)) above the horizon and
 // ground_albedo * horizon below. With ShadeSettings::sun_disc they also see the sun, an HDR disc
@@ -132,7 +140,13 @@ struct ShadeSettings {
   bool sun_disc = false;
   // Misses above the horizon see the circumsolar aureole (formula above); needs a sun.
   bool sun_aureole = false;
-  int max_shadowed_lights = 2;  // point/spot lights per hit with a shadow ray, in [0, kMaxShadowedLights]
+  // Point and spot lights (the file comment, "Light choice"): per hit, the max_shadowed_lights
+  // strongest lights whose share of the hit's unshadowed light is at least min_shadowed_share get a
+  // shadow ray each, the others are added without one; with sample_lights, one shadow ray per sample
+  // to a light drawn among those at or above the share instead.
+  bool sample_lights = false;
+  float min_shadowed_share = 0.0f;
+  int max_shadowed_lights = 2;  // in [0, kMaxShadowedLights]
 };
 
 // Time-dependent camera pose of one Render call (motion blur, rolling shutter, trigger offsets;

@@ -26,6 +26,10 @@ constexpr int kTile = 8;
 constexpr int kTilePixels = kTile * kTile;
 constexpr float kInvPi = 0.318309886f;
 constexpr int kSunSamples = 64;  // points of the soft-shadow sun-disc sequence
+// ShadeSettings::sample_lights: lit lights a hit draws from; further ones are added without a shadow ray.
+constexpr int kMaxSampledLights = 64;
+// A Blinn-Phong factor max(0, n.h)^m below this is taken as 0 (render/tracer.h).
+constexpr float kNegligibleHighlight = 1e-7f;
 
 // splitmix64: the per-pixel hash behind the fixed sample patterns and the soft-shadow sun samples.
 inline uint64_t Mix64(uint64_t x) {
@@ -111,19 +115,34 @@ struct Tracer::Impl {
   };
   std::vector<ShadeLight> lights;
   bool lights_move = false;  // some light rides on a dynamic object: re-placed on every SetFrame
-  // The lights whose range disc reaches each cell of a 2-D grid over x, y (CSR lists), and the
-  // lights without a range (tested everywhere).
+  // Four lights in structure-of-arrays form, the unit of the lights' SSE loop (lights.cc). Unused
+  // lanes have light = kNoLight and lie far outside their range.
+  struct LightBlock {
+    static constexpr uint32_t kNoLight = 0xffffffffu;
+    alignas(16) float px[4], py[4], pz[4];
+    float inv_range2[4];   // 0: no cut-off
+    float ax[4], ay[4], az[4];  // spot axis (unit); 0 for point lights
+    float spot_cos[4];     // cos(angle / 2); -2 for point lights
+    float inv_smooth[4];   // 1 / ((1 - spot_cos) * blend); +inf without a blend
+    float is_spot[4];      // all bits set for a spot, 0 for a point light
+    float ir[4], ig[4], ib[4];  // intensity
+    uint32_t light[4];     // index into lights
+  };
+  // The lights that may reach each cell of a 3-D grid of cubes (range sphere and spot cone), as
+  // blocks of four (CSR lists, cell index (z * ny + y) * nx + x), and the lights without a range
+  // (tested everywhere), as blocks too.
   struct LightGrid {
-    float x0 = 0.0f, y0 = 0.0f, inv_cell = 1.0f;
-    int nx = 0, ny = 0;
-    std::vector<uint32_t> cell_begin;  // nx * ny + 1
-    std::vector<uint32_t> items;
-    std::vector<uint32_t> unbounded;
+    float x0 = 0.0f, y0 = 0.0f, z0 = 0.0f, inv_cell = 1.0f;
+    int nx = 0, ny = 0, nz = 0;
+    std::vector<uint32_t> cell_begin;  // nx * ny * nz + 1, into blocks
+    std::vector<LightBlock> blocks;
+    std::vector<LightBlock> unbounded;
   } light_grid;
   // Per material: emission (r, g, b, 0), Blinn-Phong specular and shininess.
   bool any_emission = false;
   std::vector<std::array<float, 4>> material_emission;
   std::vector<float> material_specular, material_shininess;
+  std::vector<float> material_highlight_floor;  // kNegligibleHighlight^(1 / shininess); 0 without a highlight
 
   bool instances_move = false;  // SetFrameWindow gave the dynamic instances three time steps
 
@@ -175,8 +194,10 @@ constexpr int kMaxShadowRays = kTilePixels * (1 + kMaxShadowedLights);
 struct alignas(64) TileBuffers {
   RTCRayHit rayhit[kTilePixels];
   RTCRay shadow[kMaxShadowRays];
+  RTCRay shadow_scratch[kMaxShadowRays];  // the shadow rays not cast as packets, contiguous
   int pixel[kTilePixels];            // tile-local pixel index of each ray
   int shadow_pixel[kMaxShadowRays];  // tile-local pixel index of each shadow ray
+  uint32_t shadow_target[kMaxShadowRays];  // what each shadow ray is cast towards: 0 the sun, i + 1 light i
   __m128 direct[kMaxShadowRays];     // the light each shadow ray lets through (sun: albedo * E_sun * cos / pi)
   __m128 sum[kTilePixels];           // linear radiance sums per pixel
   int count[kTilePixels];
@@ -237,7 +258,7 @@ struct RenderJob {
   bool moving = false;
   float row_time_scale = 0.0f;  // readout / (height - 1)
   int spp = 1;
-  float inv_sqrt_spp = 1.0f;
+  float inv_spp = 1.0f, inv_sqrt_spp = 1.0f;
   float theta_max = 0.0f;
   bool precomputed_samples = false, soft_sun = false, textures = false;
   // A pixel's sun samples: the block of `spp` consecutive points of the (0,2)-sequence starting at
@@ -275,7 +296,7 @@ __m128 MissRadiance(const RenderJob& job, const Eigen::Vector3f& dir, size_t pi)
 // Appends a shadow ray from `org` along unit `dir` over (tnear, tfar) that adds `direct` to pixel
 // `local` when nothing blocks it.
 inline void PushShadowRay(TileBuffers& tb, int* num_shadow, const Eigen::Vector3f& org, const Eigen::Vector3f& dir,
-                          float tnear, float tfar, int local, __m128 direct) {
+                          float tnear, float tfar, int local, __m128 direct, uint32_t target) {
   RTCRay& sr = tb.shadow[*num_shadow];
   sr.org_x = org.x();
   sr.org_y = org.y();
@@ -290,14 +311,17 @@ inline void PushShadowRay(TileBuffers& tb, int* num_shadow, const Eigen::Vector3
   sr.id = 0;
   sr.flags = 0;
   tb.shadow_pixel[*num_shadow] = local;
+  tb.shadow_target[*num_shadow] = target;
   tb.direct[*num_shadow] = direct;
   ++*num_shadow;
 }
 
-// lights.cc: point and spot lights at hit h (formula: render/tracer.h): the `max_shadowed_lights`
-// strongest get a shadow ray from `shadow_origin`; the others are added to the pixel at once.
+// lights.cc: point and spot lights at hit h (formula and light choice: render/tracer.h): with
+// ShadeSettings::sample_lights one light drawn at `u` in [0, 1) gets a shadow ray from
+// `shadow_origin`, else the `max_shadowed_lights` strongest do and the others are added at once.
 void AddPointLights(const RenderJob& job, int h, const Eigen::Vector3f& x, const Eigen::Vector3f& view,
-                    const Eigen::Vector3f& shadow_origin, float offset, int local, TileBuffers& tb, int* num_shadow);
+                    const Eigen::Vector3f& shadow_origin, float offset, float u, int local, TileBuffers& tb,
+                    int* num_shadow);
 
 // shading.cc: the three shading passes of a sample (see there).
 void GatherHits(const RenderJob& job, const TileRect& t, int n, TileBuffers& tb, int* num_hits_out,

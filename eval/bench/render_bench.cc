@@ -1,5 +1,5 @@
 // `rovo bench render`: speed table (full render vs. raw Embree cast of the same rays, BVH build,
-// peak memory, optional Cycles ratio) and the --quality anti-aliasing study.
+// peak memory, optional Cycles ratio); --quality runs the studies of render_quality.h.
 #include "eval/bench/render_bench.h"
 
 #include <sys/resource.h>
@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "eval/bench/render_quality.h"
 #include "render/render.h"
 #include "render/tracer.h"
 
@@ -41,99 +42,6 @@ double PeakMemoryMb() {
 double LoadAverage() {
   double load[1] = {0.0};
   return getloadavg(load, 1) == 1 ? load[0] : -1.0;
-}
-
-double MeanAbsDiff(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b, const std::vector<uint8_t>& valid) {
-  double sum = 0.0;
-  size_t n = 0;
-  for (size_t i = 0; i < valid.size(); ++i) {
-    if (!valid[i]) continue;
-    for (int c = 0; c < 3; ++c) sum += std::abs(static_cast<int>(a[3 * i + c]) - static_cast<int>(b[3 * i + c]));
-    n += 3;
-  }
-  return n ? sum / n : 0.0;
-}
-
-// Renders camera 0 of frame 0 turned by quarter-pixel yaw steps (a slow pan) with each sampling
-// setting and prints the mean absolute difference to a 32-spp reference and the shimmer: mean
-// |(I_k - I_k-1) - (R_k - R_k-1)|, the frame-to-frame change not explained by the reference's.
-void RunQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tbb::task_arena& arena) {
-  constexpr int kSteps = 5;
-  constexpr int kReferenceSpp = 32;
-  CameraRays rays;
-  arena.execute([&] { rays = CameraRays::Make(rig.cameras[0].camera); });
-  const Rigid3 world_from_cam = scene.rig_trajectory[0].world_from_rig * rig.cameras[0].cam_from_rig.Inverse();
-  const size_t centre = static_cast<size_t>(rays.height / 2) * rays.width + rays.width / 2;
-  const double step_rad = 0.25 * rays.pixel_angle[centre];
-  auto render_steps = [&](const ShadeSettings& settings) {
-    std::vector<std::vector<uint8_t>> images;
-    for (int k = 0; k < kSteps; ++k) {
-      // Yaw about the camera's y axis (image columns shift by about k/4 px at the centre).
-      const Rigid3 nudge = Rigid3::FromAxisAngle(Eigen::Vector3d(0, k * step_rad, 0), Eigen::Vector3d::Zero());
-      CameraImage image;
-      arena.execute([&] {
-        tracer.SetFrame(0);
-        tracer.Render(rays, world_from_cam * nudge, settings, &image);
-      });
-      images.push_back(std::move(image.rgb));
-    }
-    return images;
-  };
-  auto shimmer = [&](const std::vector<std::vector<uint8_t>>& images, const std::vector<std::vector<uint8_t>>& ref) {
-    double sum = 0.0;
-    size_t n = 0;
-    for (int k = 1; k < kSteps; ++k) {
-      for (size_t i = 0; i < rays.valid.size(); ++i) {
-        if (!rays.valid[i]) continue;
-        for (int c = 0; c < 3; ++c) {
-          const int d_img = images[k][3 * i + c] - images[k - 1][3 * i + c];
-          const int d_ref = ref[k][3 * i + c] - ref[k - 1][3 * i + c];
-          sum += std::abs(d_img - d_ref);
-          ++n;
-        }
-      }
-    }
-    return n ? sum / n : 0.0;
-  };
-  ShadeSettings reference_settings;
-  reference_settings.spp = kReferenceSpp;
-  reference_settings.lod_bias = 0.0f;
-  const auto reference = render_steps(reference_settings);
-
-  struct Variant {
-    int spp;
-    bool trilinear;
-    float lod_bias;
-    bool rotate;
-  };
-  const std::vector<Variant> variants = {
-      {1, true, 0.0f, false},   {1, true, -0.5f, false},  {1, false, 0.0f, false}, {1, false, -0.5f, false},
-      {2, true, -0.5f, false},  {2, false, -0.5f, false}, {2, true, -0.5f, true},  {4, true, -0.5f, false},
-      {4, false, -0.5f, false}, {4, true, -0.5f, true},
-  };
-  std::printf(
-      "\nanti-aliasing: camera 0 of frame 0, %dx%d, %d quarter-pixel yaw steps, reference %d spp "
-      "(fixed pattern, trilinear, LOD bias 0); 8-bit units, mean over valid pixels and channels\n",
-      rays.width, rays.height, kSteps, kReferenceSpp);
-  std::printf("| spp | pattern | texture filter | LOD bias | mean abs error | shimmer | CPU s/view |\n");
-  std::printf("|---:|---|---|---:|---:|---:|---:|\n");
-  for (const Variant& v : variants) {
-    ShadeSettings settings;
-    settings.spp = v.spp;
-    settings.trilinear = v.trilinear;
-    settings.lod_bias = v.lod_bias;
-    settings.rotate_pattern = v.rotate;
-    const double cpu0 = CpuSeconds();
-    const auto images = render_steps(settings);
-    const double cpu = (CpuSeconds() - cpu0) / kSteps;
-    double error = 0.0;
-    for (int k = 0; k < kSteps; ++k) error += MeanAbsDiff(images[k], reference[k], rays.valid);
-    std::printf("| %d | %s | %s | %+.1f | %.3f | %.3f | %.3f |\n", v.spp,
-                v.spp == 1 ? "centre" : (v.rotate ? "per-pixel rotated" : "fixed"),
-                v.trilinear ? "trilinear" : "bilinear, nearest level", v.lod_bias, error / kSteps,
-                shimmer(images, reference), cpu);
-  }
-  std::printf("(CPU s/view computes sub-pixel bearings on the fly; rovo render precomputes them per camera)\n");
 }
 
 // Prints the Cycles comparison from WORK/timing.json of scenes/blender/time_cycles_vs_rovo.py.
@@ -314,7 +222,10 @@ void RunRenderBenchmark(const RenderBenchOptions& options) {
   std::printf("peak memory (getrusage): %.0f MB\n", PeakMemoryMb());
   if (!options.cycles_timing.empty())
     PrintCyclesRatio(options.cycles_timing, full_default.cpu_seconds_per_frame, spp_default);
-  if (options.quality) RunQualityStudy(scene, rig, *tracer, arena);
+  if (options.quality) {
+    RunQualityStudy(scene, rig, *tracer, arena);
+    RunLightQualityStudy(scene, rig, *tracer, arena);
+  }
 }
 
 }  // namespace rovo
