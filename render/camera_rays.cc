@@ -195,8 +195,8 @@ CameraRays CameraRays::Make(const Camera& camera, int threads, int spp) {
   return rays;
 }
 
-std::vector<CameraRays> MakeCameraRays(const std::vector<Camera>& cameras, int threads, int spp) {
-  std::vector<CameraRays> rays(cameras.size());
+RigCameraRays MakeCameraRays(const std::vector<Camera>& cameras, int threads, int spp) {
+  RigCameraRays rays(cameras.size());
   for (size_t i = 0; i < cameras.size(); ++i) {
     const Camera& c = cameras[i];
     size_t same = i;
@@ -206,7 +206,7 @@ std::vector<CameraRays> MakeCameraRays(const std::vector<Camera>& cameras, int t
           o.max_fov_deg == c.max_fov_deg)
         same = j;
     }
-    rays[i] = same < i ? rays[same] : CameraRays::Make(c, threads, spp);
+    rays[i] = same < i ? rays[same] : std::make_shared<const CameraRays>(CameraRays::Make(c, threads, spp));
   }
   return rays;
 }

@@ -299,7 +299,7 @@ void ApplyIllumination(const OpticsSettings& optics, const CameraRays& rays, std
 // its MeterLuminance.
 std::vector<std::vector<double>> MeterFrames(const RenderOptions& options, const Scene& scene, const Rig& rig,
                                              int begin, int count, tbb::task_arena& arena, Tracer& tracer) {
-  std::vector<CameraRays> rays;
+  RigCameraRays rays;
   arena.execute([&] {
     std::vector<Camera> cameras;
     for (const RigCamera& cam : rig.cameras) {
@@ -324,9 +324,9 @@ std::vector<std::vector<double>> MeterFrames(const RenderOptions& options, const
     arena.execute([&] {
       tracer.SetFrame(begin + f);
       for (int c = 0; c < rig.NumCameras(); ++c) {
-        tracer.Render(rays[c], world_from_rig * rig.cameras[c].cam_from_rig.Inverse(), settings, &image);
-        if (options.optics.enabled) ApplyIllumination(options.optics, rays[c], &image.linear);
-        meter[f][c] = MeterLuminance(image.linear, rays[c].bearing, rays[c].valid, options.sensor.ae_target);
+        tracer.Render(*rays[c], world_from_rig * rig.cameras[c].cam_from_rig.Inverse(), settings, &image);
+        if (options.optics.enabled) ApplyIllumination(options.optics, *rays[c], &image.linear);
+        meter[f][c] = MeterLuminance(image.linear, rays[c]->bearing, rays[c]->valid, options.sensor.ae_target);
       }
     });
     progress.Add(1);
@@ -482,7 +482,7 @@ void PlanMotion(const RenderOptions& options, const Scene& scene, const Rig& rig
 // The images of one frame with timing (render/timing.h): the dynamic objects over the frame's
 // window (the scene's motion), each camera at its own times (the rig from the dataset's poses).
 void RenderTimedFrame(const RenderOptions& options, const Rig& rig, int traj_frame, int f, const SensorPlan& plan,
-                      const std::vector<CameraRays>& rays, const ShadeSettings& settings, Tracer& tracer,
+                      const RigCameraRays& rays, const ShadeSettings& settings, Tracer& tracer,
                       std::vector<float>* linear, const SensorPipeline* pipeline, const std::vector<LensOptics>& lenses,
                       FrameJob* job) {
   const std::vector<double> shutter = ShutterMs(options.timing, plan, f, rig.NumCameras());
@@ -492,13 +492,13 @@ void RenderTimedFrame(const RenderOptions& options, const Rig& rig, int traj_fra
     Rigid3 world_from_cam;
     const CameraMotion motion =
         MakeCameraMotion(*plan.rig_motion, f, rig.cameras[c].cam_from_rig, h > 0.0 ? h : 1.0, plan.trigger_offset_ms[c],
-                         shutter[c], options.timing.rolling_shutter_ms, rays[c].height, &world_from_cam);
+                         shutter[c], options.timing.rolling_shutter_ms, rays[c]->height, &world_from_cam);
     CameraImage& image = job->images[c];
     if (pipeline) image.linear.swap(*linear);
-    tracer.Render(rays[c], world_from_cam, settings, &image, &motion);
+    tracer.Render(*rays[c], world_from_cam, settings, &image, &motion);
     if (!pipeline) continue;
     if (!lenses.empty()) lenses[c].Apply(&image.linear);
-    pipeline->Apply(image.linear, rays[c].valid, plan.exposure[f][c], plan.sensitivity[c],
+    pipeline->Apply(image.linear, rays[c]->valid, plan.exposure[f][c], plan.sensitivity[c],
                     SensorNoiseSeed(options.seed, f, c), options.sensor.grayscale ? &image.gray : &image.rgb);
     image.linear.swap(*linear);
   }
@@ -508,7 +508,7 @@ void RenderTimedFrame(const RenderOptions& options, const Rig& rig, int traj_fra
 void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& rig, int begin,
                   const std::vector<int>& todo, int spp, const SensorPlan& plan, tbb::task_arena& arena, Tracer& tracer,
                   RenderSummary* summary) {
-  std::vector<CameraRays> rays;
+  RigCameraRays rays;
   arena.execute([&] {
     std::vector<Camera> cameras;
     for (const RigCamera& cam : rig.cameras) cameras.push_back(cam.camera);
@@ -531,7 +531,7 @@ void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& r
   if (options.optics.enabled) {
     arena.execute([&] {
       for (int c = 0; c < rig.NumCameras(); ++c)
-        lenses.emplace_back(options.optics, rig.cameras[c].camera, rays[c].bearing, rays[c].valid,
+        lenses.emplace_back(options.optics, rig.cameras[c].camera, rays[c]->bearing, rays[c]->valid,
                             plan.mtf50_factor[c]);
     });
   }
@@ -557,10 +557,10 @@ void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& r
           const Rigid3 world_from_cam = world_from_rig * rig.cameras[c].cam_from_rig.Inverse();
           CameraImage& image = job.images[c];
           if (sensor) image.linear.swap(linear);
-          tracer.Render(rays[c], world_from_cam, settings, &image);
+          tracer.Render(*rays[c], world_from_cam, settings, &image);
           if (!sensor) continue;
           if (!lenses.empty()) lenses[c].Apply(&image.linear);
-          pipeline->Apply(image.linear, rays[c].valid, plan.exposure[f][c], plan.sensitivity[c],
+          pipeline->Apply(image.linear, rays[c]->valid, plan.exposure[f][c], plan.sensitivity[c],
                           SensorNoiseSeed(options.seed, f, c), options.sensor.grayscale ? &image.gray : &image.rgb);
           image.linear.swap(linear);
         }

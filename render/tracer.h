@@ -114,9 +114,12 @@ struct CameraRays {
   static Eigen::Vector2f SampleOffset(int s, int spp);
 };
 
+// The camera rays of each camera of a rig; cameras with identical intrinsics share one table.
+using RigCameraRays = std::vector<std::shared_ptr<const CameraRays>>;
+
 // CameraRays::Make for each camera of a rig; cameras with identical intrinsics (model, size,
-// parameters, FOV) share one computation (copied).
-std::vector<CameraRays> MakeCameraRays(const std::vector<Camera>& cameras, int threads = 0, int spp = 1);
+// parameters, FOV) share one computation and one table.
+RigCameraRays MakeCameraRays(const std::vector<Camera>& cameras, int threads = 0, int spp = 1);
 
 // Upper bound of ShadeSettings::max_shadowed_lights (sizes the per-tile shadow-ray buffers).
 inline constexpr int kMaxShadowedLights = 8;

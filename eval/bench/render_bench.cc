@@ -100,7 +100,7 @@ std::vector<BenchRow> BenchRows(int spp_default, bool breakdown) {
 // Times every row over `frames` frames. Rows interleaved frame by frame (one untimed warm-up frame
 // per row first), so that every row sees the same load on a shared machine and the ratios between
 // rows are robust to it.
-void TimeRows(const Scene& scene, const Rig& rig, const std::vector<CameraRays>& rays, Tracer& tracer,
+void TimeRows(const Scene& scene, const Rig& rig, const RigCameraRays& rays, Tracer& tracer,
               tbb::task_arena& arena, int frames, std::vector<BenchRow>* rows) {
   std::vector<CameraImage> images(rig.NumCameras());
   auto settings_for = [](const BenchRow& row) {
@@ -116,7 +116,7 @@ void TimeRows(const Scene& scene, const Rig& rig, const std::vector<CameraRays>&
       tracer.SetFrame(f);
       const Rigid3& world_from_rig = scene.rig_trajectory[f].world_from_rig;
       for (int c = 0; c < rig.NumCameras(); ++c)
-        tracer.Render(rays[c], world_from_rig * rig.cameras[c].cam_from_rig.Inverse(), settings, &images[c]);
+        tracer.Render(*rays[c], world_from_rig * rig.cameras[c].cam_from_rig.Inverse(), settings, &images[c]);
     });
   };
   for (const BenchRow& row : *rows) render_frame(settings_for(row), 0);
@@ -185,7 +185,7 @@ void RunRenderBenchmark(const RenderBenchOptions& options) {
 
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   std::unique_ptr<Tracer> tracer;
-  std::vector<CameraRays> rays;
+  RigCameraRays rays;
   double rays_seconds = 0.0;
   arena.execute([&] {
     tracer = std::make_unique<Tracer>(scene);
@@ -196,7 +196,7 @@ void RunRenderBenchmark(const RenderBenchOptions& options) {
     rays_seconds = Seconds(t);
   });
   int64_t valid_pixels = 0;
-  for (const CameraRays& r : rays) valid_pixels += r.num_valid;
+  for (const auto& r : rays) valid_pixels += r->num_valid;
 
   std::vector<BenchRow> rows = BenchRows(spp_default, options.breakdown);
   TimeRows(scene, rig, rays, *tracer, arena, frames, &rows);

@@ -338,13 +338,12 @@ TEST(CameraRaysTest, PrecomputedSamplesRenderTheSameImage) {
   EXPECT_EQ(plain.sample_spp, 0);
   Camera other = camera;
   other.params[0] *= 1.01;
-  const std::vector<CameraRays> rays = MakeCameraRays({camera, other, camera}, 0, 2);
+  const RigCameraRays rays = MakeCameraRays({camera, other, camera}, 0, 2);
   ASSERT_EQ(rays.size(), 3u);
-  ASSERT_EQ(rays[0].sample_spp, 2);
-  ASSERT_EQ(rays[0].sample_bearing.size(), 2u);
-  EXPECT_EQ(rays[2].bearing, rays[0].bearing);
-  EXPECT_EQ(rays[2].sample_bearing, rays[0].sample_bearing);
-  EXPECT_NE(rays[1].bearing, rays[0].bearing);
+  ASSERT_EQ(rays[0]->sample_spp, 2);
+  ASSERT_EQ(rays[0]->sample_bearing.size(), 2u);
+  EXPECT_EQ(rays[2], rays[0]) << "one shared table";
+  EXPECT_NE(rays[1]->bearing, rays[0]->bearing);
   // Many samples are not stored (memory), they are interpolated during the render.
   EXPECT_EQ(CameraRays::Make(camera, 0, CameraRays::kMaxPrecomputedSpp + 1).sample_spp, 0);
   Tracer tracer(scene);
@@ -352,7 +351,7 @@ TEST(CameraRaysTest, PrecomputedSamplesRenderTheSameImage) {
   ShadeSettings settings;
   settings.spp = 2;
   CameraImage precomputed, on_the_fly;
-  tracer.Render(rays[0], WorldFromCam(scene, 1, 0), settings, &precomputed);
+  tracer.Render(*rays[0], WorldFromCam(scene, 1, 0), settings, &precomputed);
   tracer.Render(plain, WorldFromCam(scene, 1, 0), settings, &on_the_fly);
   EXPECT_EQ(precomputed.rgb, on_the_fly.rgb);
   // And 2 spp differs from the pixel centres (the samples are really off-centre).
