@@ -13,7 +13,7 @@ namespace {
 using testing::CompareWithFormula;
 using testing::DarkPlaneScene;
 using testing::Expected;
-using testing::LookingDown;
+using testing::RedAt;
 using testing::Rendered;
 
 constexpr double kKs = 0.3, kShininess = 40.0;
@@ -93,12 +93,7 @@ TEST(LightChoiceTest, ManyLightsThroughTheGridMatchTheSumOfTheFormula) {
 struct FloorScene {
   Scene scene = DarkPlaneScene();
   FloorScene() {
-    scene.meshes.push_back(testing::MakeCube("occluder", 0.2f, 0));
-    Object cube;
-    cube.name = "occluder";
-    cube.mesh = 1;
-    cube.world_from_object = Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(1.0, 0.0, 0.6));
-    scene.objects.push_back(cube);
+    testing::AddOccluderCube(&scene);
     Light strong, weak;
     strong.name = "strong";
     strong.position = Eigen::Vector3d(-1.0, 0.0, 1.5);
@@ -109,11 +104,6 @@ struct FloorScene {
     scene.lights = {strong, weak};
   }
 };
-
-int RedAt(const Rendered& r, const Eigen::Vector3d& p) {
-  const Eigen::Vector2d uv = r.camera.Project(r.world_from_cam.Inverse() * p).value();
-  return r.image.rgb[3 * (static_cast<size_t>(std::lround(uv.y())) * r.camera.width + std::lround(uv.x()))];
-}
 
 TEST(LightChoiceTest, LightsBelowTheShareFloorGetNoShadowRay) {
   FloorScene f;
@@ -167,10 +157,7 @@ TEST(LightChoiceTest, DrawnLightEstimatesTheShadowedSumWithoutBias) {
 
 TEST(LightChoiceTest, DrawingFromOneLightIsExact) {
   Scene scene = DarkPlaneScene();
-  Light light;
-  light.name = "bulb";
-  light.position = Eigen::Vector3d(0.4, -0.3, 1.2);
-  light.intensity = Eigen::Vector3f(2.0f, 1.0f, 0.4f);
+  const Light light = testing::Bulb();
   scene.lights.push_back(light);
   Tracer tracer(scene);
   ShadeSettings settings;

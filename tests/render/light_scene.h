@@ -120,5 +120,30 @@ int CompareWithFormula(const Rendered& r, F&& expected, int* worst_out) {
   return compared;
 }
 
+// Adds the occluder: a cube of half size 0.2 m centred at (1, 0, 0.6), object 1.
+inline void AddOccluderCube(Scene* scene) {
+  scene->meshes.push_back(MakeCube("occluder", 0.2f, 0));
+  Object cube;
+  cube.name = "occluder";
+  cube.mesh = static_cast<int>(scene->meshes.size()) - 1;
+  cube.world_from_object = Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(1.0, 0.0, 0.6));
+  scene->objects.push_back(cube);
+}
+
+// The red value of the pixel that sees plane point p.
+inline int RedAt(const Rendered& r, const Eigen::Vector3d& p) {
+  const Eigen::Vector2d uv = r.camera.Project(r.world_from_cam.Inverse() * p).value();
+  return r.image.rgb[3 * (static_cast<size_t>(std::lround(uv.y())) * r.camera.width + std::lround(uv.x()))];
+}
+
+// A coloured point light 1.2 m above the plane, near the middle of the view.
+inline Light Bulb() {
+  Light light;
+  light.name = "bulb";
+  light.position = Eigen::Vector3d(0.4, -0.3, 1.2);
+  light.intensity = Eigen::Vector3f(2.0f, 1.0f, 0.4f);
+  return light;
+}
+
 }  // namespace testing
 }  // namespace rovo

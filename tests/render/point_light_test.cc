@@ -11,14 +11,12 @@ using testing::CompareWithFormula;
 using testing::DarkPlaneScene;
 using testing::Expected;
 using testing::RenderDown;
+using testing::RedAt;
 using testing::Rendered;
 
 TEST(PointLightTest, PointLightMatchesTheFormula) {
   Scene scene = DarkPlaneScene();
-  Light light;
-  light.name = "bulb";
-  light.position = Eigen::Vector3d(0.4, -0.3, 1.2);
-  light.intensity = Eigen::Vector3f(2.0f, 1.0f, 0.4f);
+  const Light light = testing::Bulb();
   scene.lights.push_back(light);
   Tracer tracer(scene);
   const Rendered r = RenderDown(tracer);
@@ -67,34 +65,24 @@ TEST(PointLightTest, SpotConeRangeWindowAndHighlightMatchTheFormula) {
 
 TEST(PointLightTest, ShadowRaysOnlyForTheStrongestLights) {
   Scene scene = DarkPlaneScene();
-  scene.meshes.push_back(testing::MakeCube("occluder", 0.2f, 0));
-  Object cube;
-  cube.name = "occluder";
-  cube.mesh = 1;
-  cube.world_from_object = Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(1.0, 0.0, 0.6));
-  scene.objects.push_back(cube);
+  testing::AddOccluderCube(&scene);
   Light light;
   light.name = "bulb";
   light.position = Eigen::Vector3d(1.0, 0.0, 1.2);  // straight above the cube
   light.intensity = Eigen::Vector3f(1.0f, 1.0f, 1.0f);
   scene.lights.push_back(light);
   Tracer tracer(scene);
-  auto red_at = [](const Rendered& r, const Eigen::Vector3d& p) {
-    const Eigen::Vector2d uv = r.camera.Project(r.world_from_cam.Inverse() * p).value();
-    return static_cast<int>(
-        r.image.rgb[3 * (static_cast<size_t>(std::lround(uv.y())) * r.camera.width + std::lround(uv.x()))]);
-  };
   // A plane point in the cube's shadow that the camera above the origin sees past the cube, and
   // one the light reaches.
   const Eigen::Vector3d shadowed(1.0, 0.55, 0.0), lit(0.0, -0.6, 0.0);
   const Rendered with_shadows = RenderDown(tracer, 4);
-  EXPECT_EQ(red_at(with_shadows, shadowed), 0);
-  EXPECT_GT(red_at(with_shadows, lit), 30);
+  EXPECT_EQ(RedAt(with_shadows, shadowed), 0);
+  EXPECT_GT(RedAt(with_shadows, lit), 30);
   // max_shadowed_lights = 0: every light is added without a shadow ray (documented), so the
   // point under the cube is lit.
   const Rendered without = RenderDown(tracer, 0);
-  EXPECT_GT(red_at(without, shadowed), 30);
-  EXPECT_EQ(red_at(without, lit), red_at(with_shadows, lit));
+  EXPECT_GT(RedAt(without, shadowed), 30);
+  EXPECT_EQ(RedAt(without, lit), RedAt(with_shadows, lit));
 }
 
 TEST(PointLightTest, LightOnAMovingObjectFollowsIt) {
