@@ -21,7 +21,8 @@ void Tracer::Impl::SetUpLights() {
     material_emission[m] = {mat.emission.x(), mat.emission.y(), mat.emission.z(), 0.0f};
     material_specular[m] = mat.specular;
     material_shininess[m] = mat.shininess;
-    if (mat.shininess > 0.0f) material_highlight_floor[m] = std::pow(tracer_internal::kNegligibleHighlight, 1.0f / mat.shininess);
+    if (mat.shininess > 0.0f)
+      material_highlight_floor[m] = std::pow(tracer_internal::kNegligibleHighlight, 1.0f / mat.shininess);
   }
   lights.resize(scene.lights.size());
   for (size_t i = 0; i < scene.lights.size(); ++i) {
@@ -109,7 +110,8 @@ void AppendBlocks(const std::vector<Tracer::Impl::ShadeLight>& lights, const uin
                   std::vector<LightBlock>* out) {
   for (size_t i = 0; i < n; i += 4) {
     LightBlock b = EmptyBlock();
-    for (size_t k = 0; k < 4 && i + k < n; ++k) SetLane(lights[indices[i + k]], indices[i + k], static_cast<int>(k), &b);
+    for (size_t k = 0; k < 4 && i + k < n; ++k)
+      SetLane(lights[indices[i + k]], indices[i + k], static_cast<int>(k), &b);
     out->push_back(b);
   }
 }

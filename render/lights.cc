@@ -97,8 +97,8 @@ inline __m128 BlockWeights(const LightBlock& b, const LitHitX4& h, __m128* geome
   if (h.glossy) {
     const __m128 hx = _mm_add_ps(lx, h.vx), hy = _mm_add_ps(ly, h.vy), hz = _mm_add_ps(lz, h.vz);
     const __m128 len2 = _mm_max_ps(Dot3(hx, hy, hz, hx, hy, hz), _mm_set1_ps(1e-30f));
-    const __m128 nh = _mm_max_ps(_mm_mul_ps(Dot3(h.nx, h.ny, h.nz, hx, hy, hz), RsqrtNewton(len2)),
-                                 _mm_set1_ps(1e-30f));
+    const __m128 nh =
+        _mm_max_ps(_mm_mul_ps(Dot3(h.nx, h.ny, h.nz, hx, hy, hz), RsqrtNewton(len2)), _mm_set1_ps(1e-30f));
     const __m128 bright = _mm_cmpgt_ps(nh, h.highlight_floor);
     if (_mm_movemask_ps(bright) != 0) {
       *specular = _mm_and_ps(bright, _mm_mul_ps(h.spec_scale, Exp2x4(_mm_mul_ps(h.shininess, Log2x4(nh)))));

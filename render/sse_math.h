@@ -11,7 +11,8 @@ inline __m128 Log2x4(__m128 x) {
   const __m128i bits = _mm_castps_si128(x);
   __m128 e = _mm_cvtepi32_ps(
       _mm_sub_epi32(_mm_and_si128(_mm_srli_epi32(bits, 23), _mm_set1_epi32(0xff)), _mm_set1_epi32(127)));
-  __m128 m = _mm_castsi128_ps(_mm_or_si128(_mm_and_si128(bits, _mm_set1_epi32(0x007fffff)), _mm_set1_epi32(0x3f800000)));
+  __m128 m =
+      _mm_castsi128_ps(_mm_or_si128(_mm_and_si128(bits, _mm_set1_epi32(0x007fffff)), _mm_set1_epi32(0x3f800000)));
   const __m128 big = _mm_cmpgt_ps(m, _mm_set1_ps(1.41421356f));
   m = _mm_or_ps(_mm_and_ps(big, _mm_mul_ps(m, _mm_set1_ps(0.5f))), _mm_andnot_ps(big, m));
   e = _mm_add_ps(e, _mm_and_ps(big, _mm_set1_ps(1.0f)));
@@ -42,8 +43,7 @@ inline __m128 Exp2x4(__m128 x) {
 // than float's own for normal x > 0).
 inline __m128 RsqrtNewton(__m128 x) {
   const __m128 y = _mm_rsqrt_ps(x);
-  return _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(0.5f), y),
-                    _mm_sub_ps(_mm_set1_ps(3.0f), _mm_mul_ps(_mm_mul_ps(x, y), y)));
+  return _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(0.5f), y), _mm_sub_ps(_mm_set1_ps(3.0f), _mm_mul_ps(_mm_mul_ps(x, y), y)));
 }
 
 }  // namespace tracer_internal

@@ -120,13 +120,13 @@ struct Tracer::Impl {
   struct LightBlock {
     static constexpr uint32_t kNoLight = 0xffffffffu;
     alignas(16) float px[4], py[4], pz[4];
-    float inv_range2[4];   // 0: no cut-off
+    float inv_range2[4];        // 0: no cut-off
     float ax[4], ay[4], az[4];  // spot axis (unit); 0 for point lights
-    float spot_cos[4];     // cos(angle / 2); -2 for point lights
-    float inv_smooth[4];   // 1 / ((1 - spot_cos) * blend); +inf without a blend
-    float is_spot[4];      // all bits set for a spot, 0 for a point light
+    float spot_cos[4];          // cos(angle / 2); -2 for point lights
+    float inv_smooth[4];        // 1 / ((1 - spot_cos) * blend); +inf without a blend
+    float is_spot[4];           // all bits set for a spot, 0 for a point light
     float ir[4], ig[4], ib[4];  // intensity
-    uint32_t light[4];     // index into lights
+    uint32_t light[4];          // index into lights
   };
   // The lights that may reach each cell of a 3-D grid of cubes (range sphere and spot cone), as
   // blocks of four (CSR lists, cell index (z * ny + y) * nx + x), and the lights without a range
@@ -194,12 +194,12 @@ constexpr int kMaxShadowRays = kTilePixels * (1 + kMaxShadowedLights);
 struct alignas(64) TileBuffers {
   RTCRayHit rayhit[kTilePixels];
   RTCRay shadow[kMaxShadowRays];
-  RTCRay shadow_scratch[kMaxShadowRays];  // the shadow rays not cast as packets, contiguous
-  int pixel[kTilePixels];            // tile-local pixel index of each ray
-  int shadow_pixel[kMaxShadowRays];  // tile-local pixel index of each shadow ray
+  RTCRay shadow_scratch[kMaxShadowRays];   // the shadow rays not cast as packets, contiguous
+  int pixel[kTilePixels];                  // tile-local pixel index of each ray
+  int shadow_pixel[kMaxShadowRays];        // tile-local pixel index of each shadow ray
   uint32_t shadow_target[kMaxShadowRays];  // what each shadow ray is cast towards: 0 the sun, i + 1 light i
-  __m128 direct[kMaxShadowRays];     // the light each shadow ray lets through (sun: albedo * E_sun * cos / pi)
-  __m128 sum[kTilePixels];           // linear radiance sums per pixel
+  __m128 direct[kMaxShadowRays];           // the light each shadow ray lets through (sun: albedo * E_sun * cos / pi)
+  __m128 sum[kTilePixels];                 // linear radiance sums per pixel
   int count[kTilePixels];
   float pixel_time[kTilePixels];  // ray time of each pixel's ray in the current pass (CameraMotion)
   // The hits of the current sample pass, compacted.

@@ -100,8 +100,8 @@ std::vector<BenchRow> BenchRows(int spp_default, bool breakdown) {
 // Times every row over `frames` frames. Rows interleaved frame by frame (one untimed warm-up frame
 // per row first), so that every row sees the same load on a shared machine and the ratios between
 // rows are robust to it.
-void TimeRows(const Scene& scene, const Rig& rig, const RigCameraRays& rays, Tracer& tracer,
-              tbb::task_arena& arena, int frames, std::vector<BenchRow>* rows) {
+void TimeRows(const Scene& scene, const Rig& rig, const RigCameraRays& rays, Tracer& tracer, tbb::task_arena& arena,
+              int frames, std::vector<BenchRow>* rows) {
   std::vector<CameraImage> images(rig.NumCameras());
   auto settings_for = [](const BenchRow& row) {
     ShadeSettings settings;

@@ -104,7 +104,6 @@ void RunQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tbb::ta
   std::printf("(CPU s/view computes sub-pixel bearings on the fly; rovo render precomputes them per camera)\n");
 }
 
-
 // A 32-spp reference gives every light in reach a shadow ray (kMaxShadowedLights, no share floor).
 void RunLightQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tbb::task_arena& arena) {
   if (scene.lights.empty()) return;
@@ -133,15 +132,15 @@ void RunLightQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tb
     int max_shadowed;
     float share;
   };
-  const std::vector<Variant> variants = {{2, false, 2, 0.0f},  {2, false, 2, 0.05f}, {2, false, 2, 0.1f},
-                                         {2, false, 2, 0.2f},  {2, false, 1, 0.1f},  {2, false, 0, 0.0f},
-                                         {2, true, 0, 0.0f},   {2, true, 0, 0.1f},   {4, false, 2, 0.1f},
-                                         {4, true, 0, 0.1f}};
+  const std::vector<Variant> variants = {
+      {2, false, 2, 0.0f}, {2, false, 2, 0.05f}, {2, false, 2, 0.1f}, {2, false, 2, 0.2f}, {2, false, 1, 0.1f},
+      {2, false, 0, 0.0f}, {2, true, 0, 0.0f},   {2, true, 0, 0.1f},  {4, false, 2, 0.1f}, {4, true, 0, 0.1f}};
   std::printf(
       "\npoint and spot lights: camera 0 of frame 0, %dx%d, reference %d spp with a shadow ray to every light in "
       "reach; 8-bit units over valid pixels and channels; off > 8: share of values off by more than 8 codes\n",
       rays.width, rays.height, kReferenceSpp);
-  std::printf("| spp | shadow rays | share floor | mean abs error | off > 8 | CPU s/view |\n|---:|---|---:|---:|---:|---:|\n");
+  std::printf(
+      "| spp | shadow rays | share floor | mean abs error | off > 8 | CPU s/view |\n|---:|---|---:|---:|---:|---:|\n");
   for (const Variant& v : variants) {
     ShadeSettings settings;
     settings.spp = v.spp;
@@ -156,9 +155,9 @@ void RunLightQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tb
       for (int c = 0; c < 3; ++c) off += std::abs(image[3 * i + c] - reference[3 * i + c]) > 8;
       n += 3;
     }
-    const std::string rays_text = v.sample ? "one to a drawn light per sample"
-                                           : (v.max_shadowed == 0 ? "none"
-                                                                  : "the " + std::to_string(v.max_shadowed) + " strongest");
+    const std::string rays_text =
+        v.sample ? "one to a drawn light per sample"
+                 : (v.max_shadowed == 0 ? "none" : "the " + std::to_string(v.max_shadowed) + " strongest");
     std::printf("| %d | %s | %.2f | %.3f | %.4f | %.3f |\n", v.spp, rays_text.c_str(), v.share,
                 MeanAbsDiff(image, reference, rays.valid), n ? static_cast<double>(off) / n : 0.0, cpu);
   }

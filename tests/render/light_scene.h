@@ -75,7 +75,7 @@ inline Rendered RenderDown(Tracer& tracer, int max_shadowed = 4) {
 
 // The formula of render/tracer.h for one light at plane point x (normal +z, viewer at `eye`).
 inline Eigen::Vector3d Expected(const Light& light, const Eigen::Vector3d& x, const Eigen::Vector3d& eye, double ks,
-                         double shininess) {
+                                double shininess) {
   const Eigen::Vector3d to = light.position - x;
   const double d = to.norm();
   const Eigen::Vector3d l = to / d, n(0, 0, 1), v = (eye - x).normalized();

@@ -10,8 +10,8 @@ namespace {
 using testing::CompareWithFormula;
 using testing::DarkPlaneScene;
 using testing::Expected;
-using testing::RenderDown;
 using testing::RedAt;
+using testing::RenderDown;
 using testing::Rendered;
 
 TEST(PointLightTest, PointLightMatchesTheFormula) {
