@@ -159,7 +159,8 @@ void PrecomputeSampleBearings(const Camera& camera, int threads, int spp, Camera
   CameraRays& rays = *rays_out;
   const size_t n = static_cast<size_t>(camera.width) * camera.height;
   rays.sample_spp = spp;
-  rays.sample_bearing.assign(spp, std::vector<Eigen::Vector3f>(n, Eigen::Vector3f::Zero()));
+  rays.sample_bearing.assign(spp, {});
+  for (std::vector<Eigen::Vector3f>& v : rays.sample_bearing) v.resize(n);  // every entry is written below
   RunWithThreads(threads, [&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& r) {
       for (int s = 0; s < spp; ++s) {
@@ -167,9 +168,9 @@ void PrecomputeSampleBearings(const Camera& camera, int threads, int spp, Camera
         for (int y = r.begin(); y < r.end(); ++y) {
           for (int x = 0; x < camera.width; ++x) {
             const size_t i = static_cast<size_t>(y) * camera.width + x;
-            if (!rays.valid[i]) continue;
             Eigen::Vector3f b;
-            if (rays.SampleBearing(x + offset.x(), y + offset.y(), &b)) rays.sample_bearing[s][i] = b;
+            rays.sample_bearing[s][i] =
+                rays.valid[i] && rays.SampleBearing(x + offset.x(), y + offset.y(), &b) ? b : Eigen::Vector3f::Zero();
           }
         }
       }
