@@ -32,7 +32,6 @@ void Tracer::Impl::SetUpLights() {
                                   " out of range");
     ShadeLight& l = lights[i];
     l.intensity = in.intensity;
-    l.rank_intensity = in.intensity.sum();
     l.inv_range2 = in.range > 0.0 ? static_cast<float>(1.0 / (in.range * in.range)) : 0.0f;
     l.spot = in.spot;
     if (in.spot) {

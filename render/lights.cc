@@ -66,7 +66,7 @@ inline __m128 Dot3(__m128 ax, __m128 ay, __m128 az, __m128 bx, __m128 by, __m128
   return _mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, bx), _mm_mul_ps(ay, by)), _mm_mul_ps(az, bz));
 }
 
-// The unshadowed light of a block's four lights at the hit (LightAtHit, four lanes at a time, pow by
+// The unshadowed light of a block's four lights at the hit (render/tracer.h's formula, four at a time, pow by
 // Log2x4 / Exp2x4): the geometric factor A * W * cos / d^2 into *geometry and the Blinn-Phong term
 // ks * (m + 8) / (8 pi) * max(0, n.h)^m into *specular; returns r + g + b of the light, 0 where a
 // light does not reach the hit.

@@ -107,8 +107,7 @@ struct Tracer::Impl {
   struct ShadeLight {
     Eigen::Vector3f position = Eigen::Vector3f::Zero();
     Eigen::Vector3f intensity = Eigen::Vector3f::Zero();
-    float rank_intensity = 0.0f;  // intensity.r + g + b
-    float inv_range2 = 0.0f;      // 1 / range^2; 0: no cut-off
+    float inv_range2 = 0.0f;  // 1 / range^2; 0: no cut-off
     bool spot = false;
     Eigen::Vector3f spot_axis = Eigen::Vector3f::UnitZ();  // unit, world
     float spot_cos = -1.0f, spot_smooth = 0.0f;            // cos(angle / 2), (1 - spot_cos) * blend
