@@ -34,6 +34,9 @@ void AddRenderBenchCommand(CLI::App* bench) {
                   "timing.json written by scenes/blender/time_cycles_vs_rovo.py: print the Cycles/rovo ratio "
                   "(Cycles takes minutes per frame, so it is timed by that script, not here)");
   cmd->add_option("--write", options->write_dir, "Also time a full `rovo render` of the frames into this folder");
+  cmd->add_option("--against", options->against,
+                  "Also time the default-quality render of this preset (e.g. cloudy_urban), frame by frame in turn "
+                  "with the scene's, and print the ratio of their CPU per frame");
   cmd->callback([options] { RunRenderBenchmark(*options); });
 }
 

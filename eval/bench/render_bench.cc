@@ -170,31 +170,83 @@ void PrintRowTable(const std::vector<BenchRow>& rows, int64_t valid_pixels, int 
               spp_default, full_default.seconds_per_frame, full_default.cpu_seconds_per_frame);
 }
 
+// A scene ready to time: the scene, its rig, the tracer and the camera rays at the default spp.
+struct BenchScene {
+  Scene scene;
+  Rig rig;
+  std::unique_ptr<Tracer> tracer;
+  RigCameraRays rays;
+  std::vector<CameraImage> images;  // reused, as rovo render reuses its buffers
+  int frames = 0;
+  double scene_seconds = 0.0, rays_seconds = 0.0;
+};
+
+std::unique_ptr<BenchScene> LoadBenchScene(const RenderBenchOptions& options, const std::string& preset,
+                                           const std::string& scene_dir, int spp, tbb::task_arena& arena) {
+  auto b = std::make_unique<BenchScene>();
+  const auto t_scene = std::chrono::steady_clock::now();
+  b->scene = SceneForOptions(scene_dir.empty() ? preset : "", false, options.seed, scene_dir);
+  b->scene_seconds = Seconds(t_scene);
+  b->rig = RigForOptions("", b->scene, options.scale, scene_dir);
+  b->frames = std::min<int>(options.frames, static_cast<int>(b->scene.rig_trajectory.size()));
+  arena.execute([&] {
+    b->tracer = std::make_unique<Tracer>(b->scene);
+    const auto t = std::chrono::steady_clock::now();
+    std::vector<Camera> cameras;
+    for (const RigCamera& cam : b->rig.cameras) cameras.push_back(cam.camera);
+    b->rays = MakeCameraRays(cameras, 0, spp);
+    b->rays_seconds = Seconds(t);
+  });
+  return b;
+}
+
+// CPU seconds of rendering frame f of `b` at `settings` (all cameras).
+double FrameCpuSeconds(BenchScene& b, const ShadeSettings& settings, int f, tbb::task_arena& arena) {
+  b.images.resize(b.rig.NumCameras());
+  const double cpu0 = CpuSeconds();
+  arena.execute([&] {
+    b.tracer->SetFrame(f);
+    const Rigid3& world_from_rig = b.scene.rig_trajectory[f].world_from_rig;
+    for (int c = 0; c < b.rig.NumCameras(); ++c)
+      b.tracer->Render(*b.rays[c], world_from_rig * b.rig.cameras[c].cam_from_rig.Inverse(), settings, &b.images[c]);
+  });
+  return CpuSeconds() - cpu0;
+}
+
+// --against: the default-quality render of this scene and of the reference preset, frame by frame in
+// turn (so that both see the same load, after an untimed frame each), and the ratio of their CPU.
+void PrintRatioAgainst(const RenderBenchOptions& options, BenchScene& main, int spp, tbb::task_arena& arena) {
+  const std::unique_ptr<BenchScene> ref = LoadBenchScene(options, options.against, "", spp, arena);
+  const int frames = std::min(main.frames, ref->frames);
+  ShadeSettings settings;
+  settings.spp = spp;
+  FrameCpuSeconds(main, settings, 0, arena);
+  FrameCpuSeconds(*ref, settings, 0, arena);
+  double cpu_main = 0.0, cpu_ref = 0.0;
+  for (int f = 0; f < frames; ++f) {
+    cpu_main += FrameCpuSeconds(main, settings, f, arena) / frames;
+    cpu_ref += FrameCpuSeconds(*ref, settings, f, arena) / frames;
+  }
+  std::printf(
+      "default quality (%d spp) against preset %s, frames in turn: %.4f / %.4f CPU s/frame = %.2fx (target <= 1.5 "
+      "for every preset against cloudy_urban)\n",
+      spp, options.against.c_str(), cpu_main, cpu_ref, cpu_ref > 0.0 ? cpu_main / cpu_ref : 0.0);
+}
+
 }  // namespace
 
 void RunRenderBenchmark(const RenderBenchOptions& options) {
   if (options.frames < 1) throw std::invalid_argument("--frames: must be >= 1");
   const double load_before = LoadAverage();
-  const auto t_scene = std::chrono::steady_clock::now();
-  const Scene scene =
-      SceneForOptions(options.scene_dir.empty() ? options.preset : "", false, options.seed, options.scene_dir);
-  const double scene_seconds = Seconds(t_scene);
-  const Rig rig = RigForOptions("", scene, options.scale, options.scene_dir);
-  const int frames = std::min<int>(options.frames, static_cast<int>(scene.rig_trajectory.size()));
   const int spp_default = options.spp > 0 ? options.spp : kDefaultSpp;
-
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
-  std::unique_ptr<Tracer> tracer;
-  RigCameraRays rays;
-  double rays_seconds = 0.0;
-  arena.execute([&] {
-    tracer = std::make_unique<Tracer>(scene);
-    const auto t = std::chrono::steady_clock::now();
-    std::vector<Camera> cameras;
-    for (const RigCamera& cam : rig.cameras) cameras.push_back(cam.camera);
-    rays = MakeCameraRays(cameras, 0, spp_default);
-    rays_seconds = Seconds(t);
-  });
+  const std::unique_ptr<BenchScene> bench =
+      LoadBenchScene(options, options.preset, options.scene_dir, spp_default, arena);
+  const Scene& scene = bench->scene;
+  const Rig& rig = bench->rig;
+  const RigCameraRays& rays = bench->rays;
+  Tracer* tracer = bench->tracer.get();
+  const int frames = bench->frames;
   int64_t valid_pixels = 0;
   for (const auto& r : rays) valid_pixels += r->num_valid;
 
@@ -212,8 +264,8 @@ void RunRenderBenchmark(const RenderBenchOptions& options) {
   std::printf(
       "scene: %zu static triangles, %zu objects; generate/load %.2f s; static BVH build %.3f s; "
       "pixel and sample bearings (%d spp) %.2f s\n",
-      tracer->num_static_triangles(), scene.objects.size(), scene_seconds, tracer->static_build_seconds(), spp_default,
-      rays_seconds);
+      tracer->num_static_triangles(), scene.objects.size(), bench->scene_seconds, tracer->static_build_seconds(),
+      spp_default, bench->rays_seconds);
   PrintRowTable(rows, valid_pixels, spp_default);
   const BenchRow& full_default = spp_default != 1 ? rows[3] : rows[1];
   if (write_seconds_per_frame >= 0.0)
@@ -222,6 +274,7 @@ void RunRenderBenchmark(const RenderBenchOptions& options) {
   std::printf("peak memory (getrusage): %.0f MB\n", PeakMemoryMb());
   if (!options.cycles_timing.empty())
     PrintCyclesRatio(options.cycles_timing, full_default.cpu_seconds_per_frame, spp_default);
+  if (!options.against.empty()) PrintRatioAgainst(options, *bench, spp_default, arena);
   if (options.quality) {
     RunQualityStudy(scene, rig, *tracer, arena);
     RunLightQualityStudy(scene, rig, *tracer, arena);

@@ -19,6 +19,7 @@ struct RenderBenchOptions {
   bool quality = false;       // also measure aliasing: error vs. a 32-spp reference and shimmer
   bool breakdown = false;     // also time 1 spp without trilinear filtering and without textures
   std::string cycles_timing;  // timing.json of scenes/blender/time_cycles_vs_rovo.py: print the Cycles ratio
+  std::string against;        // a preset: print this scene's default-quality CPU per frame over that preset's
 };
 void RunRenderBenchmark(const RenderBenchOptions& options);
 

@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <thread>
@@ -165,6 +166,33 @@ TEST_F(RenderCliTest, SceneFolderRigJsonIsUsedAndPrinted) {
       << ReadFile(Path("e.log"));
   EXPECT_NE(ReadFile(Path("e.log")).find("rig: preset omnimvs4 (--rig)"), std::string::npos) << ReadFile(Path("e.log"));
   EXPECT_EQ(ReadDatasetInfo(Path("out_explicit")).rig.cameras[0].camera.width, 80);
+}
+
+// `rovo bench render --against PRESET` times both scenes' default render and prints the ratio; an
+// unknown preset is named.
+TEST_F(RenderCliTest, BenchRenderPrintsTheRatioAgainstAPreset) {
+  SaveScene(testing::MakeBoxScene(2, false), Path("scene"));
+  ASSERT_EQ(RunRovo({"bench", "render", "--scene", Path("scene"), "--frames", "2", "--scale", "0.25", "--threads", "2",
+                     "--against", "static_urban"},
+                    Path("b.log")),
+            0)
+      << ReadFile(Path("b.log"));
+  const std::string log = ReadFile(Path("b.log"));
+  const size_t at = log.find("against preset static_urban, frames in turn: ");
+  ASSERT_NE(at, std::string::npos) << log;
+  double mine = 0.0, reference = 0.0, ratio = 0.0;
+  ASSERT_EQ(
+      std::sscanf(log.c_str() + log.find(": ", at) + 2, "%lf / %lf CPU s/frame = %lfx", &mine, &reference, &ratio), 3)
+      << log;
+  EXPECT_GT(mine, 0.0);
+  EXPECT_GT(reference, 0.0);
+  EXPECT_NEAR(ratio, mine / reference, 0.05 * ratio + 0.01);
+
+  EXPECT_NE(RunRovo({"bench", "render", "--scene", Path("scene"), "--frames", "1", "--scale", "0.05", "--against",
+                     "no_such_preset"},
+                    Path("bad.log")),
+            0);
+  EXPECT_NE(ReadFile(Path("bad.log")).find("no_such_preset"), std::string::npos) << ReadFile(Path("bad.log"));
 }
 
 }  // namespace
