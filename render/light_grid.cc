@@ -116,7 +116,7 @@ void AppendBlocks(const std::vector<Tracer::Impl::ShadeLight>& lights, const uin
 }
 
 // Whether a sphere (centre v relative to a cone's apex, radius rho) meets the cone of unit axis `axis`
-// and half-angle alpha (cos_a, sin_a), alpha < 90 degrees (Eberly, "Intersection of a Sphere and a
+// and half-angle alpha (cos_a, sin_a), alpha <= 90 degrees (Eberly, "Intersection of a Sphere and a
 // Cone": the cone moved back by rho / sin(alpha) contains the sphere's centre, and the centre is not
 // behind the apex farther than rho).
 bool SphereMeetsCone(const Eigen::Vector3f& v, float rho, const Eigen::Vector3f& axis, float cos_a, float sin_a) {
@@ -129,15 +129,14 @@ bool SphereMeetsCone(const Eigen::Vector3f& v, float rho, const Eigen::Vector3f&
 }
 
 // Whether light l may reach some point of the axis-aligned box [lo, hi]: the box comes closer than
-// the range (exact), and for a spot, the box's bounding sphere meets the cone (conservative; spots
-// wider than a hemisphere are not culled, a hemisphere culls the half-space behind it).
+// the range (exact), and for a spot of up to 180 degrees, the box's bounding sphere meets the cone
+// (conservative); wider spots are not culled.
 bool LightMayReachBox(const Tracer::Impl::ShadeLight& l, const Eigen::Vector3f& lo, const Eigen::Vector3f& hi) {
   const Eigen::Vector3f gap = (lo - l.position).cwiseMax(l.position - hi).cwiseMax(0.0f);
   if (gap.squaredNorm() * l.inv_range2 >= 1.0f) return false;
   if (!l.spot || l.spot_cos < 0.0f) return true;
   const Eigen::Vector3f v = 0.5f * (lo + hi) - l.position;
   const float rho = 0.5001f * (hi - lo).norm();
-  if (l.spot_cos == 0.0f) return v.dot(l.spot_axis) + rho > 0.0f;
   return SphereMeetsCone(v, rho, l.spot_axis, l.spot_cos, std::sqrt(1.0f - l.spot_cos * l.spot_cos));
 }
 
@@ -167,7 +166,7 @@ void ForEachCellReached(const Tracer::Impl::LightGrid& g, const Tracer::Impl::Sh
 // lights' range spheres; a light is listed in the cells it may reach (LightMayReachBox). The lights
 // without a range form the unbounded blocks.
 void Tracer::Impl::BuildLightGrid() {
-  constexpr double kMaxCells = 1 << 22;
+  constexpr double kMaxCells = 1 << 20;
   LightGrid& g = light_grid;
   g = LightGrid();
   std::vector<float> ranges;
@@ -193,11 +192,15 @@ void Tracer::Impl::BuildLightGrid() {
   g.x0 = lo.x();
   g.y0 = lo.y();
   g.z0 = lo.z();
-  g.inv_cell = 1.0f / cell;
-  g.nx = std::max(1, static_cast<int>(std::ceil(extent.x() * g.inv_cell)));
-  g.ny = std::max(1, static_cast<int>(std::ceil(extent.y() * g.inv_cell)));
-  g.nz = std::max(1, static_cast<int>(std::ceil(extent.z() * g.inv_cell)));
-  // Two passes over the lights' discs: count, then fill a CSR list of light indices per cell.
+  // Larger cells until the rounded-up counts fit (a flat spread rounds its thin axis up to one cell).
+  for (;; cell *= 1.25f) {
+    g.inv_cell = 1.0f / cell;
+    g.nx = std::max(1, static_cast<int>(std::ceil(extent.x() * g.inv_cell)));
+    g.ny = std::max(1, static_cast<int>(std::ceil(extent.y() * g.inv_cell)));
+    g.nz = std::max(1, static_cast<int>(std::ceil(extent.z() * g.inv_cell)));
+    if (static_cast<double>(g.nx) * g.ny * g.nz <= kMaxCells) break;
+  }
+  // Two passes over the lights' spheres: count, then fill a CSR list of light indices per cell.
   const size_t num_cells = static_cast<size_t>(g.nx) * g.ny * g.nz;
   std::vector<uint32_t> begin(num_cells + 1, 0), items;
   for (int pass = 0; pass < 2; ++pass) {

@@ -116,10 +116,10 @@ inline __m128 LaneDirect(const LightBlock& b, int lane, const LitHit& hit, float
 
 // The lights that reach a hit, as lanes of their blocks (unlit lanes weigh 0).
 struct LitLights {
-  alignas(16) float weight[kMaxSampledLights];  // r + g + b of the unshadowed light
-  alignas(16) float geometry[kMaxSampledLights];
-  alignas(16) float specular[kMaxSampledLights];
-  const LightBlock* block[kMaxSampledLights / 4];
+  alignas(16) float weight[kMaxLightLanes];  // r + g + b of the unshadowed light
+  alignas(16) float geometry[kMaxLightLanes];
+  alignas(16) float specular[kMaxLightLanes];
+  const LightBlock* block[kMaxLightLanes / 4];
   int num_lanes = 0;
   float total = 0.0f;
   __m128 Direct(int j, const LitHit& hit) const {
@@ -127,15 +127,34 @@ struct LitLights {
   }
 };
 
-// Evaluates the blocks near the hit without branches into `lit`; lights beyond its capacity are
-// added to the pixel at once (V = 1).
+// Removes the blocks none of whose lanes lights the hit; false when there is none.
+bool DropUnlitBlocks(LitLights* lit) {
+  int kept = 0;
+  for (int b = 0; b < lit->num_lanes / 4; ++b) {
+    const float* w = lit->weight + 4 * b;
+    if (!(w[0] > 0.0f || w[1] > 0.0f || w[2] > 0.0f || w[3] > 0.0f)) continue;
+    if (kept != b) {
+      std::copy_n(lit->weight + 4 * b, 4, lit->weight + 4 * kept);
+      std::copy_n(lit->geometry + 4 * b, 4, lit->geometry + 4 * kept);
+      std::copy_n(lit->specular + 4 * b, 4, lit->specular + 4 * kept);
+      lit->block[kept] = lit->block[b];
+    }
+    ++kept;
+  }
+  const bool freed = 4 * kept < lit->num_lanes;
+  lit->num_lanes = 4 * kept;
+  return freed;
+}
+
+// Evaluates the blocks near the hit without branches into `lit`; when it is full, blocks that light
+// nothing make room, and lights beyond that are added to the pixel at once (V = 1).
 void GatherLitLights(const RenderJob& job, const LitHit& hit, int local, TileBuffers& tb, LitLights* lit) {
   __m128 total4 = _mm_setzero_ps();
   const LitHitX4 hit4(hit);
   ForEachBlockNear(job.d.light_grid, hit.x, [&](const LightBlock& b) {
     __m128 g, spec;
     const __m128 w = BlockWeights(b, hit4, &g, &spec);
-    if (lit->num_lanes == kMaxSampledLights) {
+    if (lit->num_lanes == kMaxLightLanes && !DropUnlitBlocks(lit)) {
       alignas(16) float gl[4], sl[4];
       _mm_store_ps(gl, g);
       _mm_store_ps(sl, spec);

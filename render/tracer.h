@@ -43,7 +43,8 @@
 // render/README.md) each sample casts one shadow ray instead, to a light drawn among those at or above
 // the share with probability p_i = w_i / sum w (inverse CDF in grid order at u = frac((s + 1/2) / spp
 // + r_p), r_p a hashed per-pixel offset: stratified over the pixel's samples), adding its term / p_i.
-// A hit reached by more than 64 lights adds the further ones without a shadow ray. Lights are found
+// Where more than 256 lights in the blocks near a hit (lit or not, after dropping blocks that light
+// nothing) would be ranked, the further ones are added without a shadow ray. Lights are found
 // through a 3-D grid of cubes listing the lights that may reach each cube (range sphere, spot cone);
 // lights without a range are tested at every hit. A material's emission (radiance) is added to every
 // hit on it. The sun term is skipped when sun_radiance is zero. A Blender point or spot lamp of power

@@ -26,8 +26,9 @@ constexpr int kTile = 8;
 constexpr int kTilePixels = kTile * kTile;
 constexpr float kInvPi = 0.318309886f;
 constexpr int kSunSamples = 64;  // points of the soft-shadow sun-disc sequence
-// ShadeSettings::sample_lights: lit lights a hit draws from; further ones are added without a shadow ray.
-constexpr int kMaxSampledLights = 64;
+// Lanes (lights of the blocks near a hit, lit or not) a hit ranks or draws from; blocks that light
+// nothing make room, and the lights beyond are added without a shadow ray.
+constexpr int kMaxLightLanes = 256;
 // A Blinn-Phong factor max(0, n.h)^m below this is taken as 0 (render/tracer.h).
 constexpr float kNegligibleHighlight = 1e-7f;
 

@@ -18,6 +18,7 @@
 #include "eval/bench/render_quality.h"
 #include "render/render.h"
 #include "render/tracer.h"
+#include "scenes/city.h"
 
 namespace rovo {
 namespace {
@@ -237,6 +238,7 @@ void PrintRatioAgainst(const RenderBenchOptions& options, BenchScene& main, int 
 
 void RunRenderBenchmark(const RenderBenchOptions& options) {
   if (options.frames < 1) throw std::invalid_argument("--frames: must be >= 1");
+  if (!options.against.empty()) FindScenePreset(options.against);  // an unknown name fails before the timing
   const double load_before = LoadAverage();
   const int spp_default = options.spp > 0 ? options.spp : kDefaultSpp;
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);

@@ -137,7 +137,8 @@ void RunLightQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tb
       {2, false, 0, 0.0f}, {2, true, 0, 0.0f},   {2, true, 0, 0.1f},  {4, false, 2, 0.1f}, {4, true, 0, 0.1f}};
   std::printf(
       "\npoint and spot lights: camera 0 of frame 0, %dx%d, reference %d spp with a shadow ray to every light in "
-      "reach; 8-bit units over valid pixels and channels; off > 8: share of values off by more than 8 codes\n",
+      "reach (up to 8 per hit); 8-bit units over valid pixels and channels; off > 8: share of values off by more than "
+      "8 codes\n",
       rays.width, rays.height, kReferenceSpp);
   std::printf(
       "| spp | shadow rays | share floor | mean abs error | off > 8 | CPU s/view |\n|---:|---|---:|---:|---:|---:|\n");

@@ -5,6 +5,7 @@
 
 #include <random>
 
+#include "render/tracer_internal.h"
 #include "tests/render/light_scene.h"
 
 namespace rovo {
@@ -104,6 +105,40 @@ struct FloorScene {
     scene.lights = {strong, weak};
   }
 };
+
+// 300 narrow spots without a range (every hit looks at all of them, 76 blocks, more than the lanes a
+// hit holds) and, last, a bright bulb straight above the occluder: the blocks that light nothing make
+// room, so the bulb is still ranked and its shadow cast.
+TEST(LightChoiceTest, ManyUnlitBlocksLeaveRoomForTheStrongestLight) {
+  Scene scene = DarkPlaneScene();
+  testing::AddOccluderCube(&scene);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int i = 0; i < 300; ++i) {
+    Light spot;
+    spot.name = "spot_" + std::to_string(i);
+    spot.position = Eigen::Vector3d(-5.0 + 10.0 * unit(rng), -5.0 + 10.0 * unit(rng), 2.0);
+    spot.intensity = Eigen::Vector3f(0.01f, 0.01f, 0.01f);
+    spot.spot = true;
+    spot.spot_angle_deg = 10.0;
+    spot.spot_direction = Eigen::Vector3d(0.0, 0.0, -1.0);
+    scene.lights.push_back(spot);
+  }
+  Light bulb;
+  bulb.name = "bulb";
+  bulb.position = Eigen::Vector3d(1.0, 0.0, 1.2);
+  bulb.intensity = Eigen::Vector3f(1.0f, 1.0f, 1.0f);
+  scene.lights.push_back(bulb);
+  ASSERT_GT(scene.lights.size(), static_cast<size_t>(tracer_internal::kMaxLightLanes));
+  Tracer tracer(scene);
+  ShadeSettings settings;
+  const Rendered shadowed = Render(tracer, settings);
+  settings.max_shadowed_lights = 0;
+  const Rendered unshadowed = Render(tracer, settings);
+  const Eigen::Vector3d in_shadow(1.0, 0.55, 0.0);
+  EXPECT_GT(RedAt(unshadowed, in_shadow), 30);
+  EXPECT_LT(RedAt(shadowed, in_shadow), RedAt(unshadowed, in_shadow) - 20) << "the bulb's shadow is cast";
+}
 
 TEST(LightChoiceTest, LightsBelowTheShareFloorGetNoShadowRay) {
   FloorScene f;
