@@ -208,7 +208,7 @@ float AddLightsBelowFloor(const RenderJob& job, const LitHit& hit, int local, Ti
 void AddStrongestLights(const RenderJob& job, const LitHit& hit, const Eigen::Vector3f& shadow_origin, float offset,
                         int local, LitLights& lit, TileBuffers& tb, int* num_shadow) {
   const int k_max = job.settings.shadows ? std::clamp(job.settings.max_shadowed_lights, 0, kMaxShadowedLights) : 0;
-  if (k_max > 0) AddLightsBelowFloor(job, hit, local, tb, &lit);
+  if (k_max > 0 && job.settings.min_shadowed_share > 0.0f) AddLightsBelowFloor(job, hit, local, tb, &lit);
   int best[kMaxShadowedLights];
   int num_best = 0;
   for (int j = 0; j < lit.num_lanes; ++j) {

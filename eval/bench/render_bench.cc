@@ -98,12 +98,52 @@ std::vector<BenchRow> BenchRows(int spp_default, bool breakdown) {
   return rows;
 }
 
-// Times every row over `frames` frames. Rows interleaved frame by frame (one untimed warm-up frame
+// A scene ready to time: the scene, its rig, the tracer and the camera rays at the default spp.
+struct BenchScene {
+  Scene scene;
+  Rig rig;
+  std::unique_ptr<Tracer> tracer;
+  RigCameraRays rays;
+  std::vector<CameraImage> images;  // RenderFrame's, reused
+  int frames = 0;
+  double scene_seconds = 0.0, rays_seconds = 0.0;
+};
+
+std::unique_ptr<BenchScene> LoadBenchScene(const RenderBenchOptions& options, const std::string& preset,
+                                           const std::string& scene_dir, int spp, tbb::task_arena& arena) {
+  auto b = std::make_unique<BenchScene>();
+  const auto t_scene = std::chrono::steady_clock::now();
+  b->scene = SceneForOptions(scene_dir.empty() ? preset : "", false, options.seed, scene_dir);
+  b->scene_seconds = Seconds(t_scene);
+  b->rig = RigForOptions("", b->scene, options.scale, scene_dir);
+  b->frames = std::min<int>(options.frames, static_cast<int>(b->scene.rig_trajectory.size()));
+  arena.execute([&] {
+    b->tracer = std::make_unique<Tracer>(b->scene);
+    const auto t = std::chrono::steady_clock::now();
+    std::vector<Camera> cameras;
+    for (const RigCamera& cam : b->rig.cameras) cameras.push_back(cam.camera);
+    b->rays = MakeCameraRays(cameras, 0, spp);
+    b->rays_seconds = Seconds(t);
+  });
+  return b;
+}
+
+// Renders frame f of `b` with every camera at `settings` into b.images (reused, as rovo render reuses
+// its buffers).
+void RenderFrame(BenchScene& b, const ShadeSettings& settings, int f, tbb::task_arena& arena) {
+  b.images.resize(b.rig.NumCameras());
+  arena.execute([&] {
+    b.tracer->SetFrame(f);
+    const Rigid3& world_from_rig = b.scene.rig_trajectory[f].world_from_rig;
+    for (int c = 0; c < b.rig.NumCameras(); ++c)
+      b.tracer->Render(*b.rays[c], world_from_rig * b.rig.cameras[c].cam_from_rig.Inverse(), settings, &b.images[c]);
+  });
+}
+
+// Times every row over b.frames frames. Rows interleaved frame by frame (one untimed warm-up frame
 // per row first), so that every row sees the same load on a shared machine and the ratios between
 // rows are robust to it.
-void TimeRows(const Scene& scene, const Rig& rig, const RigCameraRays& rays, Tracer& tracer, tbb::task_arena& arena,
-              int frames, std::vector<BenchRow>* rows) {
-  std::vector<CameraImage> images(rig.NumCameras());
+void TimeRows(BenchScene& b, tbb::task_arena& arena, std::vector<BenchRow>* rows) {
   auto settings_for = [](const BenchRow& row) {
     ShadeSettings settings;
     settings.spp = row.spp;
@@ -112,22 +152,14 @@ void TimeRows(const Scene& scene, const Rig& rig, const RigCameraRays& rays, Tra
     settings.trilinear = row.trilinear;
     return settings;
   };
-  auto render_frame = [&](const ShadeSettings& settings, int f) {
-    arena.execute([&] {
-      tracer.SetFrame(f);
-      const Rigid3& world_from_rig = scene.rig_trajectory[f].world_from_rig;
-      for (int c = 0; c < rig.NumCameras(); ++c)
-        tracer.Render(*rays[c], world_from_rig * rig.cameras[c].cam_from_rig.Inverse(), settings, &images[c]);
-    });
-  };
-  for (const BenchRow& row : *rows) render_frame(settings_for(row), 0);
-  for (int f = 0; f < frames; ++f) {
+  for (const BenchRow& row : *rows) RenderFrame(b, settings_for(row), 0, arena);
+  for (int f = 0; f < b.frames; ++f) {
     for (BenchRow& row : *rows) {
       const auto t = std::chrono::steady_clock::now();
       const double cpu0 = CpuSeconds();
-      render_frame(settings_for(row), f);
-      row.seconds_per_frame += Seconds(t) / frames;
-      row.cpu_seconds_per_frame += (CpuSeconds() - cpu0) / frames;
+      RenderFrame(b, settings_for(row), f, arena);
+      row.seconds_per_frame += Seconds(t) / b.frames;
+      row.cpu_seconds_per_frame += (CpuSeconds() - cpu0) / b.frames;
     }
   }
 }
@@ -171,46 +203,10 @@ void PrintRowTable(const std::vector<BenchRow>& rows, int64_t valid_pixels, int 
               spp_default, full_default.seconds_per_frame, full_default.cpu_seconds_per_frame);
 }
 
-// A scene ready to time: the scene, its rig, the tracer and the camera rays at the default spp.
-struct BenchScene {
-  Scene scene;
-  Rig rig;
-  std::unique_ptr<Tracer> tracer;
-  RigCameraRays rays;
-  std::vector<CameraImage> images;  // reused, as rovo render reuses its buffers
-  int frames = 0;
-  double scene_seconds = 0.0, rays_seconds = 0.0;
-};
-
-std::unique_ptr<BenchScene> LoadBenchScene(const RenderBenchOptions& options, const std::string& preset,
-                                           const std::string& scene_dir, int spp, tbb::task_arena& arena) {
-  auto b = std::make_unique<BenchScene>();
-  const auto t_scene = std::chrono::steady_clock::now();
-  b->scene = SceneForOptions(scene_dir.empty() ? preset : "", false, options.seed, scene_dir);
-  b->scene_seconds = Seconds(t_scene);
-  b->rig = RigForOptions("", b->scene, options.scale, scene_dir);
-  b->frames = std::min<int>(options.frames, static_cast<int>(b->scene.rig_trajectory.size()));
-  arena.execute([&] {
-    b->tracer = std::make_unique<Tracer>(b->scene);
-    const auto t = std::chrono::steady_clock::now();
-    std::vector<Camera> cameras;
-    for (const RigCamera& cam : b->rig.cameras) cameras.push_back(cam.camera);
-    b->rays = MakeCameraRays(cameras, 0, spp);
-    b->rays_seconds = Seconds(t);
-  });
-  return b;
-}
-
 // CPU seconds of rendering frame f of `b` at `settings` (all cameras).
 double FrameCpuSeconds(BenchScene& b, const ShadeSettings& settings, int f, tbb::task_arena& arena) {
-  b.images.resize(b.rig.NumCameras());
   const double cpu0 = CpuSeconds();
-  arena.execute([&] {
-    b.tracer->SetFrame(f);
-    const Rigid3& world_from_rig = b.scene.rig_trajectory[f].world_from_rig;
-    for (int c = 0; c < b.rig.NumCameras(); ++c)
-      b.tracer->Render(*b.rays[c], world_from_rig * b.rig.cameras[c].cam_from_rig.Inverse(), settings, &b.images[c]);
-  });
+  RenderFrame(b, settings, f, arena);
   return CpuSeconds() - cpu0;
 }
 
@@ -253,7 +249,7 @@ void RunRenderBenchmark(const RenderBenchOptions& options) {
   for (const auto& r : rays) valid_pixels += r->num_valid;
 
   std::vector<BenchRow> rows = BenchRows(spp_default, options.breakdown);
-  TimeRows(scene, rig, rays, *tracer, arena, frames, &rows);
+  TimeRows(*bench, arena, &rows);
   const double write_seconds_per_frame =
       options.write_dir.empty() ? -1.0 : TimeDatasetWriting(options, frames, spp_default);
 

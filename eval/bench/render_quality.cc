@@ -23,14 +23,28 @@ double MeanAbsDiff(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b,
   return n ? sum / n : 0.0;
 }
 
+// Camera 0 at frame 0: its rays (pixel centres; sample bearings are interpolated during the render)
+// and its pose.
+struct FirstView {
+  CameraRays rays;
+  Rigid3 world_from_cam;
+};
+
+FirstView FirstViewOf(const Scene& scene, const Rig& rig, tbb::task_arena& arena) {
+  FirstView view;
+  arena.execute([&] { view.rays = CameraRays::Make(rig.cameras[0].camera); });
+  view.world_from_cam = scene.rig_trajectory[0].world_from_rig * rig.cameras[0].cam_from_rig.Inverse();
+  return view;
+}
+
 }  // namespace
 
 void RunQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tbb::task_arena& arena) {
   constexpr int kSteps = 5;
   constexpr int kReferenceSpp = 32;
-  CameraRays rays;
-  arena.execute([&] { rays = CameraRays::Make(rig.cameras[0].camera); });
-  const Rigid3 world_from_cam = scene.rig_trajectory[0].world_from_rig * rig.cameras[0].cam_from_rig.Inverse();
+  const FirstView view = FirstViewOf(scene, rig, arena);
+  const CameraRays& rays = view.rays;
+  const Rigid3& world_from_cam = view.world_from_cam;
   const size_t centre = static_cast<size_t>(rays.height / 2) * rays.width + rays.width / 2;
   const double step_rad = 0.25 * rays.pixel_angle[centre];
   auto render_steps = [&](const ShadeSettings& settings) {
@@ -108,9 +122,9 @@ void RunQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tbb::ta
 void RunLightQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tbb::task_arena& arena) {
   if (scene.lights.empty()) return;
   constexpr int kReferenceSpp = 32;
-  CameraRays rays;
-  arena.execute([&] { rays = CameraRays::Make(rig.cameras[0].camera); });
-  const Rigid3 world_from_cam = scene.rig_trajectory[0].world_from_rig * rig.cameras[0].cam_from_rig.Inverse();
+  const FirstView view = FirstViewOf(scene, rig, arena);
+  const CameraRays& rays = view.rays;
+  const Rigid3& world_from_cam = view.world_from_cam;
   auto render = [&](const ShadeSettings& settings, double* cpu_seconds) {
     CameraImage image;
     const double cpu0 = CpuMs();
