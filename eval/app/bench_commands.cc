@@ -27,7 +27,9 @@ void AddRenderBenchCommand(CLI::App* bench) {
   cmd->add_option("--spp", options->spp, "Default-quality spp (0 = the default)");
   cmd->add_flag("--quality", options->quality,
                 "Also measure anti-aliasing per spp, sample pattern and texture filter: mean error vs. a 32-spp "
-                "reference and shimmer (frame-to-frame change not in the reference) over quarter-pixel pan steps");
+                "reference and shimmer (frame-to-frame change not in the reference) over quarter-pixel pan steps; on a "
+                "scene with point or spot lights also the light choice (strongest lights' shadow rays, share floor, "
+                "one drawn light per sample) against a reference that shadows every light in reach");
   cmd->add_flag("--breakdown", options->breakdown,
                 "Also time the 1-spp render with bilinear (single mip level) texturing and without textures");
   cmd->add_option("--cycles-timing", options->cycles_timing,
