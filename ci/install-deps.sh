@@ -1,27 +1,36 @@
 #!/usr/bin/env bash
 # Installs the Debian packages rovo needs. Idempotent: packages that are already present are left
 # alone, so a second run costs one dpkg query.
-# Usage: ci/install-deps.sh [demo|all]   (default all)
-#   demo: what building rovo and running `rovo demo` need (ci/demo.sh);
-#   all:  also what the tests use: lint tools, Blender (exporter and Cycles cross-checks), Chromium
-#         (report screenshots), Slurm (batch tests), COLMAP (the third-party system of the suite tests).
+# Usage: ci/install-deps.sh [build|plots|all]   (default all)
+#   build: what configuring and building rovo need (ci/demo.sh installs these before it builds). OpenCV
+#          comes as the six modules rovo uses, not libopencv-dev, which pulls every module (VTK, Qt);
+#          ccache is left out: a first build gains nothing from an empty cache.
+#   plots: Python's matplotlib, for the plots of report.html (ci/demo.sh installs it after the table).
+#   all:   build and plots, and what the tests use: ccache, lint tools, OpenImageIO's tools (fixtures),
+#          Blender (exporter and Cycles cross-checks), Chromium (report screenshots), Slurm (batch tests),
+#          COLMAP (the third-party system of the suite tests).
 set -euo pipefail
 what=${1:-all}
 
-PACKAGES=(
-  build-essential cmake ninja-build pkg-config git ccache
+BUILD=(
+  build-essential cmake ninja-build git
   libembree-dev libtbb-dev
-  libopenimageio-dev openimageio-tools
-  libopencv-dev
+  libopenimageio-dev
+  libopencv-core-dev libopencv-imgproc-dev libopencv-features2d-dev libopencv-video-dev libopencv-calib3d-dev
+  libopencv-imgcodecs-dev
   libeigen3-dev libceres-dev libopengv-dev
   nlohmann-json3-dev libyaml-cpp-dev libcli11-dev libfastcdr-dev zlib1g-dev libdeflate-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3 python3-matplotlib python3-numpy python3-yaml
 )
+PLOTS=(python3 python3-matplotlib)
 case "$what" in
-  demo) ;;
-  all) PACKAGES+=(clang-format clang-tidy blender chromium slurm-wlm munge colmap) ;;
-  *) echo "install-deps: unknown set '$what' (demo or all)" >&2; exit 2 ;;
+  build) PACKAGES=("${BUILD[@]}") ;;
+  plots) PACKAGES=("${PLOTS[@]}") ;;
+  all)
+    PACKAGES=("${BUILD[@]}" "${PLOTS[@]}" ccache pkg-config openimageio-tools python3-numpy python3-yaml
+              clang-format clang-tidy blender chromium slurm-wlm munge colmap)
+    ;;
+  *) echo "install-deps: unknown set '$what' (build, plots or all)" >&2; exit 2 ;;
 esac
 
 missing=()
