@@ -4,9 +4,10 @@
 # Usage: ci/install-deps.sh [build|plots|all]   (default all)
 #   build: what configuring and building rovo need (ci/demo.sh installs these before it builds). OpenCV
 #          comes as the six modules rovo uses, not libopencv-dev, which pulls every module (VTK, Qt);
-#          ccache is left out: a first build gains nothing from an empty cache.
+#          ccache is left out: a first build gains nothing from an empty cache. openimageio-tools is here
+#          because OpenImageIO's CMake package checks that its tools exist.
 #   plots: Python's matplotlib, for the plots of report.html (ci/demo.sh installs it after the table).
-#   all:   build and plots, and what the tests use: ccache, lint tools, OpenImageIO's tools (fixtures),
+#   all:   build and plots, and what the tests use: ccache, lint tools,
 #          Blender (exporter and Cycles cross-checks), Chromium (report screenshots), Slurm (batch tests),
 #          COLMAP (the third-party system of the suite tests).
 set -euo pipefail
@@ -15,7 +16,7 @@ what=${1:-all}
 BUILD=(
   build-essential cmake ninja-build git
   libembree-dev libtbb-dev
-  libopenimageio-dev
+  libopenimageio-dev openimageio-tools
   libopencv-core-dev libopencv-imgproc-dev libopencv-features2d-dev libopencv-video-dev libopencv-calib3d-dev
   libopencv-imgcodecs-dev
   libeigen3-dev libceres-dev libopengv-dev
@@ -27,7 +28,7 @@ case "$what" in
   build) PACKAGES=("${BUILD[@]}") ;;
   plots) PACKAGES=("${PLOTS[@]}") ;;
   all)
-    PACKAGES=("${BUILD[@]}" "${PLOTS[@]}" ccache pkg-config openimageio-tools python3-numpy python3-yaml
+    PACKAGES=("${BUILD[@]}" "${PLOTS[@]}" ccache pkg-config python3-numpy python3-yaml
               clang-format clang-tidy blender chromium slurm-wlm munge colmap)
     ;;
   *) echo "install-deps: unknown set '$what' (build, plots or all)" >&2; exit 2 ;;
