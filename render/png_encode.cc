@@ -25,25 +25,31 @@ void PutChunk(const char type[4], const void* data, size_t size, std::string* ou
   PutU32(static_cast<uint32_t>(libdeflate_crc32(0, out->data() + type_at, size + 4)), out);
 }
 
-// The filtered scanlines: per row the filter byte 2 ("Up": each byte minus the byte above it), then
-// the row's bytes (16-bit samples big-endian).
-std::vector<uint8_t> UpFiltered(int width, int height, int channels, int bit_depth, const void* pixels) {
+// A buffer that keeps its memory between calls of its thread: a view's buffers are the same size from
+// frame to frame, so their pages are mapped and touched once per thread, not once per image.
+uint8_t* Scratch(std::vector<uint8_t>* buffer, size_t size) {
+  if (buffer->size() < size) buffer->resize(size);
+  return buffer->data();
+}
+
+// The filtered scanlines into `filtered` (height * (row_bytes + 1) bytes): per row the filter byte 2
+// ("Up": each byte minus the byte above it), then the row's bytes (16-bit samples big-endian).
+void UpFiltered(int width, int height, int channels, int bit_depth, const void* pixels, uint8_t* filtered) {
   const size_t row_bytes = static_cast<size_t>(width) * channels * (bit_depth / 8);
-  std::vector<uint8_t> big_endian;
   const uint8_t* bytes = static_cast<const uint8_t*>(pixels);
   if (bit_depth == 16) {
+    static thread_local std::vector<uint8_t> big_endian_buffer;
+    uint8_t* big_endian = Scratch(&big_endian_buffer, static_cast<size_t>(height) * row_bytes);
     const uint16_t* in = static_cast<const uint16_t*>(pixels);
-    big_endian.resize(static_cast<size_t>(height) * row_bytes);
-    for (size_t i = 0; i < big_endian.size() / 2; ++i) {
+    for (size_t i = 0; i < static_cast<size_t>(height) * row_bytes / 2; ++i) {
       big_endian[2 * i] = static_cast<uint8_t>(in[i] >> 8);
       big_endian[2 * i + 1] = static_cast<uint8_t>(in[i]);
     }
-    bytes = big_endian.data();
+    bytes = big_endian;
   }
-  std::vector<uint8_t> filtered(static_cast<size_t>(height) * (row_bytes + 1));
   for (int y = 0; y < height; ++y) {
     const uint8_t* row = bytes + y * row_bytes;
-    uint8_t* out = filtered.data() + y * (row_bytes + 1);
+    uint8_t* out = filtered + y * (row_bytes + 1);
     out[0] = 2;
     if (y == 0) {
       std::memcpy(out + 1, row, row_bytes);
@@ -52,7 +58,6 @@ std::vector<uint8_t> UpFiltered(int width, int height, int channels, int bit_dep
     const uint8_t* above = row - row_bytes;
     for (size_t x = 0; x < row_bytes; ++x) out[1 + x] = static_cast<uint8_t>(row[x] - above[x]);
   }
-  return filtered;
 }
 
 struct CompressorDeleter {
@@ -69,14 +74,18 @@ std::string EncodePng(int width, int height, int channels, int bit_depth, const 
                                 std::to_string(height) + ", " + std::to_string(channels) + " channel(s) of " +
                                 std::to_string(bit_depth) + " bits");
   }
-  const std::vector<uint8_t> filtered = UpFiltered(width, height, channels, bit_depth, pixels);
+  const size_t filtered_size =
+      static_cast<size_t>(height) * (static_cast<size_t>(width) * channels * (bit_depth / 8) + 1);
+  static thread_local std::vector<uint8_t> filtered_buffer, zlib_buffer;
+  uint8_t* filtered = Scratch(&filtered_buffer, filtered_size);
+  UpFiltered(width, height, channels, bit_depth, pixels, filtered);
   // One compressor per thread: its tables are allocated once.
   static thread_local std::unique_ptr<libdeflate_compressor, CompressorDeleter> compressor(
       libdeflate_alloc_compressor(1));
   if (!compressor) throw std::runtime_error("EncodePng: libdeflate cannot allocate a compressor");
-  std::vector<uint8_t> zlib(libdeflate_zlib_compress_bound(compressor.get(), filtered.size()));
-  const size_t zlib_size =
-      libdeflate_zlib_compress(compressor.get(), filtered.data(), filtered.size(), zlib.data(), zlib.size());
+  const size_t zlib_bound = libdeflate_zlib_compress_bound(compressor.get(), filtered_size);
+  uint8_t* zlib = Scratch(&zlib_buffer, zlib_bound);
+  const size_t zlib_size = libdeflate_zlib_compress(compressor.get(), filtered, filtered_size, zlib, zlib_bound);
   if (zlib_size == 0) throw std::runtime_error("EncodePng: libdeflate's output exceeded its own bound");
   if (zlib_size > 0x7fffffffu)
     throw std::length_error("EncodePng: image data over PNG's chunk limit of 2^31 - 1 bytes");
@@ -93,7 +102,7 @@ std::string EncodePng(int width, int height, int channels, int bit_depth, const 
   PutChunk("IHDR", header, sizeof(header), &png);
   const std::string text = "Software" + std::string(1, '\0') + software;
   PutChunk("tEXt", text.data(), text.size(), &png);
-  PutChunk("IDAT", zlib.data(), zlib_size, &png);
+  PutChunk("IDAT", zlib, zlib_size, &png);
   PutChunk("IEND", nullptr, 0, &png);
   return png;
 }

@@ -15,6 +15,7 @@
 #include <optional>
 #include <stdexcept>
 #include <thread>
+#include <vector>
 
 #include "datasets/dataset.h"
 #include "datasets/io.h"
@@ -45,7 +46,8 @@ struct FrameJob {
   std::vector<CameraImage> images;
 };
 
-// Encodes and writes frames beside the tracer; at most `capacity` frames wait in memory.
+// Encodes and writes frames beside the tracer; at most kCapacity frames wait in memory, and as many
+// written ones are kept for the tracer to render into again (Reuse).
 class FrameWriter {
  public:
   FrameWriter(const std::string& out_dir, const Rig& rig, bool depth, bool masks, Progress* progress)
@@ -67,6 +69,16 @@ class FrameWriter {
     if (error_) std::rethrow_exception(error_);
     queue_.push_back(std::move(job));
     ready_.notify_one();
+  }
+
+  // A written frame's job, whose image buffers are allocated already (their pages stay mapped from
+  // frame to frame), or a new one.
+  FrameJob Reuse() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (written_.empty()) return FrameJob();
+    FrameJob job = std::move(written_.back());
+    written_.pop_back();
+    return job;
   }
 
   // Waits for all pending frames; rethrows a writer error.
@@ -108,6 +120,8 @@ class FrameWriter {
         return;
       }
       if (progress_) progress_->Add(1);
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (written_.size() < kCapacity) written_.push_back(std::move(job));
     }
   }
 
@@ -137,6 +151,7 @@ class FrameWriter {
   std::mutex mutex_;
   std::condition_variable ready_, space_;
   std::deque<FrameJob> queue_;
+  std::vector<FrameJob> written_;  // at most kCapacity, for Reuse
   bool closing_ = false;
   std::exception_ptr error_;
   std::thread thread_;
@@ -543,7 +558,7 @@ void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& r
     for (int f : todo) {
       const int traj_frame = begin + f;
       const Rigid3& world_from_rig = scene.rig_trajectory[traj_frame].world_from_rig;
-      FrameJob job;
+      FrameJob job = writer.Reuse();
       job.dataset_frame = f;
       job.images.resize(rig.NumCameras());
       arena.execute([&] {

@@ -1,5 +1,7 @@
 // The tracer's scene build: index checks, shading records, the static and dynamic Embree
 // scenes, and the placement of moving objects at a frame or over a frame's time window.
+#include <tbb/parallel_for.h>
+
 #include <chrono>
 
 #include "render/timing.h"
@@ -69,8 +71,9 @@ RTCGeometry Tracer::Impl::MakeTriangles(const Mesh& mesh, const Rigid3* world_fr
 // Textures, per-triangle shading records (UV-to-object area ratio; rigid transforms keep areas),
 // the per-object and per-material shading tables.
 void Tracer::Impl::BuildShadeRecords() {
-  textures.reserve(scene.textures.size());
-  for (const Texture& tex : scene.textures) textures.emplace_back(tex);
+  // Each texture's pyramid is built on its own: in parallel, with the same result on any thread count.
+  textures.resize(scene.textures.size());
+  tbb::parallel_for(size_t{0}, scene.textures.size(), [&](size_t i) { textures[i] = MipTexture(scene.textures[i]); });
 
   // Per-triangle shading records; UV-to-object area ratio (rigid transforms keep areas).
   mesh_shade.resize(scene.meshes.size());

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -14,6 +15,34 @@ float LinearToSrgb(float linear) {
   return linear <= 0.0031308f ? 12.92f * linear : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
 }
 
+namespace {
+
+// 16-bit linear r, g, b (x 1/65535) in one texel word: lround(y) for y = clamp(x) * 65535 in [0, 65535],
+// as y + 1/2 is exact in float (y < 2^16 has an ulp of at most 2^-8) and truncation rounds it down.
+uint64_t Pack(float r, float g, float b) {
+  auto q = [](float x) { return static_cast<uint64_t>(std::clamp(x, 0.0f, 1.0f) * 65535.0f + 0.5f); };
+  return q(r) | (q(g) << 16) | (q(b) << 32);
+}
+
+// The box-filtered reduction of a sw x sh level whose linear colour channel c at (x, y) is
+// source(x, y, c): the dst_w x dst_h level (odd sizes clamp the last row or column) as floats in `next`
+// (3 per texel) and packed by `put(x, y, texel)`.
+template <typename Source, typename Put>
+void Reduce(const Source& source, int sw, int sh, int dst_w, int dst_h, float* next, const Put& put) {
+  for (int y = 0; y < dst_h; ++y) {
+    const int y0 = std::min(2 * y, sh - 1), y1 = std::min(2 * y + 1, sh - 1);
+    for (int x = 0; x < dst_w; ++x) {
+      const int x0 = std::min(2 * x, sw - 1), x1 = std::min(2 * x + 1, sw - 1);
+      float* out = next + (static_cast<size_t>(y) * dst_w + x) * 3;
+      for (int c = 0; c < 3; ++c)
+        out[c] = 0.25f * (source(x0, y0, c) + source(x1, y0, c) + source(x0, y1, c) + source(x1, y1, c));
+      put(x, y, Pack(out[0], out[1], out[2]));
+    }
+  }
+}
+
+}  // namespace
+
 MipTexture::MipTexture(const Texture& texture) {
   if (texture.width <= 0 || texture.height <= 0 ||
       texture.rgb.size() != static_cast<size_t>(texture.width) * texture.height * 3) {
@@ -25,44 +54,39 @@ MipTexture::MipTexture(const Texture& texture) {
     throw std::invalid_argument("texture '" + texture.name + "': more than 2^31 texels (lookups use 32-bit indices)");
   float to_linear[256];
   for (int i = 0; i < 256; ++i) to_linear[i] = SrgbToLinear(i / 255.0f);
-  auto pack = [](float r, float g, float b) -> uint64_t {
-    auto q = [](float x) { return static_cast<uint64_t>(std::lround(std::clamp(x, 0.0f, 1.0f) * 65535.0f)); };
-    return q(r) | (q(g) << 16) | (q(b) << 32);
-  };
 
+  // Level 0 straight from the 8-bit texels; the reduced levels average linear floats, level 1 read
+  // through the table (no float copy of level 0).
   Level base;
   base.Allocate(texture.width, texture.height);
-  const size_t n = static_cast<size_t>(texture.width) * texture.height;
-  // Working copy of the current level in linear float (reduced levels are averaged from it).
-  std::vector<float> linear(n * 3);
-  for (size_t i = 0; i < n; ++i) {
-    for (int c = 0; c < 3; ++c) linear[3 * i + c] = to_linear[texture.rgb[3 * i + c]];
-    base.texels[base.Index(static_cast<int>(i % texture.width), static_cast<int>(i / texture.width))] =
-        pack(linear[3 * i], linear[3 * i + 1], linear[3 * i + 2]);
+  const uint8_t* rgb = texture.rgb.data();
+  for (int y = 0; y < texture.height; ++y) {
+    const uint8_t* row = rgb + static_cast<size_t>(y) * texture.width * 3;
+    const size_t row_offset = base.RowOffset(y);
+    for (int x = 0; x < texture.width; ++x) {
+      base.texels[row_offset + Level::ColumnOffset(x)] =
+          Pack(to_linear[row[3 * x]], to_linear[row[3 * x + 1]], to_linear[row[3 * x + 2]]);
+    }
   }
   levels_.push_back(std::move(base));
   texels_per_uv_ = std::sqrt(static_cast<float>(texture.width) * static_cast<float>(texture.height));
 
-  // Box-filtered reduction until 1x1.
+  // Box-filtered reduction until 1x1; `linear` holds the last reduced level (3 floats per texel).
+  std::unique_ptr<float[]> linear, next;
   while (levels_.back().width > 1 || levels_.back().height > 1) {
     const int sw = levels_.back().width, sh = levels_.back().height;
     Level dst;
     dst.Allocate(std::max(1, sw / 2), std::max(1, sh / 2));
-    std::vector<float> next(static_cast<size_t>(dst.width) * dst.height * 3);
-    for (int y = 0; y < dst.height; ++y) {
-      const int y0 = std::min(2 * y, sh - 1), y1 = std::min(2 * y + 1, sh - 1);
-      for (int x = 0; x < dst.width; ++x) {
-        const int x0 = std::min(2 * x, sw - 1), x1 = std::min(2 * x + 1, sw - 1);
-        const size_t o = static_cast<size_t>(y) * dst.width + x;
-        for (int c = 0; c < 3; ++c) {
-          const float sum = linear[(static_cast<size_t>(y0) * sw + x0) * 3 + c] +
-                            linear[(static_cast<size_t>(y0) * sw + x1) * 3 + c] +
-                            linear[(static_cast<size_t>(y1) * sw + x0) * 3 + c] +
-                            linear[(static_cast<size_t>(y1) * sw + x1) * 3 + c];
-          next[o * 3 + c] = 0.25f * sum;
-        }
-        dst.texels[dst.Index(x, y)] = pack(next[o * 3], next[o * 3 + 1], next[o * 3 + 2]);
-      }
+    next.reset(new float[static_cast<size_t>(dst.width) * dst.height * 3]);  // every value is written
+    auto put = [&dst](int x, int y, uint64_t texel) { dst.texels[dst.Index(x, y)] = texel; };
+    if (levels_.size() == 1) {
+      const int w = texture.width;
+      Reduce([&](int x, int y, int c) { return to_linear[rgb[(static_cast<size_t>(y) * w + x) * 3 + c]]; }, sw, sh,
+             dst.width, dst.height, next.get(), put);
+    } else {
+      const float* src = linear.get();
+      Reduce([&](int x, int y, int c) { return src[(static_cast<size_t>(y) * sw + x) * 3 + c]; }, sw, sh, dst.width,
+             dst.height, next.get(), put);
     }
     linear.swap(next);
     levels_.push_back(std::move(dst));
