@@ -3,7 +3,7 @@
 # alone, so a second run costs one dpkg query.
 # Usage: ci/install-deps.sh [build|plots|all]   (default all)
 #   build: what configuring and building rovo need (ci/demo.sh installs these before it builds). OpenCV
-#          comes as the six modules rovo uses, not libopencv-dev, which pulls every module (VTK, Qt);
+#          comes as the six modules rovo uses, not libopencv-dev, which pulls every module (VTK, contrib, dnn);
 #          ccache is left out: a first build gains nothing from an empty cache. openimageio-tools is here
 #          because OpenImageIO's CMake package checks that its tools exist.
 #   plots: Python's matplotlib, for the plots of report.html (ci/demo.sh installs it after the table).

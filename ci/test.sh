@@ -6,6 +6,11 @@
 # Set ROVO_SKIP_SANITIZERS=1 to run the unit tests on the Release build instead.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# The demo's package set (ci/demo.sh builds with nothing else) must be enough to configure the project: on a new
+# machine this configure runs before the test tools are installed.
+bash ci/install-deps.sh build
+cmake -S . -B build-setup-check -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+rm -rf build-setup-check
 bash ci/install-deps.sh
 if [ "${ROVO_SKIP_SANITIZERS:-0}" = "1" ]; then
   bash ci/build.sh

@@ -17,10 +17,14 @@ float LinearToSrgb(float linear) {
 
 namespace {
 
-// 16-bit linear r, g, b (x 1/65535) in one texel word: lround(y) for y = clamp(x) * 65535 in [0, 65535],
-// as y + 1/2 is exact in float (y < 2^16 has an ulp of at most 2^-8) and truncation rounds it down.
+// 16-bit linear r, g, b (x 1/65535) in one texel word: lround(y) for the float y = clamp(x) * 65535 in
+// [0, 65535], without the library call. y + 1/2 in double is exact wherever it could reach an integer (a
+// float below 1/2 is at most 1/2 - 2^-25), so truncating it rounds half away from zero as lround does.
 uint64_t Pack(float r, float g, float b) {
-  auto q = [](float x) { return static_cast<uint64_t>(std::clamp(x, 0.0f, 1.0f) * 65535.0f + 0.5f); };
+  auto q = [](float x) {
+    const float y = std::clamp(x, 0.0f, 1.0f) * 65535.0f;
+    return static_cast<uint64_t>(static_cast<double>(y) + 0.5);  // NOLINT(bugprone-incorrect-roundings): above
+  };
   return q(r) | (q(g) << 16) | (q(b) << 32);
 }
 
