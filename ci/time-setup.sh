@@ -14,10 +14,11 @@ root="$work/root"
 mkdir -p "$root"
 debootstrap --variant=minbase bookworm "$root" http://deb.debian.org/debian >"$work/debootstrap.log"
 cp /etc/resolv.conf "$root/etc/"
+# Only /proc is mounted: the root's own /dev (debootstrap's device nodes) is enough, and no bind mount of the
+# host's /dev can be left behind for a later `rm -rf WORK` to walk into. (apt says it cannot write its log
+# without /dev/pts; harmless.)
 mount -t proc proc "$root/proc"
-mount --rbind /dev "$root/dev"
-mount --make-rslave "$root/dev"
-trap 'umount -R "$root/dev"; umount "$root/proc"' EXIT
+trap 'umount "$root/proc"' EXIT
 export DEBIAN_FRONTEND=noninteractive
 chroot "$root" apt-get update -qq
 chroot "$root" apt-get install -y -qq --no-install-recommends build-essential cmake git libgtest-dev libgmock-dev \
