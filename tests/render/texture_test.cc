@@ -71,6 +71,39 @@ TEST(MipTextureTest, PyramidSizesAndBoxFilterPreservesMean) {
   EXPECT_NEAR(mip.Texel(0, 3, 2).z(), 0.0f, 1e-6f);
 }
 
+// The stored 16-bit code of a texel channel (Texel returns code / 65535).
+long Code(float value) { return std::lround(value * 65535.0f); }
+
+TEST(MipTextureTest, TexelsAreLinearValuesRoundedTo16BitCodes) {
+  // Level 0: every 8-bit code, decoded and rounded to 16 bits as lround does; level 1: each texel the float
+  // mean of its 2x2 parents, rounded the same way.
+  Texture tex;
+  tex.name = "codes";
+  tex.width = 256;
+  tex.height = 2;
+  tex.rgb.resize(256 * 2 * 3);
+  for (int x = 0; x < 256; ++x)
+    for (int c = 0; c < 3; ++c) {
+      tex.rgb[x * 3 + c] = static_cast<uint8_t>(x);
+      tex.rgb[(256 + x) * 3 + c] = static_cast<uint8_t>(255 - (x * 7 + c * 31) % 256);
+    }
+  const MipTexture mip(tex);
+  auto linear = [&](int x, int y, int c) { return SrgbToLinear(tex.rgb[(y * 256 + x) * 3 + c] / 255.0f); };
+  for (int x = 0; x < 256; ++x) {
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_EQ(Code(mip.Texel(0, x, 0)[c]), Code(linear(x, 0, c))) << "code " << x;
+      ASSERT_EQ(Code(mip.Texel(0, x, 1)[c]), Code(linear(x, 1, c))) << "column " << x;
+    }
+  }
+  for (int x = 0; x < 128; ++x) {
+    for (int c = 0; c < 3; ++c) {
+      const float mean =
+          0.25f * (linear(2 * x, 0, c) + linear(2 * x + 1, 0, c) + linear(2 * x, 1, c) + linear(2 * x + 1, 1, c));
+      ASSERT_EQ(Code(mip.Texel(1, x, 0)[c]), Code(mean)) << "level-1 column " << x;
+    }
+  }
+}
+
 TEST(MipTextureTest, BilinearHitsTexelCentresInterpolatesAndWraps) {
   const MipTexture mip(Gradient(8, 8));
   for (int y = 0; y < 8; ++y)
