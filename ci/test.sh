@@ -9,6 +9,7 @@ cd "$(dirname "$0")/.."
 # The demo's package set (ci/demo.sh builds with nothing else) must be enough to configure the project: on a new
 # machine this configure runs before the test tools are installed.
 bash ci/install-deps.sh build
+rm -rf build-setup-check
 cmake -S . -B build-setup-check -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 rm -rf build-setup-check
 bash ci/install-deps.sh

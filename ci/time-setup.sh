@@ -18,7 +18,7 @@ cp /etc/resolv.conf "$root/etc/"
 # host's /dev can be left behind for a later `rm -rf WORK` to walk into. (apt says it cannot write its log
 # without /dev/pts; harmless.)
 mount -t proc proc "$root/proc"
-trap 'umount "$root/proc"' EXIT
+trap 'umount "$root/proc" || umount -l "$root/proc"' EXIT
 export DEBIAN_FRONTEND=noninteractive
 chroot "$root" apt-get update -qq
 chroot "$root" apt-get install -y -qq --no-install-recommends build-essential cmake git libgtest-dev libgmock-dev \

@@ -3,6 +3,8 @@
 #include <tbb/parallel_for.h>
 
 #include <chrono>
+#include <exception>
+#include <vector>
 
 #include "render/timing.h"
 #include "render/tracer_internal.h"
@@ -71,9 +73,20 @@ RTCGeometry Tracer::Impl::MakeTriangles(const Mesh& mesh, const Rigid3* world_fr
 // Textures, per-triangle shading records (UV-to-object area ratio; rigid transforms keep areas),
 // the per-object and per-material shading tables.
 void Tracer::Impl::BuildShadeRecords() {
-  // Each texture's pyramid is built on its own: in parallel, with the same result on any thread count.
-  textures.resize(scene.textures.size());
-  tbb::parallel_for(size_t{0}, scene.textures.size(), [&](size_t i) { textures[i] = MipTexture(scene.textures[i]); });
+  // Each texture's pyramid is built on its own: in parallel, with the same result on any thread count
+  // (and the same error: the first bad texture's).
+  const size_t num_textures = scene.textures.size();
+  textures.resize(num_textures);
+  std::vector<std::exception_ptr> errors(num_textures);
+  tbb::parallel_for(size_t{0}, num_textures, [&](size_t i) {
+    try {
+      textures[i] = MipTexture(scene.textures[i]);
+    } catch (...) {
+      errors[i] = std::current_exception();
+    }
+  });
+  for (const std::exception_ptr& error : errors)
+    if (error) std::rethrow_exception(error);
 
   // Per-triangle shading records; UV-to-object area ratio (rigid transforms keep areas).
   mesh_shade.resize(scene.meshes.size());
