@@ -32,10 +32,10 @@ uint8_t* Scratch(std::vector<uint8_t>* buffer, size_t size) {
   return buffer->data();
 }
 
-// The filtered scanlines into `filtered` (height * (row_bytes + 1) bytes): per row the filter byte 2
-// ("Up": each byte minus the byte above it), then the row's bytes (16-bit samples big-endian).
-void UpFiltered(int width, int height, int channels, int bit_depth, const void* pixels, uint8_t* filtered) {
-  const size_t row_bytes = static_cast<size_t>(width) * channels * (bit_depth / 8);
+// The filtered scanlines of `height` rows of `row_bytes` into `filtered` (height * (row_bytes + 1) bytes): per
+// row the filter byte 2 ("Up": each byte minus the byte above it), then the row's bytes (16-bit samples
+// big-endian).
+void UpFiltered(size_t row_bytes, int height, int bit_depth, const void* pixels, uint8_t* filtered) {
   const uint8_t* bytes = static_cast<const uint8_t*>(pixels);
   if (bit_depth == 16) {
     static thread_local std::vector<uint8_t> big_endian_buffer;
@@ -74,11 +74,11 @@ std::string EncodePng(int width, int height, int channels, int bit_depth, const 
                                 std::to_string(height) + ", " + std::to_string(channels) + " channel(s) of " +
                                 std::to_string(bit_depth) + " bits");
   }
-  const size_t filtered_size =
-      static_cast<size_t>(height) * (static_cast<size_t>(width) * channels * (bit_depth / 8) + 1);
+  const size_t row_bytes = static_cast<size_t>(width) * channels * (bit_depth / 8);
+  const size_t filtered_size = static_cast<size_t>(height) * (row_bytes + 1);
   static thread_local std::vector<uint8_t> filtered_buffer, zlib_buffer;
   uint8_t* filtered = Scratch(&filtered_buffer, filtered_size);
-  UpFiltered(width, height, channels, bit_depth, pixels, filtered);
+  UpFiltered(row_bytes, height, bit_depth, pixels, filtered);
   // One compressor per thread: its tables are allocated once.
   static thread_local std::unique_ptr<libdeflate_compressor, CompressorDeleter> compressor(
       libdeflate_alloc_compressor(1));
