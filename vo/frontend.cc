@@ -1,6 +1,8 @@
 #include "vo/frontend.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -289,9 +291,16 @@ void Frontend::Impl::RunViewStages(const std::vector<cv::Mat>& fisheye_images, V
       start = now;
     };
     fisheye_gray[i] = ToGray(fisheye_images[i], i);
-    // A fresh buffer: the tracker still holds the previous warped image (warped[i] shares it).
-    cv::Mat warped_image;
-    projections[i].Warp(fisheye_gray[i], &warped_image);
+    // A fresh buffer: the tracker still holds the previous warped image (warped[i] shares it). Warped
+    // in bands of rows (cheaper, HybridProjection::kWarpBandRows), which a worker done with its own
+    // views can take part in (isolated: this thread takes no other view's work while it waits).
+    cv::Mat warped_image(projections[i].height(), projections[i].width(), fisheye_gray[i].type());
+    tbb::this_task_arena::isolate([&] {
+      tbb::parallel_for(tbb::blocked_range<int>(0, warped_image.rows, HybridProjection::kWarpBandRows),
+                        [&](const tbb::blocked_range<int>& rows) {
+                          projections[i].WarpRows(fisheye_gray[i], rows.begin(), rows.end(), &warped_image);
+                        });
+    });
     warped[i] = warped_image;
     lap(kWarp);
     trackers[i].Track(warped[i], view_masks[i]);

@@ -341,13 +341,34 @@ void HybridProjection::BuildMaps() {
   cv::convertMaps(map_x_, map_y_, map_fixed_, map_frac_, CV_16SC2);
 }
 
-void HybridProjection::Warp(const cv::Mat& fisheye, cv::Mat* warped) const {
-  if (fisheye.cols != camera_.width || fisheye.rows != camera_.height) {
+namespace {
+
+void CheckFisheyeSize(const cv::Mat& fisheye, const Camera& camera) {
+  if (fisheye.cols != camera.width || fisheye.rows != camera.height) {
     throw std::invalid_argument("hybrid projection: image is " + std::to_string(fisheye.cols) + "x" +
-                                std::to_string(fisheye.rows) + ", camera is " + std::to_string(camera_.width) + "x" +
-                                std::to_string(camera_.height));
+                                std::to_string(fisheye.rows) + ", camera is " + std::to_string(camera.width) + "x" +
+                                std::to_string(camera.height));
   }
+}
+
+}  // namespace
+
+void HybridProjection::Warp(const cv::Mat& fisheye, cv::Mat* warped) const {
+  CheckFisheyeSize(fisheye, camera_);
   cv::remap(fisheye, *warped, map_fixed_, map_frac_, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+}
+
+void HybridProjection::WarpRows(const cv::Mat& fisheye, int first_row, int last_row, cv::Mat* warped) const {
+  CheckFisheyeSize(fisheye, camera_);
+  if (warped->rows != height_ || warped->cols != width_ || warped->type() != fisheye.type()) {
+    throw std::invalid_argument(
+        "hybrid projection: WarpRows needs a warped image of the projection's size and the "
+        "fisheye's type");
+  }
+  if (first_row < 0 || last_row > height_ || first_row >= last_row) return;
+  cv::Mat band = warped->rowRange(first_row, last_row);
+  cv::remap(fisheye, band, map_fixed_.rowRange(first_row, last_row), map_frac_.rowRange(first_row, last_row),
+            cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
 }
 
 }  // namespace rovo

@@ -3,11 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 #include <stdexcept>
 #include <string>
+
+#include "vo/patch_kernels.h"
 
 namespace rovo {
 
@@ -105,14 +106,12 @@ namespace {
 //   zncc = (n S_ab - S_a S_b) / sqrt((n S_aa - S_a^2) (n S_bb - S_b^2)),  n = patch_px^2.
 struct ReferencePatch {
   std::vector<uint8_t> values;  // row-major
-  // For side <= kSimdSide: the values as int16 in rows of kSimdSide, zero beyond `side` (the SIMD form).
+  // For side <= kPatchRowPixels: the values as int16 in rows of kPatchRowPixels, zero beyond `side` (the
+  // form PatchSumsAgainst takes).
   std::vector<int16_t> padded;
   int side = 0;
   int64_t sum = 0, variance_n2 = 0;  // S_a and n S_aa - S_a^2
 };
-
-// Patch rows up to this many pixels take one 16-byte load each (OpenCV's universal intrinsics).
-constexpr int kSimdSide = 16;
 
 // Top-left corner of the patch around the nearest pixel of p; false when the patch leaves the image.
 bool PatchCorner(const cv::Mat& image, const Eigen::Vector2d& p, int side, int* x0, int* y0) {
@@ -147,10 +146,10 @@ bool LoadReference(const cv::Mat& image, const Eigen::Vector2d& p, int side, Ref
   patch->sum = sum;
   patch->variance_n2 = n * sum2 - sum * sum;
   patch->padded.clear();
-  if (side <= kSimdSide) {
-    patch->padded.assign(static_cast<size_t>(side) * kSimdSide, 0);
+  if (side <= kPatchRowPixels) {
+    patch->padded.assign(static_cast<size_t>(side) * kPatchRowPixels, 0);
     for (int r = 0; r < side; ++r) {
-      std::copy_n(patch->values.data() + r * side, side, patch->padded.data() + r * kSimdSide);
+      std::copy_n(patch->values.data() + r * side, side, patch->padded.data() + r * kPatchRowPixels);
     }
   }
   return !Flat(patch->variance_n2, n);
@@ -163,33 +162,13 @@ std::optional<double> ZnccWithReference(const ReferencePatch& reference, const c
   const int side = reference.side;
   int x0, y0;
   if (!PatchCorner(image, p, side, &x0, &y0)) return std::nullopt;
-  int32_t ab = 0, sb = 0, sb2 = 0;  // at most 121 * 255^2 < 2^23 for an 11 px patch
-#if CV_SIMD128
-  if (!reference.padded.empty() && x0 + kSimdSide <= image.cols) {
-    // One 16-byte load per row, the bytes beyond `side` masked to zero (the reference's padding is
-    // zero too): the same integer sums as the scalar loop below. Per lane at most 16 rows * 4 * 255^2
-    // < 2^31 (products) and 16 rows * 2 * 255 < 2^16 (sums).
-    static const uint8_t kMask[2 * kSimdSide] = {255, 255, 255, 255, 255, 255, 255, 255,
-                                                 255, 255, 255, 255, 255, 255, 255, 255};  // then 16 zeros
-    const cv::v_uint8x16 keep = cv::v_load(kMask + kSimdSide - side);                      // `side` bytes 255, then 0
-    cv::v_int32x4 ab4 = cv::v_setzero_s32(), bb4 = cv::v_setzero_s32();
-    cv::v_uint16x8 sum8 = cv::v_setzero_u16();
-    const int16_t* a = reference.padded.data();
-    for (int r = 0; r < side; ++r, a += kSimdSide) {
-      const cv::v_uint8x16 b = cv::v_load(image.ptr<uint8_t>(y0 + r) + x0) & keep;
-      cv::v_uint16x8 lo, hi;
-      cv::v_expand(b, lo, hi);
-      const cv::v_int16x8 slo = cv::v_reinterpret_as_s16(lo), shi = cv::v_reinterpret_as_s16(hi);
-      ab4 += cv::v_dotprod(slo, cv::v_load(a)) + cv::v_dotprod(shi, cv::v_load(a + 8));
-      bb4 += cv::v_dotprod(slo, slo) + cv::v_dotprod(shi, shi);
-      sum8 += lo + hi;
-    }
-    ab = cv::v_reduce_sum(ab4);
-    sb2 = cv::v_reduce_sum(bb4);
-    sb = static_cast<int32_t>(cv::v_reduce_sum(sum8));
-  } else
-#endif
-  {
+  int32_t ab = 0, sb = 0, sb2 = 0;  // at most 45^2 * 255^2 < 2^31
+  if (!reference.padded.empty() && x0 + kPatchRowPixels <= image.cols) {
+    const PatchSums sums = PatchSumsAgainst(reference.padded.data(), image, x0, y0, side);
+    ab = sums.ab;
+    sb = sums.b;
+    sb2 = sums.bb;
+  } else {
     const uint8_t* a = reference.values.data();
     for (int r = 0; r < side; ++r, a += side) {
       const uint8_t* row = image.ptr<uint8_t>(y0 + r) + x0;

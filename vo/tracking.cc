@@ -1,5 +1,9 @@
 #include "vo/tracking.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -8,6 +12,8 @@
 #include <opencv2/video/tracking.hpp>
 #include <stdexcept>
 #include <string>
+
+#include "vo/patch_kernels.h"
 
 namespace rovo {
 
@@ -28,8 +34,6 @@ void TrackerOptions::Check() const {
   require(border_px >= 0, "border_px must be >= 0");
 }
 namespace {
-
-constexpr int kOrbPatchRadius = 15;
 
 // Square-grid occupancy for the minimum-distance rule: cell side = min distance / sqrt(2), so one
 // point per cell and a check of the 5x5 cell neighbourhood is exact.
@@ -89,41 +93,9 @@ cv::Mat DetectionMask(const cv::Mat& mask, int border) {
 }  // namespace
 
 float IntensityCentroidAngleDeg(const cv::Mat& image, cv::Point2f px) {
-  // Half-width of the disc per row offset, computed once.
-  static const std::array<int, kOrbPatchRadius + 1> kHalf = [] {
-    std::array<int, kOrbPatchRadius + 1> half{};
-    for (int dy = 0; dy <= kOrbPatchRadius; ++dy) {
-      half[dy] = static_cast<int>(std::sqrt(double(kOrbPatchRadius * kOrbPatchRadius - dy * dy)));
-    }
-    return half;
-  }();
   const int cx = static_cast<int>(std::lround(px.x)), cy = static_cast<int>(std::lround(px.y));
-  const bool inside = cx >= kOrbPatchRadius && cy >= kOrbPatchRadius && cx + kOrbPatchRadius < image.cols &&
-                      cy + kOrbPatchRadius < image.rows;
-  int64_t m01 = 0, m10 = 0;
-  for (int dy = -kOrbPatchRadius; dy <= kOrbPatchRadius; ++dy) {
-    const int y = cy + dy;
-    if (y < 0 || y >= image.rows) continue;
-    const uint8_t* row = image.ptr<uint8_t>(y);
-    const int half = kHalf[std::abs(dy)];
-    int64_t row_sum = 0, row_moment = 0;
-    if (inside) {
-      for (int dx = -half; dx <= half; ++dx) {
-        row_sum += row[cx + dx];
-        row_moment += static_cast<int64_t>(dx) * row[cx + dx];
-      }
-    } else {
-      for (int dx = -half; dx <= half; ++dx) {
-        const int x = cx + dx;
-        if (x < 0 || x >= image.cols) continue;
-        row_sum += row[x];
-        row_moment += static_cast<int64_t>(dx) * row[x];
-      }
-    }
-    m10 += row_moment;
-    m01 += dy * row_sum;
-  }
-  float angle = static_cast<float>(std::atan2(static_cast<double>(m01), static_cast<double>(m10)) * 180.0 / M_PI);
+  const DiscMoments m = DiscMomentsAt(image, cx, cy);
+  float angle = static_cast<float>(std::atan2(static_cast<double>(m.m01), static_cast<double>(m.m10)) * 180.0 / M_PI);
   if (angle < 0) angle += 360.0f;
   return angle;
 }
@@ -154,6 +126,33 @@ void ViewTracker::ResetImage(const cv::Mat& image, const cv::Mat& mask, std::vec
 
 namespace {
 
+// Points per cv::calcOpticalFlowPyrLK call in PyrLkInChunks.
+constexpr size_t kLkChunk = 64;
+
+// cv::calcOpticalFlowPyrLK of `from` into `to` (its start when flags has OPTFLOW_USE_INITIAL_FLOW), in
+// chunks of points under TBB. LK tracks every point on its own, so the results are those of one call;
+// the chunks let a worker that has finished its own views take part of this view's pass.
+void PyrLkInChunks(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
+                   const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to, std::vector<uint8_t>* status,
+                   cv::Size window, int levels, const cv::TermCriteria& criteria, int flags) {
+  const size_t n = from.size();
+  to->resize(n);
+  status->assign(n, 0);
+  // Isolated: while it waits for its chunks, this thread takes no other view's work.
+  tbb::this_task_arena::isolate([&] {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kLkChunk), [&](const tbb::blocked_range<size_t>& range) {
+      const auto first = static_cast<std::ptrdiff_t>(range.begin()), last = static_cast<std::ptrdiff_t>(range.end());
+      const std::vector<cv::Point2f> chunk_from(from.begin() + first, from.begin() + last);
+      std::vector<cv::Point2f> chunk_to(to->begin() + first, to->begin() + last);
+      std::vector<uint8_t> chunk_status;
+      cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, chunk_from, chunk_to, chunk_status, cv::noArray(), window,
+                               levels, criteria, flags);
+      std::copy(chunk_to.begin(), chunk_to.end(), to->begin() + first);
+      std::copy(chunk_status.begin(), chunk_status.end(), status->begin() + first);
+    });
+  });
+}
+
 // KLT rounds from the previous image's pyramid into the current one, for ViewTracker::Track.
 struct KltPass {
   const std::vector<cv::Mat>& previous_pyramid;
@@ -175,8 +174,8 @@ struct KltPass {
     previous.reserve(which.size());
     for (int i : which) previous.push_back(points[i].px);
     std::vector<uint8_t> status_fw, status_bw;
-    cv::calcOpticalFlowPyrLK(previous_pyramid, pyramid, previous, forward, status_fw, cv::noArray(), window, levels,
-                             criteria, guided ? cv::OPTFLOW_USE_INITIAL_FLOW : 0);
+    PyrLkInChunks(previous_pyramid, pyramid, previous, &forward, &status_fw, window, levels, criteria,
+                  guided ? cv::OPTFLOW_USE_INITIAL_FLOW : 0);
     std::vector<int> candidates, lost;
     std::vector<cv::Point2f> forward_ok, backward;
     for (size_t k = 0; k < which.size(); ++k) {
@@ -188,8 +187,7 @@ struct KltPass {
       forward_ok.push_back(forward[k]);
     }
     if (!candidates.empty()) {
-      cv::calcOpticalFlowPyrLK(pyramid, previous_pyramid, forward_ok, backward, status_bw, cv::noArray(), window,
-                               check_levels, criteria);
+      PyrLkInChunks(pyramid, previous_pyramid, forward_ok, &backward, &status_bw, window, check_levels, criteria, 0);
     }
     for (size_t c = 0; c < candidates.size(); ++c) {
       const int k = candidates[c];
@@ -222,6 +220,22 @@ std::vector<TrackedPoint> SpacedOut(std::vector<TrackedPoint> kept, int width, i
     spaced.push_back(std::move(p));
   }
   return spaced;
+}
+
+// Indices of the corners, strongest response first. std::sort of (response, index) pairs under a
+// comparison of the responses alone makes the same comparisons, and so the same order, as sorting the
+// key points themselves, with an eighth of the data to move.
+std::vector<int> ByResponse(const std::vector<cv::KeyPoint>& corners) {
+  struct Entry {
+    float response;
+    int index;
+  };
+  std::vector<Entry> entries(corners.size());
+  for (size_t k = 0; k < corners.size(); ++k) entries[k] = {corners[k].response, static_cast<int>(k)};
+  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) { return a.response > b.response; });
+  std::vector<int> order(entries.size());
+  for (size_t k = 0; k < entries.size(); ++k) order[k] = entries[k].index;
+  return order;
 }
 
 }  // namespace
@@ -275,15 +289,15 @@ void ViewTracker::DetectAndDescribe(const std::function<uint64_t()>& next_id) {
   if (static_cast<int>(points_.size()) < options_.target_features) {
     std::vector<cv::KeyPoint> corners;
     cv::FAST(image_, corners, options_.fast_threshold, true, cv::FastFeatureDetector::TYPE_9_16);
-    std::sort(corners.begin(), corners.end(),
-              [](const cv::KeyPoint& a, const cv::KeyPoint& b) { return a.response > b.response; });
+    const std::vector<int> strongest_first = ByResponse(corners);
     OccupancyGrid grid(image_.cols, image_.rows, options_.min_feature_distance_px);
     for (const TrackedPoint& p : points_) grid.Add(p.px);
     const size_t limit =
         points_.empty() || options_.max_new_per_frame <= 0
             ? options_.target_features
             : std::min(options_.target_features, static_cast<int>(points_.size()) + options_.max_new_per_frame);
-    for (const cv::KeyPoint& kp : corners) {
+    for (const int c : strongest_first) {
+      const cv::KeyPoint& kp = corners[c];
       if (points_.size() >= limit) break;
       if (!MaskAt(detect_mask_, kp.pt) || !grid.Free(kp.pt)) continue;
       grid.Add(kp.pt);

@@ -72,9 +72,14 @@ class Floor {
       (*ms)[stage] += now - start;
       start = now;
     };
-    cv::Mat warped;
-    cv::remap(fisheye, warped, projection.map_fixed(), projection.map_frac(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
-              cv::Scalar::all(0));
+    // cv::remap in bands of rows, as the front-end calls it (HybridProjection::kWarpBandRows).
+    cv::Mat warped(projection.height(), projection.width(), fisheye.type());
+    for (int first = 0; first < warped.rows; first += HybridProjection::kWarpBandRows) {
+      const int last = std::min(first + HybridProjection::kWarpBandRows, warped.rows);
+      cv::Mat band = warped.rowRange(first, last);
+      cv::remap(fisheye, band, projection.map_fixed().rowRange(first, last),
+                projection.map_frac().rowRange(first, last), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+    }
     lap(kWarp);
     const cv::Size window(options_.klt_window_px, options_.klt_window_px);
     std::swap(view->pyramid, view->previous_pyramid);

@@ -7,7 +7,7 @@ namespace rovo {
 
 // Per frame of options.io.frames (decoded beforehand): the front-end (Frontend::Process with the
 // run's threads and front-end options, GTExt) and, on the same images on one thread, the floor: per
-// view cv::remap with the warp's fixed-point maps, cv::buildOpticalFlowPyramid,
+// view cv::remap with the warp's fixed-point maps (in bands of rows, as the front-end), cv::buildOpticalFlowPyramid,
 // cv::calcOpticalFlowPyrLK of the previous frame's points with a backward pass from scratch, cv::FAST
 // and ORB::compute of the strongest target_features_per_view corners; per pair of neighbouring views
 // a k = 2 Hamming matching (cv::BFMatcher) both ways between the halves of the two views that face

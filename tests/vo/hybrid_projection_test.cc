@@ -2,9 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <random>
+#include <stdexcept>
 #include <string>
 
 #include "datasets/rig.h"
@@ -119,6 +121,27 @@ TEST(HybridProjection, MapsMatchExactFunctions) {
       EXPECT_GT(valid, 0.8 * p.width() * p.height()) << rig_name;
     }
   }
+}
+
+// Bands of rows warped one by one (the front-end warps them in parallel) are the whole warp's pixels;
+// a band outside the image leaves the buffer alone, a buffer of the wrong size is refused.
+TEST(HybridProjection, WarpRowsInBandsIsTheWholeWarp) {
+  const Rig rig = MakeRigPreset("rovo4").Scaled(0.25);
+  const HybridProjection p = HybridProjection::ForRig(rig)[1];
+  cv::Mat fisheye(rig.cameras[1].camera.height, rig.cameras[1].camera.width, CV_8UC1);
+  cv::RNG(4).fill(fisheye, cv::RNG::UNIFORM, 0, 256);
+  cv::Mat whole;
+  p.Warp(fisheye, &whole);
+  cv::Mat bands(p.height(), p.width(), CV_8UC1, cv::Scalar(7));
+  for (int first = 0; first < p.height(); first += 13) {
+    p.WarpRows(fisheye, first, std::min(first + 13, p.height()), &bands);
+  }
+  EXPECT_EQ(cv::norm(whole, bands, cv::NORM_INF), 0.0);
+  const cv::Mat before = bands.clone();
+  p.WarpRows(cv::Mat::zeros(fisheye.size(), CV_8UC1), p.height(), p.height() + 5, &bands);
+  EXPECT_EQ(cv::norm(before, bands, cv::NORM_INF), 0.0);
+  cv::Mat small(p.height() - 1, p.width(), CV_8UC1);
+  EXPECT_THROW(p.WarpRows(fisheye, 0, 1, &small), std::invalid_argument);
 }
 
 // No jumps: along rows and columns the fisheye position changes smoothly (second difference <= 0.5

@@ -1,6 +1,7 @@
 #include "vo/tracking.h"
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <cmath>
 #include <map>
@@ -259,6 +260,37 @@ TEST(Tracking, UprightDescriptorsAreSteadierUnderSubpixelShift) {
   ASSERT_EQ(expected.rows, 1);
   EXPECT_EQ(HammingDistance(expected, p.descriptor), 0);
   EXPECT_FLOAT_EQ(p.angle_deg, IntensityCentroidAngleDeg(image, p.px));
+}
+
+// KLT runs in chunks of points that idle workers may take: the tracks, their positions, ages and
+// descriptors are the same on one thread and on two, in the same order.
+TEST(Tracking, TracksAreTheSameOnOneThreadAndOnTwo) {
+  const auto run = [](int threads) {
+    const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    uint64_t next = 0;
+    ViewTracker tracker;
+    const cv::Mat image = TexturedImage(640, 480, 9);
+    const cv::Mat mask(480, 640, CV_8UC1, cv::Scalar(255));
+    std::vector<TrackedPoint> points;
+    for (int frame = 0; frame < 4; ++frame) {
+      tracker.Track(Shifted(image, 3.5 * frame, -1.25 * frame), mask);
+      tracker.DetectAndDescribe([&next] { return ++next; });
+    }
+    return tracker.points();
+  };
+  const std::vector<TrackedPoint> one = run(1), two = run(2);
+  ASSERT_GT(one.size(), 300u);  // several chunks of 64 points
+  ASSERT_EQ(one.size(), two.size());
+  int aged = 0;
+  for (size_t k = 0; k < one.size(); ++k) {
+    EXPECT_EQ(one[k].track_id, two[k].track_id);
+    EXPECT_EQ(one[k].px, two[k].px);
+    EXPECT_EQ(one[k].age, two[k].age);
+    EXPECT_EQ(one[k].angle_deg, two[k].angle_deg);
+    EXPECT_EQ(cv::norm(one[k].descriptor, two[k].descriptor, cv::NORM_HAMMING), 0.0);
+    aged += one[k].age >= 3;
+  }
+  EXPECT_GT(aged, 100);
 }
 
 TEST(Tracking, HammingDistanceCountsBits) {
