@@ -1,6 +1,7 @@
 #include "datasets/camera.h"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <unsupported/Eigen/AutoDiff>
@@ -16,6 +17,8 @@ namespace {
 constexpr double kOcamRoundTripTolerancePx = 0.1;
 // InFov tolerance: rounding noise of an unprojected edge pixel must not reject it.
 constexpr double kFovSlackRad = 1e-9;
+// InFov's fast path decides only this far (in cosine) from the limit.
+constexpr double kFovCosMargin = 1e-12;
 // Check() accepts an ocam inverse polynomial that is this close to the forward one over the FOV.
 constexpr double kOcamCheckInverseTolerancePx = 0.05;
 
@@ -219,6 +222,21 @@ std::optional<Eigen::Vector3d> Camera::Unproject(const Eigen::Vector2d& uv) cons
 }
 
 bool Camera::InFov(const Eigen::Vector3d& point_in_cam) const {
+  // Fast path: the cosine of the angle from the axis against the cosine of the limit, decided only
+  // when it is more than kFovCosMargin away from it. Then the angle is more than kFovCosMargin rad
+  // from the limit (|d cos / d angle| <= 1), far beyond the rounding of either test, so the answer is
+  // the exact test's below; within the margin the exact test decides.
+  thread_local double cached_fov_deg = std::numeric_limits<double>::quiet_NaN(), cos_limit = 0.0;
+  if (max_fov_deg != cached_fov_deg) {
+    cached_fov_deg = max_fov_deg;
+    cos_limit = std::cos(0.5 * max_fov_deg * kDegToRad + kFovSlackRad);
+  }
+  const double norm2 = point_in_cam.squaredNorm();
+  if (norm2 > 0.0 && std::isfinite(norm2)) {
+    const double cos_angle = point_in_cam.z() / std::sqrt(norm2);
+    if (cos_angle > cos_limit + kFovCosMargin) return true;
+    if (cos_angle < cos_limit - kFovCosMargin) return false;
+  }
   const double r_xy = std::hypot(point_in_cam.x(), point_in_cam.y());
   if (r_xy == 0.0 && point_in_cam.z() == 0.0) return false;
   const double angle_from_axis = std::atan2(r_xy, point_in_cam.z());

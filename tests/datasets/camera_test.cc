@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -72,6 +74,33 @@ TEST(Camera, InFovUsesTheHalfAngleAroundTheAxis) {
   camera.max_fov_deg = 180;
   EXPECT_TRUE(camera.InFov(Direction(89.9, 10)));
   EXPECT_FALSE(camera.InFov(Direction(90.1, 10)));
+}
+
+// InFov decides as the angle test atan2(|xy|, z) <= fov / 2 + 1e-9 rad does, also for directions within
+// rounding of the limit, for any length and for every limit (it caches the limit's cosine per thread).
+TEST(Camera, InFovIsTheAngleTestEverywhere) {
+  Camera camera = Equidistant220();
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> azimuth(0.0, 360.0), unit(-1.0, 1.0), scale_exp(-8.0, 8.0);
+  int near_limit = 0;
+  for (const double fov : {60.0, 180.0, 195.5, 220.0, 359.0, 360.0, 220.0}) {
+    camera.max_fov_deg = fov;
+    const double limit = 0.5 * fov * kDegToRad + 1e-9;  // as Camera::InFov writes it
+    for (int k = 0; k < 20000; ++k) {
+      Eigen::Vector3d p;
+      if (k % 2 == 0) {
+        // Within 1e-8 rad of the limit, down to the last bits.
+        const double angle = std::min(M_PI, limit + unit(rng) * std::pow(10.0, -8.0 - 8.0 * std::abs(unit(rng))));
+        p = Direction(angle * 180.0 / M_PI, azimuth(rng)) * std::pow(10.0, scale_exp(rng));
+        ++near_limit;
+      } else {
+        p = Eigen::Vector3d(unit(rng), unit(rng), unit(rng)) * std::pow(10.0, scale_exp(rng));
+      }
+      const bool expected = std::atan2(std::hypot(p.x(), p.y()), p.z()) <= limit;
+      ASSERT_EQ(camera.InFov(p), expected) << "fov " << fov << " p " << p.transpose();
+    }
+  }
+  EXPECT_GT(near_limit, 60000);
 }
 
 // Project and Unproject apply the FOV limit; inside it they invert each other.
