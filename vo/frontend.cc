@@ -93,6 +93,7 @@ struct Frontend::Impl {
   // Steps of Frontend::Process (bearings_in_cam: per view, the bearing of every tracked point).
   using ViewBearings = std::vector<std::vector<std::optional<Eigen::Vector3d>>>;
   void CheckImages(const std::vector<cv::Mat>& fisheye_images) const;
+  cv::Mat WarpView(int i) const;
   void RunViewStages(const std::vector<cv::Mat>& fisheye_images, ViewBearings* bearings_in_cam, FrontendFrame* frame,
                      double* bearings_ms, double* bearings_cpu_ms);
   void MatchViewsAndUnifyIds(ViewBearings* bearings_in_cam, FrontendFrame* frame);
@@ -271,6 +272,21 @@ void Frontend::Impl::CheckImages(const std::vector<cv::Mat>& fisheye_images) con
   }
 }
 
+// The warp of view i's gray fisheye image, into a new buffer (the tracker still holds the previous
+// warped image), in bands of rows (cheaper, HybridProjection::kWarpBandRows), which a worker done with
+// its own views can take part in (isolated: this thread takes no other view's work while it waits).
+cv::Mat Frontend::Impl::WarpView(int i) const {
+  const HybridProjection& projection = projections[i];
+  cv::Mat image(projection.height(), projection.width(), fisheye_gray[i].type());
+  tbb::this_task_arena::isolate([&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, image.rows, HybridProjection::kWarpBandRows),
+                      [&](const tbb::blocked_range<int>& rows) {
+                        projection.WarpRows(fisheye_gray[i], rows.begin(), rows.end(), &image);
+                      });
+  });
+  return image;
+}
+
 // The per-view stages (warp, track, detect + describe, bearings) run fused in one parallel loop
 // over the views, without a barrier between stages. Stage times are the section's wall and CPU
 // time apportioned by each stage's share of the per-view wall durations summed over the views; the
@@ -291,17 +307,7 @@ void Frontend::Impl::RunViewStages(const std::vector<cv::Mat>& fisheye_images, V
       start = now;
     };
     fisheye_gray[i] = ToGray(fisheye_images[i], i);
-    // A fresh buffer: the tracker still holds the previous warped image (warped[i] shares it). Warped
-    // in bands of rows (cheaper, HybridProjection::kWarpBandRows), which a worker done with its own
-    // views can take part in (isolated: this thread takes no other view's work while it waits).
-    cv::Mat warped_image(projections[i].height(), projections[i].width(), fisheye_gray[i].type());
-    tbb::this_task_arena::isolate([&] {
-      tbb::parallel_for(tbb::blocked_range<int>(0, warped_image.rows, HybridProjection::kWarpBandRows),
-                        [&](const tbb::blocked_range<int>& rows) {
-                          projections[i].WarpRows(fisheye_gray[i], rows.begin(), rows.end(), &warped_image);
-                        });
-    });
-    warped[i] = warped_image;
+    warped[i] = WarpView(i);
     lap(kWarp);
     trackers[i].Track(warped[i], view_masks[i]);
     lap(kTrack);

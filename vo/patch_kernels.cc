@@ -7,6 +7,9 @@
 #include <cstdlib>
 #include <opencv2/core/hal/intrin.hpp>
 
+// Compiles a function for AVX2 (called only after HasAvx2()).
+#define ROVO_TARGET_AVX2 __attribute__((target("avx2")))
+
 namespace rovo {
 namespace {
 
@@ -15,7 +18,7 @@ constexpr std::array<int16_t, 32> kKeep16 = {-1, -1, -1, -1, -1, -1, -1, -1, -1,
 constexpr std::array<uint8_t, 32> kKeep8 = {255, 255, 255, 255, 255, 255, 255, 255,
                                             255, 255, 255, 255, 255, 255, 255, 255};
 
-__attribute__((target("avx2"))) int32_t SumLanes(__m256i v) {
+ROVO_TARGET_AVX2 int32_t SumLanes(__m256i v) {
   __m128i s = _mm_add_epi32(_mm256_castsi256_si128(v), _mm256_extracti128_si256(v, 1));
   s = _mm_add_epi32(s, _mm_shuffle_epi32(s, _MM_SHUFFLE(1, 0, 3, 2)));
   s = _mm_add_epi32(s, _mm_shuffle_epi32(s, _MM_SHUFFLE(2, 3, 0, 1)));
@@ -100,8 +103,7 @@ PatchSums PatchSumsPortable(const int16_t* a, const cv::Mat& image, int x0, int 
 }
 
 // A row of 16 pixels widened to 16 int16 lanes: one multiply-add each for a*b and b^2. Bounds as above.
-__attribute__((target("avx2"))) PatchSums PatchSumsAvx2(const int16_t* a, const cv::Mat& image, int x0, int y0,
-                                                        int side) {
+ROVO_TARGET_AVX2 PatchSums PatchSumsAvx2(const int16_t* a, const cv::Mat& image, int x0, int y0, int side) {
   const __m256i keep = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(kKeep16.data() + kPatchRowPixels - side));
   __m256i ab = _mm256_setzero_si256(), bb = _mm256_setzero_si256(), sum = _mm256_setzero_si256();
   for (int r = 0; r < side; ++r, a += kPatchRowPixels) {
@@ -147,7 +149,7 @@ DiscMoments DiscMomentsPortable(const cv::Mat& image, int cx, int cy) {
   return m;
 }
 
-__attribute__((target("avx2"))) DiscMoments DiscMomentsAvx2(const cv::Mat& image, int cx, int cy) {
+ROVO_TARGET_AVX2 DiscMoments DiscMomentsAvx2(const cv::Mat& image, int cx, int cy) {
   const DiscRowWeights& w = RowWeights();
   const __m256i ones = _mm256_set1_epi16(1);
   __m256i m10 = _mm256_setzero_si256(), m01 = _mm256_setzero_si256();
