@@ -232,7 +232,9 @@ bool Camera::InFov(const Eigen::Vector3d& point_in_cam) const {
     cos_limit = std::cos(0.5 * max_fov_deg * kDegToRad + kFovSlackRad);
   }
   const double norm2 = point_in_cam.squaredNorm();
-  if (norm2 > 0.0 && std::isfinite(norm2)) {
+  // Normal (not subnormal) squared lengths only, and limits that Check() accepts (cos is monotone there).
+  if (norm2 >= std::numeric_limits<double>::min() && std::isfinite(norm2) && max_fov_deg > 0.0 &&
+      max_fov_deg <= 360.0) {
     const double cos_angle = point_in_cam.z() / std::sqrt(norm2);
     if (cos_angle > cos_limit + kFovCosMargin) return true;
     if (cos_angle < cos_limit - kFovCosMargin) return false;

@@ -1,6 +1,5 @@
 #include "vo/frontend.h"
 
-#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -278,11 +277,11 @@ void Frontend::Impl::CheckImages(const std::vector<cv::Mat>& fisheye_images) con
 cv::Mat Frontend::Impl::WarpView(int i) const {
   const HybridProjection& projection = projections[i];
   cv::Mat image(projection.height(), projection.width(), fisheye_gray[i].type());
+  const int band = HybridProjection::kWarpBandRows;
   tbb::this_task_arena::isolate([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, image.rows, HybridProjection::kWarpBandRows),
-                      [&](const tbb::blocked_range<int>& rows) {
-                        projection.WarpRows(fisheye_gray[i], rows.begin(), rows.end(), &image);
-                      });
+    tbb::parallel_for(0, (image.rows + band - 1) / band, [&](int b) {
+      projection.WarpRows(fisheye_gray[i], b * band, std::min((b + 1) * band, image.rows), &image);
+    });
   });
   return image;
 }
@@ -290,7 +289,9 @@ cv::Mat Frontend::Impl::WarpView(int i) const {
 // The per-view stages (warp, track, detect + describe, bearings) run fused in one parallel loop
 // over the views, without a barrier between stages. Stage times are the section's wall and CPU
 // time apportioned by each stage's share of the per-view wall durations summed over the views; the
-// bearings' share is returned for the matching time.
+// bearings' share is returned for the matching time. On more than one thread the split is
+// approximate: idle workers help with a view's warp and KLT, which shortens their wall more than
+// their CPU.
 void Frontend::Impl::RunViewStages(const std::vector<cv::Mat>& fisheye_images, ViewBearings* bearings_in_cam,
                                    FrontendFrame* frame, double* bearings_ms, double* bearings_cpu_ms) {
   const int n = rig.NumCameras();

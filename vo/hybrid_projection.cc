@@ -365,7 +365,9 @@ void HybridProjection::WarpRows(const cv::Mat& fisheye, int first_row, int last_
         "hybrid projection: WarpRows needs a warped image of the projection's size and the "
         "fisheye's type");
   }
-  if (first_row < 0 || last_row > height_ || first_row >= last_row) return;
+  first_row = std::max(first_row, 0);
+  last_row = std::min(last_row, height_);
+  if (first_row >= last_row) return;
   cv::Mat band = warped->rowRange(first_row, last_row);
   cv::remap(fisheye, band, map_fixed_.rowRange(first_row, last_row), map_frac_.rowRange(first_row, last_row),
             cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));

@@ -129,13 +129,13 @@ class HybridProjection {
   // Warps a fisheye image (8-bit, 1 or 3 channels) into `warped` (same type) with the fixed-point
   // maps (cv::remap, bilinear, 0 outside the valid area).
   void Warp(const cv::Mat& fisheye, cv::Mat* warped) const;
-  // Warp of the rows [first_row, last_row) only, into `warped` (allocated: height() x width(), the
-  // fisheye's type): the same pixels as Warp there, so bands can be warped in parallel.
+  // Warp of the rows [first_row, last_row) (clipped to the image) only, into `warped` (allocated:
+  // height() x width(), the fisheye's type): the same pixels as Warp there, so bands can be warped in
+  // parallel.
   void WarpRows(const cv::Mat& fisheye, int first_row, int last_row, cv::Mat* warped) const;
-  // Rows per band for WarpRows. cv::remap works in blocks of 2^14 pixels as tall as its output: on the
-  // whole warped image, strips 16 columns wide down its full height, whose source pixels fall out of
-  // the cache; on 8-row bands, blocks 8 x 2048. Bands of 8 rows cost about 0.6x the whole warp
-  // (BM_HybridWarpOneViewInBands).
+  // Rows per band for WarpRows. cv::remap works in blocks of up to 128 rows and 2^14 pixels: 128 x 128
+  // on the whole warped image, 8 x 2048 on 8-row bands, which cost about 0.6x the whole warp (bands of
+  // 128 rows cost what the whole does; BM_HybridWarpOneViewInBands).
   static constexpr int kWarpBandRows = 8;
   // CV_8U, 255 where the warped pixel maps into the fisheye's valid area.
   const cv::Mat& valid_mask() const { return valid_mask_; }

@@ -1,6 +1,5 @@
 #include "vo/tracking.h"
 
-#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -100,6 +99,31 @@ float IntensityCentroidAngleDeg(const cv::Mat& image, cv::Point2f px) {
   return angle;
 }
 
+void PyrLkInChunks(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
+                   const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to, std::vector<uint8_t>* status,
+                   cv::Size window, int levels, const cv::TermCriteria& criteria, int flags) {
+  const int n = static_cast<int>(from.size());
+  if ((flags & cv::OPTFLOW_USE_INITIAL_FLOW) != 0 && static_cast<int>(to->size()) != n) {
+    throw std::invalid_argument("PyrLkInChunks: the starts and the points differ in number");
+  }
+  to->resize(n);
+  status->assign(n, 0);
+  const int chunks = (n + kLkChunkPoints - 1) / kLkChunkPoints;
+  tbb::this_task_arena::isolate([&] {
+    tbb::parallel_for(0, chunks, [&](int c) {
+      const auto first = static_cast<std::ptrdiff_t>(c) * kLkChunkPoints;
+      const auto last = std::min<std::ptrdiff_t>(first + kLkChunkPoints, n);
+      const std::vector<cv::Point2f> chunk_from(from.begin() + first, from.begin() + last);
+      std::vector<cv::Point2f> chunk_to(to->begin() + first, to->begin() + last);
+      std::vector<uint8_t> chunk_status;
+      cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, chunk_from, chunk_to, chunk_status, cv::noArray(), window,
+                               levels, criteria, flags);
+      std::copy(chunk_to.begin(), chunk_to.end(), to->begin() + first);
+      std::copy(chunk_status.begin(), chunk_status.end(), status->begin() + first);
+    });
+  });
+}
+
 int HammingDistance(const cv::Mat& a, const cv::Mat& b) { return static_cast<int>(cv::norm(a, b, cv::NORM_HAMMING)); }
 
 ViewTracker::ViewTracker(const TrackerOptions& options) : options_(options) { options_.Check(); }
@@ -125,33 +149,6 @@ void ViewTracker::ResetImage(const cv::Mat& image, const cv::Mat& mask, std::vec
 }
 
 namespace {
-
-// Points per cv::calcOpticalFlowPyrLK call in PyrLkInChunks.
-constexpr size_t kLkChunk = 64;
-
-// cv::calcOpticalFlowPyrLK of `from` into `to` (its start when flags has OPTFLOW_USE_INITIAL_FLOW), in
-// chunks of points under TBB. LK tracks every point on its own, so the results are those of one call;
-// the chunks let a worker that has finished its own views take part of this view's pass.
-void PyrLkInChunks(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
-                   const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to, std::vector<uint8_t>* status,
-                   cv::Size window, int levels, const cv::TermCriteria& criteria, int flags) {
-  const size_t n = from.size();
-  to->resize(n);
-  status->assign(n, 0);
-  // Isolated: while it waits for its chunks, this thread takes no other view's work.
-  tbb::this_task_arena::isolate([&] {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kLkChunk), [&](const tbb::blocked_range<size_t>& range) {
-      const auto first = static_cast<std::ptrdiff_t>(range.begin()), last = static_cast<std::ptrdiff_t>(range.end());
-      const std::vector<cv::Point2f> chunk_from(from.begin() + first, from.begin() + last);
-      std::vector<cv::Point2f> chunk_to(to->begin() + first, to->begin() + last);
-      std::vector<uint8_t> chunk_status;
-      cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, chunk_from, chunk_to, chunk_status, cv::noArray(), window,
-                               levels, criteria, flags);
-      std::copy(chunk_to.begin(), chunk_to.end(), to->begin() + first);
-      std::copy(chunk_status.begin(), chunk_status.end(), status->begin() + first);
-    });
-  });
-}
 
 // KLT rounds from the previous image's pyramid into the current one, for ViewTracker::Track.
 struct KltPass {

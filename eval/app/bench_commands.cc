@@ -61,10 +61,11 @@ void AddBenchCommands(CommandTree& tree) {
                   "Decode every frame's images before timing (a live rig delivers decoded images; without it, the "
                   "replay decodes PNGs ahead on a thread of its own). Keeps all frames in memory: use --frames");
   auto floor = std::make_shared<bool>(false);
-  bench->add_flag("--floor", *floor,
-                  "Instead of the pipeline: the front-end's CPU per frame against the floor, the bare OpenCV calls it "
-                  "is made of (remap, pyramid, LK with a backward pass, FAST, ORB, Hamming matching) with its "
-                  "parameters on the same images on one thread, by stage, and their ratio (eval/bench/vo_floor.h)");
+  bench->add_flag(
+      "--floor", *floor,
+      "Instead of the pipeline: the front-end's CPU per frame against the floor, the bare OpenCV calls it "
+      "is made of (remap in bands of rows, pyramid, LK with a backward pass, FAST, ORB, Hamming matching) with its "
+      "parameters on the same images on one thread, by stage, and their ratio (eval/bench/vo_floor.h)");
   bench->callback([bench, bench_args, floor] {
     FinaliseVoArgs(bench, bench_args.get());
     if (*floor) {

@@ -77,11 +77,12 @@ TEST(Camera, InFovUsesTheHalfAngleAroundTheAxis) {
 }
 
 // InFov decides as the angle test atan2(|xy|, z) <= fov / 2 + 1e-9 rad does, also for directions within
-// rounding of the limit, for any length and for every limit (it caches the limit's cosine per thread).
+// rounding of the limit, for lengths from 1e-170 (subnormal squares) to 1e150, for six limits (220 twice:
+// it caches the limit's cosine per thread).
 TEST(Camera, InFovIsTheAngleTestEverywhere) {
   Camera camera = Equidistant220();
   std::mt19937_64 rng(17);
-  std::uniform_real_distribution<double> azimuth(0.0, 360.0), unit(-1.0, 1.0), scale_exp(-8.0, 8.0);
+  std::uniform_real_distribution<double> azimuth(0.0, 360.0), unit(-1.0, 1.0), scale_exp(-170.0, 150.0);
   int near_limit = 0;
   for (const double fov : {60.0, 180.0, 195.5, 220.0, 359.0, 360.0, 220.0}) {
     camera.max_fov_deg = fov;
@@ -101,6 +102,10 @@ TEST(Camera, InFovIsTheAngleTestEverywhere) {
     }
   }
   EXPECT_GT(near_limit, 60000);
+  // Subnormal squares: the cosine would say 44.6 deg, the angle is 45.001 deg.
+  camera.max_fov_deg = 90.0;
+  EXPECT_FALSE(camera.InFov(Eigen::Vector3d(1.00004e-161, 0.0, 1e-161)));
+  EXPECT_TRUE(camera.InFov(Eigen::Vector3d(0.99996e-161, 0.0, 1e-161)));
 }
 
 // Project and Unproject apply the FOV limit; inside it they invert each other.

@@ -69,8 +69,11 @@ TEST(PatchKernels, PatchSumsAreTheDirectSumsForEverySide) {
   const cv::Mat image = NoiseImage(120, 90, 3);
   cv::RNG rng(11);
   for (int side = 1; side <= kPatchRowPixels; ++side) {
-    for (int trial = 0; trial < 50; ++trial) {
-      const int x0 = rng.uniform(0, image.cols - kPatchRowPixels + 1), y0 = rng.uniform(0, image.rows - side + 1);
+    for (int trial = 0; trial < 54; ++trial) {
+      // The four corners of the area PatchSumsAgainst allows (its last row and column of patches), then random.
+      const int last_x0 = image.cols - kPatchRowPixels, last_y0 = image.rows - side;
+      const int x0 = trial < 4 ? (trial % 2) * last_x0 : rng.uniform(0, last_x0 + 1);
+      const int y0 = trial < 4 ? (trial / 2) * last_y0 : rng.uniform(0, last_y0 + 1);
       // The reference from elsewhere in the image: its patch and the compared one differ.
       const std::vector<int16_t> a =
           ReferenceRows(image, rng.uniform(0, image.cols - side + 1), rng.uniform(0, image.rows - side + 1), side);

@@ -7,6 +7,7 @@
 #include <map>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
 #include <random>
 #include <set>
 
@@ -262,8 +263,8 @@ TEST(Tracking, UprightDescriptorsAreSteadierUnderSubpixelShift) {
   EXPECT_FLOAT_EQ(p.angle_deg, IntensityCentroidAngleDeg(image, p.px));
 }
 
-// KLT runs in chunks of points that idle workers may take: the tracks, their positions, ages and
-// descriptors are the same on one thread and on two, in the same order.
+// The tracker's KLT runs in chunks of points that idle workers may take: the tracks, their positions,
+// ages and descriptors are the same on one thread and on two, in the same order.
 TEST(Tracking, TracksAreTheSameOnOneThreadAndOnTwo) {
   const auto run = [](int threads) {
     const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
@@ -291,6 +292,52 @@ TEST(Tracking, TracksAreTheSameOnOneThreadAndOnTwo) {
     aged += one[k].age >= 3;
   }
   EXPECT_GT(aged, 100);
+}
+
+// PyrLkInChunks gives every point the position and status of one cv::calcOpticalFlowPyrLK call over
+// all of them, from zero flow and from given starts, on one thread and on two.
+TEST(Tracking, LkInChunksIsOneCall) {
+  const cv::Mat image = TexturedImage(640, 480, 12);
+  const cv::Mat moved = Shifted(image, 4.25, -2.5);
+  const cv::Size window(15, 15);
+  std::vector<cv::Mat> from_pyramid, to_pyramid;
+  cv::buildOpticalFlowPyramid(image, from_pyramid, window, 3);
+  cv::buildOpticalFlowPyramid(moved, to_pyramid, window, 3);
+  std::vector<cv::Point2f> from, starts;
+  cv::RNG rng(5);
+  for (int k = 0; k < 3 * kLkChunkPoints + 17; ++k) {  // the last chunk partial; some points near the border
+    from.emplace_back(rng.uniform(2.0f, 638.0f), rng.uniform(2.0f, 478.0f));
+    starts.push_back(from.back() + cv::Point2f(rng.uniform(2.0f, 6.0f), rng.uniform(-4.0f, 0.0f)));
+  }
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.03);
+  for (const int flags : {0, static_cast<int>(cv::OPTFLOW_USE_INITIAL_FLOW)}) {
+    std::vector<cv::Point2f> one = starts;
+    std::vector<uint8_t> one_status;
+    cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, from, one, one_status, cv::noArray(), window, 3, criteria,
+                             flags);
+    int tracked = 0;
+    for (const int threads : {1, 2}) {
+      const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+      std::vector<cv::Point2f> chunked = flags != 0 ? starts : std::vector<cv::Point2f>{};
+      std::vector<uint8_t> status;
+      PyrLkInChunks(from_pyramid, to_pyramid, from, &chunked, &status, window, 3, criteria, flags);
+      ASSERT_EQ(chunked.size(), from.size());
+      ASSERT_EQ(status.size(), from.size());
+      tracked = 0;
+      for (size_t k = 0; k < from.size(); ++k) {
+        EXPECT_EQ(status[k], one_status[k]) << k;
+        EXPECT_EQ(chunked[k], one[k]) << k;
+        tracked += one_status[k] != 0;
+      }
+    }
+    EXPECT_GT(tracked, 150);
+    EXPECT_LT(tracked, static_cast<int>(from.size()));  // some fail: the border, flat patches
+  }
+  std::vector<cv::Point2f> short_starts(3);
+  std::vector<uint8_t> status;
+  EXPECT_THROW(PyrLkInChunks(from_pyramid, to_pyramid, from, &short_starts, &status, window, 3, criteria,
+                             cv::OPTFLOW_USE_INITIAL_FLOW),
+               std::invalid_argument);
 }
 
 TEST(Tracking, HammingDistanceCountsBits) {
