@@ -106,7 +106,7 @@ void BM_HybridWarpOneView(benchmark::State& state) {
 BENCHMARK(BM_HybridWarpOneView)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The same warp in bands of state.range(0) rows, one after the other on one thread (the front-end
-// warps bands in parallel): the bands' source pixels stay in cache, which makes the whole cheaper.
+// warps bands in parallel): cv::remap's blocks follow the band's shape (HybridProjection::kWarpBandRows).
 void BM_HybridWarpOneViewInBands(benchmark::State& state) {
   const Rig rig = MakeRigPreset("rovo4");
   const auto projections = HybridProjection::ForRig(rig);

@@ -221,7 +221,7 @@ std::vector<TrackedPoint> SpacedOut(std::vector<TrackedPoint> kept, int width, i
 
 // Indices of the corners, strongest response first. std::sort of (response, index) pairs under a
 // comparison of the responses alone makes the same comparisons, and so the same order, as sorting the
-// key points themselves, with an eighth of the data to move.
+// key points themselves, moving 8 bytes per corner instead of 28.
 std::vector<int> ByResponse(const std::vector<cv::KeyPoint>& corners) {
   struct Entry {
     float response;
