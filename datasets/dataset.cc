@@ -105,6 +105,15 @@ TimingRecord ParseTiming(JsonChecker& check, const json& tj, const std::string& 
     if (!(std::abs(t.trigger_offset_ms[c]) <= 1000.0))
       check.Issue(p + "/trigger_offset_ms/" + std::to_string(c), "must be in [-1000, 1000]");
   }
+  if (tj.contains("sampling")) {
+    const json& sj = tj["sampling"];
+    const std::string sp = p + "/sampling";
+    if (!check.Object(sj, sp)) return t;
+    t.spp = static_cast<int>(check.Integer(sj, sp, "spp", 0, 1, 4096));
+    t.min_spp = static_cast<int>(check.Integer(sj, sp, "min_spp", 0, 1, 4096));
+    if (t.spp > 0 && t.min_spp > t.spp) check.Issue(sp + "/min_spp", "must be at most spp");
+    t.threshold_codes = check.Number(sj, sp, "threshold_codes", 0.0, 0.0, 255.0);
+  }
   return t;
 }
 
@@ -133,11 +142,13 @@ json SensorJson(const SensorRecord& s) {
 }
 
 json TimingJson(const TimingRecord& t) {
-  return json{{"exposure", t.exposure},
-              {"shutter_ms", t.shutter_ms},
-              {"rolling_shutter_ms", t.rolling_shutter_ms},
-              {"trigger_offset_std_ms", t.trigger_offset_std_ms},
-              {"trigger_offset_ms", t.trigger_offset_ms}};
+  json j{{"exposure", t.exposure},
+         {"shutter_ms", t.shutter_ms},
+         {"rolling_shutter_ms", t.rolling_shutter_ms},
+         {"trigger_offset_std_ms", t.trigger_offset_std_ms},
+         {"trigger_offset_ms", t.trigger_offset_ms}};
+  if (t.spp > 0) j["sampling"] = json{{"spp", t.spp}, {"min_spp", t.min_spp}, {"threshold_codes", t.threshold_codes}};
+  return j;
 }
 
 }  // namespace

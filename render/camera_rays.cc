@@ -18,7 +18,8 @@ void InitMovingRay(const RenderJob& job, size_t pi, int y, int s, const Eigen::V
   const CameraMotion& m = *job.motion;
   float time = m.time_mid + (static_cast<float>(y) - 0.5f * static_cast<float>(job.height - 1)) * job.row_time_scale;
   if (s >= 0 && job.spp > 1 && m.shutter > 0.0f) {
-    const float w = Wrap01((s + 0.5f) / static_cast<float>(job.spp) + UnitFloat(Mix64(pi * 0xd1b54a32d192ed03ull + 3)));
+    const float stratum = job.adaptive ? AdaptiveStratum(job, s) : (s + 0.5f) / static_cast<float>(job.spp);
+    const float w = Wrap01(stratum + UnitFloat(Mix64(pi * 0xd1b54a32d192ed03ull + 3)));
     time += (w - 0.5f) * m.shutter;
   }
   time = std::clamp(time, 0.0f, 1.0f);
@@ -40,7 +41,7 @@ int MakeSampleRays(const RenderJob& job, const TileRect& t, int s, bool is_centr
     const size_t row = static_cast<size_t>(t.ty0 + ly) * job.width + t.tx0;
     for (int lx = 0; lx < t.tw; ++lx) {
       const size_t pi = row + lx;
-      if (!rays.valid[pi]) continue;
+      if (!rays.valid[pi] || (job.adaptive && !tb.active[ly * kTile + lx])) continue;
       Eigen::Vector3f bearing;
       if (is_centre) {
         bearing = rays.bearing[pi];

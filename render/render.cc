@@ -392,6 +392,14 @@ DatasetInfo MakeDatasetInfo(const RenderOptions& options, const Scene& scene, co
   return info;
 }
 
+// The timing record's samples per pixel.
+void RecordSampling(int spp, const AdaptiveSampling& adaptive, TimingRecord* timing) {
+  timing->spp = spp;
+  const bool on = adaptive.enabled && spp > adaptive.min_spp;
+  timing->min_spp = on ? adaptive.min_spp : spp;
+  timing->threshold_codes = on ? std::round(adaptive.threshold * 255.0 * 1e6) / 1e6 : 0.0;
+}
+
 void PrepareDir(const std::string& file_in_dir) {
   const std::string dir = fs::path(file_in_dir).parent_path().string();
   EnsureWritableDir(dir);
@@ -494,6 +502,19 @@ void PlanMotion(const RenderOptions& options, const Scene& scene, const Rig& rig
   }
 }
 
+// The settings of camera c at dataset frame f: with adaptive sampling and the sensor model, the factor
+// from linear radiance to the sensor's full scale, K q_c t G / FWC (render/sensor.h).
+ShadeSettings CameraShadeSettings(const ShadeSettings& settings, const RenderOptions& options, const SensorPlan& plan,
+                                  int f, int c) {
+  ShadeSettings out = settings;
+  if (settings.adaptive.enabled && options.sensor.enabled) {
+    const CameraExposure& e = plan.exposure[f][c];
+    out.adaptive.output_scale = static_cast<float>(options.sensor.sensitivity_e_per_ms * plan.sensitivity[c] *
+                                                   e.exposure_ms * e.gain / options.sensor.full_well_e);
+  }
+  return out;
+}
+
 // The images of one frame with timing (render/timing.h): the dynamic objects over the frame's
 // window (the scene's motion), each camera at its own times (the rig from the dataset's poses).
 void RenderTimedFrame(const RenderOptions& options, const Rig& rig, int traj_frame, int f, const SensorPlan& plan,
@@ -510,7 +531,7 @@ void RenderTimedFrame(const RenderOptions& options, const Rig& rig, int traj_fra
                          shutter[c], options.timing.rolling_shutter_ms, rays[c]->height, &world_from_cam);
     CameraImage& image = job->images[c];
     if (pipeline) image.linear.swap(*linear);
-    tracer.Render(*rays[c], world_from_cam, settings, &image, &motion);
+    tracer.Render(*rays[c], world_from_cam, CameraShadeSettings(settings, options, plan, f, c), &image, &motion);
     if (!pipeline) continue;
     if (!lenses.empty()) lenses[c].Apply(&image.linear);
     pipeline->Apply(image.linear, rays[c]->valid, plan.exposure[f][c], plan.sensitivity[c],
@@ -521,8 +542,8 @@ void RenderTimedFrame(const RenderOptions& options, const Rig& rig, int traj_fra
 
 // Renders the dataset frames `todo` (trajectory frames begin + f) and writes them beside the tracer.
 void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& rig, int begin,
-                  const std::vector<int>& todo, int spp, const SensorPlan& plan, tbb::task_arena& arena, Tracer& tracer,
-                  RenderSummary* summary) {
+                  const std::vector<int>& todo, int spp, const AdaptiveSampling& adaptive, const SensorPlan& plan,
+                  tbb::task_arena& arena, Tracer& tracer, RenderSummary* summary) {
   RigCameraRays rays;
   arena.execute([&] {
     std::vector<Camera> cameras;
@@ -535,6 +556,7 @@ void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& r
   settings.want_depth = options.depth;
   settings.want_mask = options.masks;
   settings.vignetting = options.vignetting;
+  settings.adaptive = adaptive;
   // The sensor model: the tracer hands over linear radiance (with the sun), the pipeline makes the image.
   const bool sensor = options.sensor.enabled;
   settings.linear_output = sensor;
@@ -572,7 +594,7 @@ void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& r
           const Rigid3 world_from_cam = world_from_rig * rig.cameras[c].cam_from_rig.Inverse();
           CameraImage& image = job.images[c];
           if (sensor) image.linear.swap(linear);
-          tracer.Render(*rays[c], world_from_cam, settings, &image);
+          tracer.Render(*rays[c], world_from_cam, CameraShadeSettings(settings, options, plan, f, c), &image);
           if (!sensor) continue;
           if (!lenses.empty()) lenses[c].Apply(&image.linear);
           pipeline->Apply(image.linear, rays[c]->valid, plan.exposure[f][c], plan.sensitivity[c],
@@ -589,6 +611,21 @@ void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& r
 }
 
 }  // namespace
+
+AdaptiveSampling RenderAdaptiveSampling(const RenderOptions& options, int spp, bool defaulted) {
+  if (options.adaptive != "auto" && options.adaptive != "on" && options.adaptive != "off")
+    throw std::invalid_argument("--adaptive " + options.adaptive + ": expected auto, on or off");
+  if (!(options.adaptive_threshold_codes >= 0.0 && options.adaptive_threshold_codes <= 255.0))
+    throw std::invalid_argument("--adaptive-threshold " + std::to_string(options.adaptive_threshold_codes) +
+                                ": expected 8-bit codes in [0, 255]");
+  AdaptiveSampling adaptive;
+  adaptive.enabled = options.adaptive == "on" || (options.adaptive == "auto" && defaulted && spp == kDefaultBlurSpp);
+  adaptive.min_spp = kDefaultSpp;
+  const double codes =
+      options.adaptive_threshold_codes > 0.0 ? options.adaptive_threshold_codes : kAdaptiveThresholdCodes;
+  adaptive.threshold = static_cast<float>(codes / 255.0);
+  return adaptive;
+}
 
 int DefaultSpp(const TimingSettings& timing, const std::vector<std::vector<CameraExposure>>& exposure) {
   if (timing.shutter_ms > 0.0) return kDefaultBlurSpp;
@@ -643,12 +680,14 @@ RenderSummary RenderDataset(const RenderOptions& options) {
   SensorPlan plan = PlanSensor(options, scene, rig, begin, count, arena, *tracer);
   PlanMotion(options, scene, rig, groundtruth, begin, &plan);
   const int spp = options.spp > 0 ? options.spp : DefaultSpp(options.timing, plan.exposure);
-  const DatasetInfo info = MakeDatasetInfo(options, scene, rig, count, plan);
+  const AdaptiveSampling adaptive = RenderAdaptiveSampling(options, spp, options.spp <= 0);
+  DatasetInfo info = MakeDatasetInfo(options, scene, rig, count, plan);
+  if (info.timing) RecordSampling(spp, adaptive, &*info.timing);
 
   PrepareOutput(options, info, groundtruth, plan);
   const std::vector<int> todo = FramesToRender(options, rig, count, &summary);
   const std::clock_t frames_start = std::clock();
-  RenderFrames(options, scene, rig, begin, todo, spp, plan, arena, *tracer, &summary);
+  RenderFrames(options, scene, rig, begin, todo, spp, adaptive, plan, arena, *tracer, &summary);
   summary.frames_cpu_seconds = static_cast<double>(std::clock() - frames_start) / CLOCKS_PER_SEC;
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;

@@ -25,6 +25,10 @@ struct RenderOptions {
   int shard_index = 0;  // render frames with (frame / chunk) % shard_count == shard_index
   int shard_count = 1;
   int spp = 0;              // samples per pixel; 0 = the measured default
+  // Adaptive sampling (render/tracer.h, AdaptiveSampling): auto = on when motion blur takes the default
+  // spp (kDefaultBlurSpp), pixels starting at kDefaultSpp samples; on = whenever spp allows; off = fixed.
+  std::string adaptive = "auto";
+  double adaptive_threshold_codes = 0.0;  // spread that takes more samples, 8-bit codes; 0 = kAdaptiveThresholdCodes
   int threads = 0;          // 0 = all cores
   uint64_t seed = 0;        // scene seed (preset) and seed of the sensor model's draws
   bool depth = false;       // write depth/ (EXR ray length)
@@ -70,6 +74,13 @@ inline constexpr int kDefaultSpp = 2;
 // Samples per pixel when RenderOptions::spp is 0 and motion blur is on: eight time strata per
 // pixel (the blur of a fast pan is several pixels wide; measured in render/README.md).
 inline constexpr int kDefaultBlurSpp = 8;
+// Adaptive sampling's threshold (AdaptiveSampling::threshold x 255): the spread of a pixel's samples, in
+// 8-bit codes of the output, above which it takes more (measured: render/README.md, "Adaptive sampling").
+inline constexpr double kAdaptiveThresholdCodes = 8.0;
+// The adaptive sampling of a render of `spp` samples per pixel (`defaulted`: spp came from DefaultSpp):
+// per RenderOptions::adaptive, min_spp kDefaultSpp; output_scale 0 (set per camera with the sensor
+// model). Throws std::invalid_argument naming --adaptive for an unknown mode.
+AdaptiveSampling RenderAdaptiveSampling(const RenderOptions& options, int spp, bool defaulted);
 // --motion-blur (the sensor's exposure) gets kDefaultBlurSpp only when some exposure of the schedule
 // is at least this long: a point 3 m to the side of a rig at 11.5 m/s moves 0.8 px of a full-size
 // view in 0.5 ms, and daylight exposures (0.07-0.3 ms) blur less.

@@ -129,10 +129,11 @@ int AmbientAndShadowRays(const RenderJob& job, const TileRect& t, int s, int num
         tb.sum[local] = _mm_add_ps(tb.sum[local], _mm_loadu_ps(d.material_emission[tb.material[h]].data()));
       if (!d.lights.empty()) {
         const Eigen::Vector3f x = origin + tfar * dir;
-        // The light choice's uniform: a hashed per-pixel rotation of (s + 1/2) / spp, stratified over
-        // the pixel's samples.
-        const float u = Wrap01((static_cast<float>(s) + 0.5f) * job.inv_spp +
-                               UnitFloat(Mix64(t.Pixel(job, local) * 0xa0761d6478bd642full + 5)));
+        // The light choice's uniform: a hashed per-pixel rotation of the sample's stratum, stratified
+        // over the pixel's samples.
+        const float stratum =
+            job.adaptive ? AdaptiveStratum(job, s) : (static_cast<float>(s) + 0.5f) * job.inv_spp;
+        const float u = Wrap01(stratum + UnitFloat(Mix64(t.Pixel(job, local) * 0xa0761d6478bd642full + 5)));
         AddPointLights(job, h, x, -dir, x + offset * normal, offset, u, local, tb, &num_shadow);
       }
     }

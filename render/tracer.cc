@@ -5,6 +5,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <memory>
 
 #include "render/tracer_internal.h"
@@ -104,60 +106,131 @@ void OccludeShadowRays(const RenderJob& job, RTCIntersectContext* context, int n
   for (int k = 0; k < num_single; ++k) tb.shadow[single[k]].tfar = tb.shadow_scratch[k].tfar;
 }
 
-// One tile: a pixel-centre pass for depth and masks (shared with the only sample when spp == 1),
-// then per sample the camera rays, the three shading passes and the shadow rays; then the resolve.
-// The raw cast computes the same shadow rays (it needs the normal and the sun sample) but no
-// albedo, texture, sky or ambient term.
-void RenderTile(const RenderJob& job, int tile, TileBuffers& tb) {
+// Adaptive sampling (AdaptiveSampling): every pixel of the tile active, no samples yet.
+void StartAdaptiveTile(TileBuffers& tb) {
+  for (int i = 0; i < kTilePixels; ++i) {
+    tb.active[i] = 1;
+    tb.lo[i] = std::numeric_limits<float>::infinity();
+    tb.hi[i] = -std::numeric_limits<float>::infinity();
+  }
+}
+
+// Before a pass: the sums and counts the pass's samples will add to.
+void BeginAdaptivePass(TileBuffers& tb) {
+  for (int i = 0; i < kTilePixels; ++i) {
+    tb.sum_before[i] = tb.sum[i];
+    tb.count_before[i] = tb.count[i];
+  }
+}
+
+// After a pass: each new sample's encoded luminance, sqrt(clamp(output_scale * Y, 0, 1)), widens its
+// pixel's range.
+void EndAdaptivePass(const RenderJob& job, TileBuffers& tb) {
+  for (int i = 0; i < kTilePixels; ++i) {
+    if (!tb.active[i] || tb.count[i] == tb.count_before[i]) continue;
+    alignas(16) float c[4];
+    _mm_store_ps(c, _mm_sub_ps(tb.sum[i], tb.sum_before[i]));
+    const float y = job.output_scale * (0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]);
+    const float e = std::sqrt(std::clamp(y, 0.0f, 1.0f));
+    tb.lo[i] = std::min(tb.lo[i], e);
+    tb.hi[i] = std::max(tb.hi[i], e);
+  }
+}
+
+// At the end of a stage: a pixel stays active when its samples or those of a 4-neighbour in the
+// tile spread more than the threshold (two samples can agree by chance beside an edge that their
+// neighbour's samples straddle). False when no pixel of the tile is left.
+bool CloseAdaptiveStage(const RenderJob& job, TileBuffers& tb) {
+  uint8_t spread[kTilePixels];
+  for (int i = 0; i < kTilePixels; ++i) spread[i] = tb.active[i] && tb.hi[i] - tb.lo[i] > job.adaptive_threshold;
+  bool any = false;
+  for (int i = 0; i < kTilePixels; ++i) {
+    if (!tb.active[i]) continue;
+    const int x = i % kTile, y = i / kTile;
+    const bool keep = spread[i] || (x > 0 && spread[i - 1]) || (x + 1 < kTile && spread[i + 1]) ||
+                      (y > 0 && spread[i - kTile]) || (y + 1 < kTile && spread[i + kTile]);
+    tb.active[i] = keep;
+    any = any || keep;
+  }
+  return any;
+}
+
+// The two intersection contexts of a tile: coherent camera rays; shadow rays through the incoherent
+// path (Embree 3.13's coherent stream path never returned for the rays towards a wide sun disc: a
+// 30-degree overcast sun hung the render).
+struct TileContexts {
+  TileContexts() {
+    rtcInitIntersectContext(&camera);
+    camera.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcInitIntersectContext(&shadow);
+    shadow.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  }
+  RTCIntersectContext camera, shadow;
+};
+
+// Sample s of the tile (-1: the extra pixel-centre pass for depth and masks): the camera rays, the
+// three shading passes and the shadow rays. Returns the number of camera rays.
+int TracePass(const RenderJob& job, const TileRect& t, int s, bool centre_pass, TileContexts& contexts,
+              TileBuffers& tb) {
   const Tracer::Impl& d = job.d;
-  const ShadeSettings& settings = job.settings;
-  const int spp = job.spp;
   const bool raw = job.raw;
+  const bool is_centre = s < 0 || job.spp == 1;
+  const int n = MakeSampleRays(job, t, s, is_centre, tb);
+  if (n == 0) return 0;
+  rtcIntersect1M(d.trace_scene, &contexts.camera, tb.rayhit, static_cast<unsigned>(n), sizeof(RTCRayHit));
+  if (is_centre && !raw && centre_pass) WriteDepthAndMask(job, t, n, tb);
+  if (s < 0) return n;  // the extra centre pass only feeds depth and masks
+
+  int num_hits = 0, num_textured = 0;
+  GatherHits(job, t, n, tb, &num_hits, &num_textured);
+  if (num_textured > 0) ApplyTextures(job, num_textured, tb);
+  const int num_shadow = AmbientAndShadowRays(job, t, s, num_hits, tb);
+  if (num_shadow == 0) return n;
+  if (job.motion) {  // shadow rays at their camera ray's time (moving objects)
+    for (int k = 0; k < num_shadow; ++k)
+      tb.shadow[k].time = job.moving ? tb.pixel_time[tb.shadow_pixel[k]] : job.motion->time_mid;
+  }
+  OccludeShadowRays(job, &contexts.shadow, num_shadow, tb);
+  if (raw) return n;
+  for (int k = 0; k < num_shadow; ++k) {
+    // Embree sets tfar to -inf for occluded rays.
+    if (tb.shadow[k].tfar >= 0.0f) tb.sum[tb.shadow_pixel[k]] = _mm_add_ps(tb.sum[tb.shadow_pixel[k]], tb.direct[k]);
+  }
+  return n;
+}
+
+// One tile: a pixel-centre pass for depth and masks (shared with the only sample when spp == 1),
+// then the samples (TracePass; with adaptive sampling in stages of doubling size, each pass only
+// for the pixels still active); then the resolve. The raw cast computes the same shadow rays (it
+// needs the normal and the sun sample) but no albedo, texture, sky or ambient term.
+void RenderTile(const RenderJob& job, int tile, TileBuffers& tb) {
   TileRect t;
   t.tx0 = (tile % job.tiles_x) * kTile;
   t.ty0 = (tile / job.tiles_x) * kTile;
   t.tw = std::min(kTile, job.width - t.tx0);
   t.th = std::min(kTile, job.height - t.ty0);
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  // Shadow rays towards a wide sun disc are not coherent; Embree 3.13's coherent stream path
-  // never returned for such rays (a 30-degree overcast sun hung the render), so they go
-  // through the incoherent path.
-  RTCIntersectContext shadow_context;
-  rtcInitIntersectContext(&shadow_context);
-  shadow_context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  TileContexts contexts;
   for (int i = 0; i < kTilePixels; ++i) {
     tb.sum[i] = _mm_setzero_ps();
     tb.count[i] = 0;
   }
+  if (job.adaptive) StartAdaptiveTile(tb);
 
-  const bool centre_pass = settings.want_depth || settings.want_mask;
-  for (int s = (centre_pass && spp > 1) ? -1 : 0; s < spp; ++s) {
-    const bool is_centre = s < 0 || spp == 1;
-    const int n = MakeSampleRays(job, t, s, is_centre, tb);
-    if (n == 0) continue;
-    rtcIntersect1M(d.trace_scene, &context, tb.rayhit, static_cast<unsigned>(n), sizeof(RTCRayHit));
-    if (is_centre && !raw && centre_pass) WriteDepthAndMask(job, t, n, tb);
-    if (s < 0) continue;  // the extra centre pass only feeds depth and masks
-
-    int num_hits = 0, num_textured = 0;
-    GatherHits(job, t, n, tb, &num_hits, &num_textured);
-    if (num_textured > 0) ApplyTextures(job, num_textured, tb);
-    const int num_shadow = AmbientAndShadowRays(job, t, s, num_hits, tb);
-    if (num_shadow == 0) continue;
-    if (job.motion) {  // shadow rays at their camera ray's time (moving objects)
-      for (int k = 0; k < num_shadow; ++k)
-        tb.shadow[k].time = job.moving ? tb.pixel_time[tb.shadow_pixel[k]] : job.motion->time_mid;
+  const bool centre_pass = job.settings.want_depth || job.settings.want_mask;
+  if (centre_pass && job.spp > 1) TracePass(job, t, -1, centre_pass, contexts, tb);
+  int64_t samples = 0;
+  int stage_end = job.adaptive ? job.min_spp : job.spp;
+  for (int s = 0; s < job.spp; ++s) {
+    if (s == stage_end) {
+      if (!CloseAdaptiveStage(job, tb)) break;
+      stage_end *= 2;
     }
-    OccludeShadowRays(job, &shadow_context, num_shadow, tb);
-    if (raw) continue;
-    for (int k = 0; k < num_shadow; ++k) {
-      // Embree sets tfar to -inf for occluded rays.
-      if (tb.shadow[k].tfar >= 0.0f) tb.sum[tb.shadow_pixel[k]] = _mm_add_ps(tb.sum[tb.shadow_pixel[k]], tb.direct[k]);
-    }
+    if (job.adaptive) BeginAdaptivePass(tb);
+    samples += TracePass(job, t, s, centre_pass, contexts, tb);
+    if (job.adaptive) EndAdaptivePass(job, tb);
   }
-  if (!raw) ResolveTile(job, t, tb);
+  job.samples.fetch_add(samples, std::memory_order_relaxed);
+  if (!job.raw) ResolveTile(job, t, tb);
 }
 
 }  // namespace
@@ -166,11 +239,14 @@ void RenderTile(const RenderJob& job, int tile, TileBuffers& tb) {
 
 using tracer_internal::kTile;
 using tracer_internal::PrepareImage;
+using tracer_internal::RadicalInverse2;
 using tracer_internal::RenderJob;
 using tracer_internal::RenderTile;
 using tracer_internal::SetSkyTerms;
+using tracer_internal::Sobol2;
 using tracer_internal::TileBuffers;
 using tracer_internal::ToF;
+using tracer_internal::Wrap01;
 
 void SetFlushDenormals() {
   _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
@@ -196,14 +272,25 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
   job.inv_spp = 1.0f / static_cast<float>(spp);
   job.inv_sqrt_spp = 1.0f / std::sqrt(static_cast<float>(spp));
   job.theta_max = static_cast<float>(0.5 * rays.camera.max_fov_deg * M_PI / 180.0);
-  job.precomputed_samples = !settings.rotate_pattern && rays.sample_spp == spp;
+  const AdaptiveSampling& adaptive = settings.adaptive;
+  const auto power_of_two = [](int k) { return k >= 1 && (k & (k - 1)) == 0; };
+  job.adaptive = adaptive.enabled && !settings.raw_cast_only && !settings.rotate_pattern && power_of_two(spp) &&
+                 spp <= 64 && power_of_two(adaptive.min_spp) && adaptive.min_spp < spp;
+  job.min_spp = job.adaptive ? adaptive.min_spp : spp;
+  job.adaptive_threshold = adaptive.threshold;
+  job.output_scale = adaptive.output_scale > 0.0f ? adaptive.output_scale : light.exposure;
+  job.precomputed_samples = !settings.rotate_pattern && !job.adaptive && rays.sample_spp == spp;
   job.soft_sun = settings.soft_shadows && d.sun_disc_radius > 0.0f && spp > 1;
   job.textures = settings.textures;
   job.spp_u = static_cast<uint32_t>(spp);
   SetSkyTerms(d, settings, &job);
   job.exposure_over_count.assign(spp + 1, 0.0f);
   for (int c = 1; c <= spp; ++c) job.exposure_over_count[c] = light.exposure / static_cast<float>(c);
-  for (int s = 0; s < std::min(spp, 64); ++s) job.offsets[s] = CameraRays::SampleOffset(s, spp);
+  for (int s = 0; s < std::min(spp, 64); ++s) {
+    job.offsets[s] = job.adaptive ? Eigen::Vector2f(Wrap01(RadicalInverse2(s) + 0.5f * job.inv_spp) - 0.5f,
+                                                    Wrap01(Sobol2(s) + 0.5f * job.inv_spp) - 0.5f)
+                                  : CameraRays::SampleOffset(s, spp);
+  }
   job.tiles_x = (width + kTile - 1) / kTile;
   job.tiles_y = (height + kTile - 1) / kTile;
 
@@ -214,6 +301,7 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
     if (!buffers) buffers = std::make_unique<TileBuffers>();
     for (int tile = range.begin(); tile < range.end(); ++tile) RenderTile(job, tile, *buffers);
   });
+  if (!settings.raw_cast_only) image->samples = job.samples.load();
 }
 
 }  // namespace rovo

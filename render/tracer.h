@@ -125,6 +125,25 @@ RigCameraRays MakeCameraRays(const std::vector<Camera>& cameras, int threads = 0
 // Upper bound of ShadeSettings::max_shadowed_lights (sizes the per-tile shadow-ray buffers).
 inline constexpr int kMaxShadowedLights = 8;
 
+// Adaptive sampling (ShadeSettings::adaptive): a pixel takes min_spp samples, then doubles its count
+// while the spread of its samples exceeds `threshold`, up to ShadeSettings::spp. The spread is
+// max - min over the pixel's samples of sqrt(clamp(output_scale * Y, 0, 1)), Y the sample's luminance
+// (Rec. 709) and output_scale the factor that takes linear radiance to the output's full scale
+// (0: Lighting::exposure, the default path's); sqrt stands for the output's gamma, so `threshold` is
+// about 8-bit codes / 255. Samples come in the order of a (0,2)-sequence, so every prefix of 2^k
+// samples is stratified in the pixel and in the exposure: sample s sits at the offset
+// (frac(radinv2(s) + 1/(2N)) - 1/2, frac(sobol2(s) + 1/(2N)) - 1/2) and, with a shutter, at the
+// exposure fraction frac(radinv2(s) + 1/(2N) + r_p) (N = spp; r_p as in CameraMotion); the light
+// choice's uniform is rotated the same way. Applies when spp is a power of two above min_spp and the
+// render is not the raw cast (and spp <= 64, no rotated pattern); the decisions are per pixel and per tile, so images do not depend on
+// the thread count.
+struct AdaptiveSampling {
+  bool enabled = false;
+  int min_spp = 2;            // a power of two >= 1
+  float threshold = 0.0f;     // spread in sqrt-encoded output units
+  float output_scale = 0.0f;  // linear radiance -> output full scale; 0: Lighting::exposure
+};
+
 struct ShadeSettings {
   int spp = 1;
   bool shadows = true;
@@ -151,6 +170,8 @@ struct ShadeSettings {
   bool sample_lights = false;
   float min_shadowed_share = 0.0f;
   int max_shadowed_lights = 2;  // in [0, kMaxShadowedLights]
+  // Adaptive sampling (AdaptiveSampling): `spp` is the most a pixel takes.
+  AdaptiveSampling adaptive;
 };
 
 // Time-dependent camera pose of one Render call (motion blur, rolling shutter, trigger offsets;
@@ -179,6 +200,7 @@ struct CameraImage {
   std::vector<uint8_t> gray;   // a grayscale sensor's output, 1 byte per pixel (render/sensor.h)
   std::vector<float> depth;    // metres along the pixel-centre ray, 0 = no hit / outside FOV
   std::vector<uint16_t> mask;  // Object::id of the pixel-centre hit, 0 = static or none
+  int64_t samples = 0;         // camera-ray samples traced (without the depth/mask centre pass)
 };
 
 class Tracer {

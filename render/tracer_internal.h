@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -202,6 +203,12 @@ struct alignas(64) TileBuffers {
   __m128 sum[kTilePixels];                 // linear radiance sums per pixel
   int count[kTilePixels];
   float pixel_time[kTilePixels];  // ray time of each pixel's ray in the current pass (CameraMotion)
+  // Adaptive sampling (AdaptiveSampling): pixels still taking samples, the encoded range of their
+  // samples so far, and their sums and counts before the current pass.
+  uint8_t active[kTilePixels];
+  float lo[kTilePixels], hi[kTilePixels];
+  __m128 sum_before[kTilePixels];
+  int count_before[kTilePixels];
   // The hits of the current sample pass, compacted.
   int hit_ray[kTilePixels];
   Eigen::Vector3f normal[kTilePixels];  // unit, facing the ray
@@ -274,7 +281,19 @@ struct RenderJob {
   std::vector<float> exposure_over_count;
   std::array<Eigen::Vector2f, 64> offsets{};
   int tiles_x = 0, tiles_y = 0;
+  // Adaptive sampling (AdaptiveSampling) of this call: on, the first stage's sample count, the
+  // spread threshold and the factor to output full scale.
+  bool adaptive = false;
+  int min_spp = 1;
+  float adaptive_threshold = 0.0f, output_scale = 1.0f;
+  mutable std::atomic<int64_t> samples{0};  // camera-ray samples traced (CameraImage::samples)
 };
+
+// The stratum of sample s in [0, 1) in the (0,2)-sequence order of adaptive sampling:
+// radinv2(s) + 1 / (2 spp) (else the samples take (s + 1/2) / spp).
+inline float AdaptiveStratum(const RenderJob& job, int s) {
+  return RadicalInverse2(static_cast<uint32_t>(s)) + 0.5f * job.inv_spp;
+}
 
 // One tile's pixel rectangle.
 struct TileRect {

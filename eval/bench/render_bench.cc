@@ -277,6 +277,7 @@ void RunRenderBenchmark(const RenderBenchOptions& options) {
     RunQualityStudy(scene, rig, *tracer, arena);
     RunLightQualityStudy(scene, rig, *tracer, arena);
   }
+  if (options.blur_quality_ms > 0.0) RunBlurQualityStudy(scene, rig, *tracer, arena, options.blur_quality_ms);
 }
 
 }  // namespace rovo

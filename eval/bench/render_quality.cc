@@ -1,11 +1,15 @@
 // The image-quality studies of `rovo bench render --quality`.
 #include "eval/bench/render_quality.h"
 
+#include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <cstdio>
 #include <string>
 #include <vector>
 
+#include "datasets/continuous_trajectory.h"
+#include "render/timing.h"
 #include "render/tracer.h"
 #include "vo/stopwatch.h"
 
@@ -29,6 +33,17 @@ struct FirstView {
   CameraRays rays;
   Rigid3 world_from_cam;
 };
+
+// Off-by-more-than-8-codes share of the valid pixels' values.
+double ShareOffBy8(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b, const std::vector<uint8_t>& valid) {
+  size_t off = 0, n = 0;
+  for (size_t i = 0; i < valid.size(); ++i) {
+    if (!valid[i]) continue;
+    for (int c = 0; c < 3; ++c) off += std::abs(a[3 * i + c] - b[3 * i + c]) > 8;
+    n += 3;
+  }
+  return n ? static_cast<double>(off) / n : 0.0;
+}
 
 FirstView FirstViewOf(const Scene& scene, const Rig& rig, tbb::task_arena& arena) {
   FirstView view;
@@ -164,17 +179,67 @@ void RunLightQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tb
     settings.min_shadowed_share = v.share;
     double cpu = 0.0;
     const std::vector<uint8_t> image = render(settings, &cpu);
-    size_t off = 0, n = 0;
-    for (size_t i = 0; i < rays.valid.size(); ++i) {
-      if (!rays.valid[i]) continue;
-      for (int c = 0; c < 3; ++c) off += std::abs(image[3 * i + c] - reference[3 * i + c]) > 8;
-      n += 3;
-    }
     const std::string rays_text =
         v.sample ? "one to a drawn light per sample"
                  : (v.max_shadowed == 0 ? "none" : "the " + std::to_string(v.max_shadowed) + " strongest");
     std::printf("| %d | %s | %.2f | %.3f | %.4f | %.3f |\n", v.spp, rays_text.c_str(), v.share,
-                MeanAbsDiff(image, reference, rays.valid), n ? static_cast<double>(off) / n : 0.0, cpu);
+                MeanAbsDiff(image, reference, rays.valid), ShareOffBy8(image, reference, rays.valid), cpu);
+  }
+}
+
+void RunBlurQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tbb::task_arena& arena,
+                         double shutter_ms) {
+  if (scene.rig_trajectory.size() < 3) throw std::invalid_argument("--blur-quality: the scene needs 3 frames");
+  constexpr int kReferenceSpp = 64;
+  const ContinuousTrajectory rig_motion(Trajectory(scene.rig_trajectory.begin(), scene.rig_trajectory.begin() + 3));
+  CameraRays rays;
+  arena.execute([&] { rays = CameraRays::Make(rig.cameras[0].camera); });
+  const double half_window_s = 0.5 * shutter_ms / 1000.0;
+  Rigid3 world_from_cam;
+  const CameraMotion motion = MakeCameraMotion(rig_motion, 1, rig.cameras[0].cam_from_rig, half_window_s, 0.0,
+                                               shutter_ms, 0.0, rays.height, &world_from_cam);
+  auto render = [&](const ShadeSettings& settings, double* cpu_seconds, int64_t* samples) {
+    CameraImage image;
+    const double cpu0 = CpuMs();
+    arena.execute([&] {
+      tracer.SetFrameWindow(1, half_window_s);
+      tracer.Render(rays, world_from_cam, settings, &image, &motion);
+    });
+    if (cpu_seconds) *cpu_seconds = (CpuMs() - cpu0) / 1000.0;
+    if (samples) *samples = image.samples;
+    return image.rgb;
+  };
+  ShadeSettings reference_settings;
+  reference_settings.spp = kReferenceSpp;
+  const std::vector<uint8_t> reference = render(reference_settings, nullptr, nullptr);
+  struct Variant {
+    int spp;
+    float threshold_codes;  // < 0: fixed
+  };
+  const std::vector<Variant> variants = {{2, -1.0f}, {4, -1.0f}, {8, -1.0f}, {16, -1.0f}, {8, 4.0f},
+                                         {8, 8.0f},  {8, 12.0f}, {16, 8.0f}, {16, 12.0f}};
+  std::printf(
+      "\nmotion blur: camera 0 of frame 1, %dx%d, global shutter %.1f ms, reference %d spp; 8-bit units over valid "
+      "pixels and channels; off > 8: share of values off by more than 8 codes; adaptive: from %d samples, doubling "
+      "while they spread more than the threshold\n",
+      rays.width, rays.height, shutter_ms, kReferenceSpp, AdaptiveSampling().min_spp);
+  std::printf("| spp | sampling | mean spp | mean abs error | off > 8 | CPU s/view |\n|---:|---|---:|---:|---:|---:|\n");
+  for (const Variant& v : variants) {
+    ShadeSettings settings;
+    settings.spp = v.spp;
+    settings.adaptive.enabled = v.threshold_codes >= 0.0f;
+    settings.adaptive.threshold = v.threshold_codes / 255.0f;
+    double cpu = 0.0;
+    int64_t samples = 0;
+    const std::vector<uint8_t> image = render(settings, &cpu, &samples);
+    char sampling[64];
+    if (settings.adaptive.enabled)
+      std::snprintf(sampling, sizeof(sampling), "adaptive, threshold %.0f codes", v.threshold_codes);
+    else
+      std::snprintf(sampling, sizeof(sampling), "fixed");
+    std::printf("| %d | %s | %.2f | %.3f | %.4f | %.3f |\n", v.spp, sampling,
+                static_cast<double>(samples) / std::max(1, rays.num_valid), MeanAbsDiff(image, reference, rays.valid),
+                ShareOffBy8(image, reference, rays.valid), cpu);
   }
 }
 

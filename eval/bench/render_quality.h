@@ -19,4 +19,12 @@ void RunQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tbb::ta
 // absolute difference to a reference, the share of values off by more than 8 codes and the CPU time.
 void RunLightQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tbb::task_arena& arena);
 
+// Motion blur: renders camera 0 of trajectory frame 1 with a global shutter of `shutter_ms` (the rig
+// from the continuous-time ground truth of frames 0-2) with fixed sample counts and with adaptive
+// sampling (render/tracer.h, AdaptiveSampling) at several thresholds, and prints the mean absolute
+// difference to a 64-spp reference, the share of values off by more than 8 codes, the mean samples per
+// pixel and the CPU time.
+void RunBlurQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tbb::task_arena& arena,
+                         double shutter_ms);
+
 }  // namespace rovo

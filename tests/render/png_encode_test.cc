@@ -28,7 +28,7 @@ std::vector<T> DecodeWithLibpng(const std::string& png, OIIO::TypeDesc type, OII
   if (in) {
     *spec = in->spec();
     pixels.resize(static_cast<size_t>(spec->width) * spec->height * spec->nchannels);
-    EXPECT_TRUE(in->read_image(type, pixels.data())) << in->geterror();
+    EXPECT_TRUE(in->read_image(0, 0, 0, spec->nchannels, type, pixels.data())) << in->geterror();
     in->close();
   }
   fs::remove(path);
