@@ -57,8 +57,8 @@ struct TimingRecord {
   double trigger_offset_std_ms = 0.0;     // standard deviation of the seeded draw (0: explicit or none)
   std::vector<double> trigger_offset_ms;  // o_c, one per rig camera
   // Samples per pixel (optional `sampling`; 0 = not recorded): at most `spp`; with adaptive
-  // sampling a pixel takes min_spp and doubles while its samples spread more than threshold_codes
-  // (render/tracer.h, AdaptiveSampling); min_spp = spp for a fixed count.
+  // sampling a pixel takes min_spp and doubles while the means of its samples' halves differ by more than
+  // threshold_codes (render/tracer.h, AdaptiveSampling); min_spp = spp for a fixed count.
   int spp = 0;
   int min_spp = 0;
   double threshold_codes = 0.0;

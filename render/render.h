@@ -24,18 +24,18 @@ struct RenderOptions {
   int frame_end = -1;
   int shard_index = 0;  // render frames with (frame / chunk) % shard_count == shard_index
   int shard_count = 1;
-  int spp = 0;              // samples per pixel; 0 = the measured default
+  int spp = 0;  // samples per pixel; 0 = the measured default
   // Adaptive sampling (render/tracer.h, AdaptiveSampling): auto = on when motion blur takes the default
   // spp (kDefaultBlurSpp), pixels starting at kDefaultSpp samples; on = whenever spp allows; off = fixed.
   std::string adaptive = "auto";
-  double adaptive_threshold_codes = 0.0;  // spread that takes more samples, 8-bit codes; 0 = kAdaptiveThresholdCodes
-  int threads = 0;          // 0 = all cores
-  uint64_t seed = 0;        // scene seed (preset) and seed of the sensor model's draws
-  bool depth = false;       // write depth/ (EXR ray length)
-  bool masks = false;       // write masks/ (16-bit object ids)
-  double scale = 0.0;       // image scale; 0 = 1.0, or the preset's quick scale with --quick
-  bool quiet = false;       // no progress output
-  float vignetting = 0.0f;  // optional vignetting: gain 1 - v * (theta / theta_max)^2 (0 = off)
+  double adaptive_threshold_codes = 0.0;  // AdaptiveSampling::threshold in 8-bit codes; 0 = kAdaptiveThresholdCodes
+  int threads = 0;                        // 0 = all cores
+  uint64_t seed = 0;                      // scene seed (preset) and seed of the sensor model's draws
+  bool depth = false;                     // write depth/ (EXR ray length)
+  bool masks = false;                     // write masks/ (16-bit object ids)
+  double scale = 0.0;                     // image scale; 0 = 1.0, or the preset's quick scale with --quick
+  bool quiet = false;                     // no progress output
+  float vignetting = 0.0f;                // optional vignetting: gain 1 - v * (theta / theta_max)^2 (0 = off)
   // The physical sensor model (render/sensor.h); off by default (the scene's exposure and sRGB).
   SensorSettings sensor;
   // The lens model of image quality (render/optics.h); off by default (an ideal lens). Needs the sensor model.
@@ -74,8 +74,9 @@ inline constexpr int kDefaultSpp = 2;
 // Samples per pixel when RenderOptions::spp is 0 and motion blur is on: eight time strata per
 // pixel (the blur of a fast pan is several pixels wide; measured in render/README.md).
 inline constexpr int kDefaultBlurSpp = 8;
-// Adaptive sampling's threshold (AdaptiveSampling::threshold x 255): the spread of a pixel's samples, in
-// 8-bit codes of the output, above which it takes more (measured: render/README.md, "Adaptive sampling").
+// Adaptive sampling's threshold (AdaptiveSampling::threshold x 255): the difference of the means of the two
+// halves of a pixel's samples, in 8-bit codes of the output, above which it takes more (measured: render/README.md,
+// "Adaptive sampling").
 inline constexpr double kAdaptiveThresholdCodes = 8.0;
 // The adaptive sampling of a render of `spp` samples per pixel (`defaulted`: spp came from DefaultSpp):
 // per RenderOptions::adaptive, min_spp kDefaultSpp; output_scale 0 (set per camera with the sensor

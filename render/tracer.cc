@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <memory>
 
 #include "render/tracer_internal.h"
@@ -106,52 +105,49 @@ void OccludeShadowRays(const RenderJob& job, RTCIntersectContext* context, int n
   for (int k = 0; k < num_single; ++k) tb.shadow[single[k]].tfar = tb.shadow_scratch[k].tfar;
 }
 
-// Adaptive sampling (AdaptiveSampling): every pixel of the tile active, no samples yet.
+// Adaptive sampling (AdaptiveSampling): every pixel of the tile active.
 void StartAdaptiveTile(TileBuffers& tb) {
+  for (int i = 0; i < kTilePixels; ++i) tb.active[i] = 1;
+}
+
+// The sums and counts that end the first half of the current stage.
+void MarkHalf(TileBuffers& tb) {
   for (int i = 0; i < kTilePixels; ++i) {
-    tb.active[i] = 1;
-    tb.lo[i] = std::numeric_limits<float>::infinity();
-    tb.hi[i] = -std::numeric_limits<float>::infinity();
+    tb.sum_half[i] = tb.sum[i];
+    tb.count_half[i] = tb.count[i];
   }
 }
 
-// Before a pass: the sums and counts the pass's samples will add to.
-void BeginAdaptivePass(TileBuffers& tb) {
-  for (int i = 0; i < kTilePixels; ++i) {
-    tb.sum_before[i] = tb.sum[i];
-    tb.count_before[i] = tb.count[i];
-  }
+// sqrt(clamp(output_scale * Y, 0, 1)) of the mean of `count` samples summing to `sum`.
+inline float EncodedMean(const RenderJob& job, __m128 sum, int count) {
+  alignas(16) float c[4];
+  _mm_store_ps(c, sum);
+  const float y = job.output_scale * (0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]) / static_cast<float>(count);
+  return std::sqrt(std::clamp(y, 0.0f, 1.0f));
 }
 
-// After a pass: each new sample's encoded luminance, sqrt(clamp(output_scale * Y, 0, 1)), widens its
-// pixel's range.
-void EndAdaptivePass(const RenderJob& job, TileBuffers& tb) {
-  for (int i = 0; i < kTilePixels; ++i) {
-    if (!tb.active[i] || tb.count[i] == tb.count_before[i]) continue;
-    alignas(16) float c[4];
-    _mm_store_ps(c, _mm_sub_ps(tb.sum[i], tb.sum_before[i]));
-    const float y = job.output_scale * (0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]);
-    const float e = std::sqrt(std::clamp(y, 0.0f, 1.0f));
-    tb.lo[i] = std::min(tb.lo[i], e);
-    tb.hi[i] = std::max(tb.hi[i], e);
-  }
-}
-
-// At the end of a stage: a pixel stays active when its samples or those of a 4-neighbour in the
-// tile spread more than the threshold (two samples can agree by chance beside an edge that their
-// neighbour's samples straddle). False when no pixel of the tile is left.
+// At the end of a stage: a pixel stays active when the means of its stage's two halves differ by more
+// than the threshold, or those of a 4-neighbour in the tile do (two samples can agree by chance beside
+// an edge that their neighbour's samples straddle). Marks the next stage's first half (this stage's
+// samples). False when no pixel of the tile is left.
 bool CloseAdaptiveStage(const RenderJob& job, TileBuffers& tb) {
-  uint8_t spread[kTilePixels];
-  for (int i = 0; i < kTilePixels; ++i) spread[i] = tb.active[i] && tb.hi[i] - tb.lo[i] > job.adaptive_threshold;
+  uint8_t differ[kTilePixels];
+  for (int i = 0; i < kTilePixels; ++i) {
+    const int n0 = tb.count_half[i], n1 = tb.count[i] - tb.count_half[i];
+    differ[i] = tb.active[i] && n0 > 0 && n1 > 0 &&
+                std::abs(EncodedMean(job, tb.sum_half[i], n0) -
+                         EncodedMean(job, _mm_sub_ps(tb.sum[i], tb.sum_half[i]), n1)) > job.adaptive_threshold;
+  }
   bool any = false;
   for (int i = 0; i < kTilePixels; ++i) {
     if (!tb.active[i]) continue;
     const int x = i % kTile, y = i / kTile;
-    const bool keep = spread[i] || (x > 0 && spread[i - 1]) || (x + 1 < kTile && spread[i + 1]) ||
-                      (y > 0 && spread[i - kTile]) || (y + 1 < kTile && spread[i + kTile]);
+    const bool keep = differ[i] || (x > 0 && differ[i - 1]) || (x + 1 < kTile && differ[i + 1]) ||
+                      (y > 0 && differ[i - kTile]) || (y + 1 < kTile && differ[i + kTile]);
     tb.active[i] = keep;
     any = any || keep;
   }
+  MarkHalf(tb);
   return any;
 }
 
@@ -225,9 +221,8 @@ void RenderTile(const RenderJob& job, int tile, TileBuffers& tb) {
       if (!CloseAdaptiveStage(job, tb)) break;
       stage_end *= 2;
     }
-    if (job.adaptive) BeginAdaptivePass(tb);
     samples += TracePass(job, t, s, centre_pass, contexts, tb);
-    if (job.adaptive) EndAdaptivePass(job, tb);
+    if (job.adaptive && s + 1 == job.min_spp / 2) MarkHalf(tb);  // the first stage's first half
   }
   job.samples.fetch_add(samples, std::memory_order_relaxed);
   if (!job.raw) ResolveTile(job, t, tb);
@@ -275,7 +270,7 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
   const AdaptiveSampling& adaptive = settings.adaptive;
   const auto power_of_two = [](int k) { return k >= 1 && (k & (k - 1)) == 0; };
   job.adaptive = adaptive.enabled && !settings.raw_cast_only && !settings.rotate_pattern && power_of_two(spp) &&
-                 spp <= 64 && power_of_two(adaptive.min_spp) && adaptive.min_spp < spp;
+                 spp <= 64 && adaptive.min_spp >= 2 && power_of_two(adaptive.min_spp) && adaptive.min_spp < spp;
   job.min_spp = job.adaptive ? adaptive.min_spp : spp;
   job.adaptive_threshold = adaptive.threshold;
   job.output_scale = adaptive.output_scale > 0.0f ? adaptive.output_scale : light.exposure;

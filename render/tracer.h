@@ -74,8 +74,9 @@
 // rotation (aliasing traded for noise). With spp = 1 the sample is the pixel centre. Soft-shadow
 // sun directions (spp > 1) come from a 64-point (0,2)-sequence on the sun disc: each pixel takes
 // a hashed, spp-aligned block of spp consecutive points (stratified for power-of-two spp). Depth and mask
-// always come from the pixel-centre ray. Every pixel's value depends only on its own samples, so
-// images are identical for any thread count.
+// always come from the pixel-centre ray. Every pixel's value depends only on its own samples (with
+// AdaptiveSampling also on how many its tile's pixels decide to take), so images are identical for any
+// thread count.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -126,21 +127,22 @@ RigCameraRays MakeCameraRays(const std::vector<Camera>& cameras, int threads = 0
 inline constexpr int kMaxShadowedLights = 8;
 
 // Adaptive sampling (ShadeSettings::adaptive): a pixel takes min_spp samples, then doubles its count
-// while the spread of its samples exceeds `threshold`, up to ShadeSettings::spp. The spread is
-// max - min over the pixel's samples of sqrt(clamp(output_scale * Y, 0, 1)), Y the sample's luminance
-// (Rec. 709) and output_scale the factor that takes linear radiance to the output's full scale
-// (0: Lighting::exposure, the default path's); sqrt stands for the output's gamma, so `threshold` is
-// about 8-bit codes / 255. Samples come in the order of a (0,2)-sequence, so every prefix of 2^k
-// samples is stratified in the pixel and in the exposure: sample s sits at the offset
-// (frac(radinv2(s) + 1/(2N)) - 1/2, frac(sobol2(s) + 1/(2N)) - 1/2) and, with a shutter, at the
-// exposure fraction frac(radinv2(s) + 1/(2N) + r_p) (N = spp; r_p as in CameraMotion); the light
-// choice's uniform is rotated the same way. Applies when spp is a power of two above min_spp and the
-// render is not the raw cast (and spp <= 64, no rotated pattern); the decisions are per pixel and per tile, so images do not depend on
-// the thread count.
+// while its samples so far disagree, up to ShadeSettings::spp. At the end of each stage (min_spp,
+// 2 min_spp, ... samples) the pixel compares the means of the stage's two halves (with min_spp = 2 its
+// two samples): it goes on when they differ by more than `threshold` after the encoding
+// sqrt(clamp(output_scale * Y, 0, 1)) (Y the luminance, Rec. 709; output_scale takes linear radiance
+// to the output's full scale, 0: Lighting::exposure, the default path's), or when a 4-neighbour in its
+// 8x8 tile's do. sqrt stands for the output's gamma, so `threshold` is about 8-bit codes / 255.
+// Samples come in the order of a (0,2)-sequence, so every prefix and half of 2^k samples is stratified
+// in the pixel and in the exposure: sample s sits at the offset (frac(radinv2(s) + 1/(2N)) - 1/2,
+// frac(sobol2(s) + 1/(2N)) - 1/2) and, with a shutter, at the exposure fraction frac(radinv2(s) +
+// 1/(2N) + r_p) (N = spp; r_p as in CameraMotion); the light choice's uniform is rotated the same way.
+// Applies when spp is a power of two above min_spp (at most 64), min_spp a power of two >= 2, no rotated
+// pattern and not the raw cast; the decisions are per tile, so images do not depend on the thread count.
 struct AdaptiveSampling {
   bool enabled = false;
-  int min_spp = 2;            // a power of two >= 1
-  float threshold = 0.0f;     // spread in sqrt-encoded output units
+  int min_spp = 2;            // a power of two >= 2
+  float threshold = 0.0f;     // difference of the halves' means in sqrt-encoded output units
   float output_scale = 0.0f;  // linear radiance -> output full scale; 0: Lighting::exposure
 };
 

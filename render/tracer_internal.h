@@ -203,12 +203,11 @@ struct alignas(64) TileBuffers {
   __m128 sum[kTilePixels];                 // linear radiance sums per pixel
   int count[kTilePixels];
   float pixel_time[kTilePixels];  // ray time of each pixel's ray in the current pass (CameraMotion)
-  // Adaptive sampling (AdaptiveSampling): pixels still taking samples, the encoded range of their
-  // samples so far, and their sums and counts before the current pass.
+  // Adaptive sampling (AdaptiveSampling): pixels still taking samples, and their sums and counts at
+  // the end of the current stage's first half.
   uint8_t active[kTilePixels];
-  float lo[kTilePixels], hi[kTilePixels];
-  __m128 sum_before[kTilePixels];
-  int count_before[kTilePixels];
+  __m128 sum_half[kTilePixels];
+  int count_half[kTilePixels];
   // The hits of the current sample pass, compacted.
   int hit_ray[kTilePixels];
   Eigen::Vector3f normal[kTilePixels];  // unit, facing the ray

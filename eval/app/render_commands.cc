@@ -285,14 +285,18 @@ void AddRenderCommand(CLI::App& root) {
                   "Samples per pixel (default " + std::to_string(kDefaultSpp) + ", measured; 1 = pixel centres)");
   cmd->add_option("--adaptive", args->options.adaptive,
                   "Adaptive sampling: a pixel takes " + std::to_string(kDefaultSpp) +
-                      " samples and doubles them while they spread more than --adaptive-threshold, up to --spp; "
+                      " samples and doubles them while the means of their two halves differ by more than "
+                      "--adaptive-threshold, up to "
+                      "--spp; "
                       "auto = on when motion blur takes the default spp (" +
                       std::to_string(kDefaultBlurSpp) + ")")
       ->check(CLI::IsMember({"auto", "on", "off"}))
       ->capture_default_str();
-  cmd->add_option("--adaptive-threshold", args->options.adaptive_threshold_codes,
-                  "Spread of a pixel's samples, in 8-bit codes of the output, above which it takes more (default " +
-                      std::to_string(kAdaptiveThresholdCodes).substr(0, 3) + ")")
+  cmd->add_option(
+         "--adaptive-threshold", args->options.adaptive_threshold_codes,
+         "Difference of the means of a pixel's two halves of samples, in 8-bit codes of the output, above which it "
+         "takes more (default " +
+             std::to_string(kAdaptiveThresholdCodes).substr(0, 3) + ")")
       ->check(CLI::Range(0.0, 255.0));
   cmd->add_option("--threads", args->options.threads, "Render threads (default: all cores)");
   cmd->add_option("--seed", args->options.seed, "Scene seed (with --preset) and seed of the sensor model's draws")

@@ -3,8 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -221,9 +221,10 @@ void RunBlurQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tbb
   std::printf(
       "\nmotion blur: camera 0 of frame 1, %dx%d, global shutter %.1f ms, reference %d spp; 8-bit units over valid "
       "pixels and channels; off > 8: share of values off by more than 8 codes; adaptive: from %d samples, doubling "
-      "while they spread more than the threshold\n",
+      "while the means of their halves differ by more than the threshold\n",
       rays.width, rays.height, shutter_ms, kReferenceSpp, AdaptiveSampling().min_spp);
-  std::printf("| spp | sampling | mean spp | mean abs error | off > 8 | CPU s/view |\n|---:|---|---:|---:|---:|---:|\n");
+  std::printf(
+      "| spp | sampling | mean spp | mean abs error | off > 8 | CPU s/view |\n|---:|---|---:|---:|---:|---:|\n");
   for (const Variant& v : variants) {
     ShadeSettings settings;
     settings.spp = v.spp;
