@@ -131,8 +131,7 @@ int AmbientAndShadowRays(const RenderJob& job, const TileRect& t, int s, int num
         const Eigen::Vector3f x = origin + tfar * dir;
         // The light choice's uniform: a hashed per-pixel rotation of the sample's stratum, stratified
         // over the pixel's samples.
-        const float stratum =
-            job.adaptive ? AdaptiveStratum(job, s) : (static_cast<float>(s) + 0.5f) * job.inv_spp;
+        const float stratum = job.adaptive ? AdaptiveStratum(job, s) : (static_cast<float>(s) + 0.5f) * job.inv_spp;
         const float u = Wrap01(stratum + UnitFloat(Mix64(t.Pixel(job, local) * 0xa0761d6478bd642full + 5)));
         AddPointLights(job, h, x, -dir, x + offset * normal, offset, u, local, tb, &num_shadow);
       }

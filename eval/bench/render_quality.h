@@ -24,7 +24,6 @@ void RunLightQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tb
 // sampling (render/tracer.h, AdaptiveSampling) at several thresholds, and prints the mean absolute
 // difference to a 64-spp reference, the share of values off by more than 8 codes, the mean samples per
 // pixel and the CPU time.
-void RunBlurQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tbb::task_arena& arena,
-                         double shutter_ms);
+void RunBlurQualityStudy(const Scene& scene, const Rig& rig, Tracer& tracer, tbb::task_arena& arena, double shutter_ms);
 
 }  // namespace rovo

@@ -28,9 +28,9 @@ inline Scene MakeEdgeScene() {
   scene.materials = {bright, dark};
   const float x = static_cast<float>(kWallX);
   scene.meshes.push_back(MakeQuad("bright", Eigen::Vector3f(x, -50, -50), Eigen::Vector3f(x, 0, -50),
-                                           Eigen::Vector3f(x, 0, 50), Eigen::Vector3f(x, -50, 50), 0));
+                                  Eigen::Vector3f(x, 0, 50), Eigen::Vector3f(x, -50, 50), 0));
   scene.meshes.push_back(MakeQuad("dark", Eigen::Vector3f(x, 0, -50), Eigen::Vector3f(x, 50, -50),
-                                           Eigen::Vector3f(x, 50, 50), Eigen::Vector3f(x, 0, 50), 1));
+                                  Eigen::Vector3f(x, 50, 50), Eigen::Vector3f(x, 0, 50), 1));
   for (int m = 0; m < 2; ++m) {
     scene.meshes[m].uvs.clear();
     Object o;
