@@ -251,6 +251,24 @@ struct ImuArgs {
   }
 };
 
+// The samples per pixel of `rovo render`: --spp and adaptive sampling (render/tracer.h, AdaptiveSampling).
+void AddSamplingOptions(CLI::App* cmd, RenderOptions* options) {
+  cmd->add_option("--spp", options->spp,
+                  "Samples per pixel (default " + std::to_string(kDefaultSpp) + ", measured; 1 = pixel centres)");
+  cmd->add_option("--adaptive", options->adaptive,
+                  "Adaptive sampling: a pixel takes " + std::to_string(kDefaultSpp) +
+                      " samples and doubles them while the means of their two halves differ by more than "
+                      "--adaptive-threshold, up to --spp; auto = on when motion blur takes the default spp (" +
+                      std::to_string(kDefaultBlurSpp) + ")")
+      ->check(CLI::IsMember({"auto", "on", "off"}))
+      ->capture_default_str();
+  cmd->add_option("--adaptive-threshold", options->adaptive_threshold_codes,
+                  "Difference of the means of a pixel's two halves of samples, in 8-bit codes of the output, above "
+                  "which it takes more (default " +
+                      std::to_string(kAdaptiveThresholdCodes).substr(0, 3) + ")")
+      ->check(CLI::Range(0.0, 255.0));
+}
+
 void AddRenderCommand(CLI::App& root) {
   struct Args {
     RenderOptions options;
@@ -281,23 +299,7 @@ void AddRenderCommand(CLI::App& root) {
   cmd->add_option("--out", args->options.out_dir, "Output dataset folder")->required();
   cmd->add_option("--frames", args->frames, "Trajectory frame range A:B (B exclusive; default: all)");
   cmd->add_option("--shard", args->shard, "Render only shard I of N (chunks of 8 frames), e.g. 0/4");
-  cmd->add_option("--spp", args->options.spp,
-                  "Samples per pixel (default " + std::to_string(kDefaultSpp) + ", measured; 1 = pixel centres)");
-  cmd->add_option("--adaptive", args->options.adaptive,
-                  "Adaptive sampling: a pixel takes " + std::to_string(kDefaultSpp) +
-                      " samples and doubles them while the means of their two halves differ by more than "
-                      "--adaptive-threshold, up to "
-                      "--spp; "
-                      "auto = on when motion blur takes the default spp (" +
-                      std::to_string(kDefaultBlurSpp) + ")")
-      ->check(CLI::IsMember({"auto", "on", "off"}))
-      ->capture_default_str();
-  cmd->add_option(
-         "--adaptive-threshold", args->options.adaptive_threshold_codes,
-         "Difference of the means of a pixel's two halves of samples, in 8-bit codes of the output, above which it "
-         "takes more (default " +
-             std::to_string(kAdaptiveThresholdCodes).substr(0, 3) + ")")
-      ->check(CLI::Range(0.0, 255.0));
+  AddSamplingOptions(cmd, &args->options);
   cmd->add_option("--threads", args->options.threads, "Render threads (default: all cores)");
   cmd->add_option("--seed", args->options.seed, "Scene seed (with --preset) and seed of the sensor model's draws")
       ->capture_default_str();

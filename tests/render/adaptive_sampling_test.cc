@@ -5,11 +5,9 @@
 #include <tbb/task_arena.h>
 
 #include <cmath>
-#include <filesystem>
 #include <stdexcept>
 #include <string>
 
-#include "datasets/dataset.h"
 #include "render/render.h"
 #include "render/timing.h"
 #include "render/tracer.h"
@@ -114,39 +112,6 @@ TEST(AdaptiveSampling, RenderModes) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("--adaptive"), std::string::npos) << e.what();
   }
-}
-
-// dataset.json records the sampling in `timing`; a min_spp above spp names its field.
-TEST(AdaptiveSampling, TimingRecordKeepsTheSampling) {
-  namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / "rovo_adaptive_record_test";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  DatasetInfo info;
-  info.generator = "test";
-  info.frame_count = 1;
-  info.rig = MakeRigPreset("omnimvs4");
-  TimingSettings t;
-  t.shutter_ms = 5.0;
-  info.timing = MakeTimingRecord(t, TriggerOffsetsMs(t, 4, 3));
-  info.timing->spp = 8;
-  info.timing->min_spp = 2;
-  info.timing->threshold_codes = 8.0;
-  WriteDatasetInfo(dir.string(), info);
-  const DatasetInfo back = ReadDatasetInfo(dir.string());
-  ASSERT_TRUE(back.timing.has_value());
-  EXPECT_EQ(back.timing->spp, 8);
-  EXPECT_EQ(back.timing->min_spp, 2);
-  EXPECT_DOUBLE_EQ(back.timing->threshold_codes, 8.0);
-  info.timing->min_spp = 16;
-  WriteDatasetInfo(dir.string(), info);
-  try {
-    ReadDatasetInfo(dir.string());
-    ADD_FAILURE() << "expected an error";
-  } catch (const std::exception& e) {
-    EXPECT_NE(std::string(e.what()).find("/timing/sampling/min_spp"), std::string::npos) << e.what();
-  }
-  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -226,11 +226,25 @@ TEST(TimingRecord, RoundTripAndValidation) {
   t.rolling_shutter_ms = 20.0;
   t.trigger_offset_std_ms = 1.0;
   info.timing = MakeTimingRecord(t, TriggerOffsetsMs(t, 4, 3));
+  info.timing->spp = 8;  // adaptive sampling from 2 samples (`sampling`)
+  info.timing->min_spp = 2;
+  info.timing->threshold_codes = 8.0;
   WriteDatasetInfo(dir.string(), info);
   const DatasetInfo back = ReadDatasetInfo(dir.string());
   ASSERT_TRUE(back.timing.has_value());
   EXPECT_EQ(*back.timing, *info.timing);
   EXPECT_EQ(back.timing->exposure, "fixed");
+  EXPECT_EQ(back.timing->min_spp, 2);
+  EXPECT_DOUBLE_EQ(back.timing->threshold_codes, 8.0);
+  info.timing->min_spp = 16;
+  WriteDatasetInfo(dir.string(), info);
+  try {
+    ReadDatasetInfo(dir.string());
+    ADD_FAILURE() << "expected an error";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("/timing/sampling/min_spp"), std::string::npos) << e.what();
+  }
+  info.timing->min_spp = 2;
   info.timing->trigger_offset_ms.pop_back();
   WriteDatasetInfo(dir.string(), info);
   try {
