@@ -236,23 +236,21 @@ TEST(TimingRecord, RoundTripAndValidation) {
   EXPECT_EQ(back.timing->exposure, "fixed");
   EXPECT_EQ(back.timing->min_spp, 2);
   EXPECT_DOUBLE_EQ(back.timing->threshold_codes, 8.0);
+  // dataset.json as `info`, read back: the error names `pointer`.
+  const auto expect_error = [&](const std::string& pointer) {
+    WriteDatasetInfo(dir.string(), info);
+    try {
+      ReadDatasetInfo(dir.string());
+      ADD_FAILURE() << "expected an error at " << pointer;
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find(pointer), std::string::npos) << e.what();
+    }
+  };
   info.timing->min_spp = 16;
-  WriteDatasetInfo(dir.string(), info);
-  try {
-    ReadDatasetInfo(dir.string());
-    ADD_FAILURE() << "expected an error";
-  } catch (const std::exception& e) {
-    EXPECT_NE(std::string(e.what()).find("/timing/sampling/min_spp"), std::string::npos) << e.what();
-  }
+  expect_error("/timing/sampling/min_spp");
   info.timing->min_spp = 2;
   info.timing->trigger_offset_ms.pop_back();
-  WriteDatasetInfo(dir.string(), info);
-  try {
-    ReadDatasetInfo(dir.string());
-    ADD_FAILURE() << "expected an error";
-  } catch (const std::exception& e) {
-    EXPECT_NE(std::string(e.what()).find("/timing/trigger_offset_ms"), std::string::npos) << e.what();
-  }
+  expect_error("/timing/trigger_offset_ms");
   fs::remove_all(dir);
 }
 
