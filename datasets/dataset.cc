@@ -202,6 +202,13 @@ bool SensorRecord::operator==(const SensorRecord& o) const { return SensorJson(*
 
 bool TimingRecord::operator==(const TimingRecord& o) const { return TimingJson(*this) == TimingJson(o); }
 
+bool TimingRecord::SameExposure(const TimingRecord& o) const {
+  TimingRecord a = *this, b = o;
+  a.spp = b.spp = a.min_spp = b.min_spp = 0;
+  a.threshold_codes = b.threshold_codes = 0.0;
+  return a == b;
+}
+
 // ---- paths --------------------------------------------------------------------------------------
 
 std::string DatasetJsonPath(const std::string& dir) { return JoinPath(dir, "dataset.json"); }

@@ -64,6 +64,8 @@ struct TimingRecord {
   double threshold_codes = 0.0;
   bool operator==(const TimingRecord& other) const;
   bool operator!=(const TimingRecord& other) const { return !(*this == other); }
+  // Equal but for the sampling (spp, min_spp, threshold_codes): the same exposure times.
+  bool SameExposure(const TimingRecord& other) const;
 };
 
 struct DatasetInfo {

@@ -83,6 +83,26 @@ Eigen::Vector2f CameraRays::SampleOffset(int s, int spp) {
   return Eigen::Vector2f((s + 0.5f) / n - 0.5f, Wrap01(RadicalInverse2(static_cast<uint32_t>(s)) + 0.5f / n) - 0.5f);
 }
 
+Eigen::Vector2f CameraRays::AdaptiveSample(int s, int spp, float* stratum) {
+  auto bitrev = [](uint32_t j, int bits) {
+    uint32_t r = 0;
+    for (int b = 0; b < bits; ++b, j >>= 1) r = (r << 1) | (j & 1u);
+    return r;
+  };
+  int m = 0;
+  while ((1 << m) < spp) ++m;
+  const uint32_t n = 1u << m, mask = n >= 4 ? n / 4 - 1 : 0u;
+  const uint32_t j = static_cast<uint32_t>(s) / 2;
+  uint32_t column = bitrev(j, m - 1) ^ mask, row = bitrev(j ^ (j >> 1), m) ^ mask;
+  if (s % 2 == 1) {
+    column = n - 1 - column;
+    row = n - 1 - row;
+  }
+  const float inv = 1.0f / static_cast<float>(n);
+  *stratum = (static_cast<float>(column) + 0.5f) * inv;
+  return Eigen::Vector2f(*stratum - 0.5f, (static_cast<float>(row) + 0.5f) * inv - 0.5f);
+}
+
 namespace {
 
 // Runs `f` in a task arena of `threads` threads (0: the calling arena, all cores).

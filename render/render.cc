@@ -174,8 +174,10 @@ void CheckExistingDataset(const std::string& out_dir, const DatasetInfo& info) {
   if (old.has_masks != info.has_masks) differ("has_masks");
   if (old.sensor.has_value() != info.sensor.has_value() || (old.sensor && *old.sensor != *info.sensor))
     differ("sensor");
-  if (old.timing.has_value() != info.timing.has_value() || (old.timing && *old.timing != *info.timing))
+  if (old.timing.has_value() != info.timing.has_value() || (old.timing && !old.timing->SameExposure(*info.timing)))
     differ("timing");
+  // A record without `sampling` resumes with any sampling.
+  if (old.timing && old.timing->spp > 0 && *old.timing != *info.timing) differ("timing/sampling");
   if (old.optics.has_value() != info.optics.has_value() || (old.optics && *old.optics != *info.optics))
     differ("optics");
   if (old.rig.NumCameras() != info.rig.NumCameras()) differ("rig/cameras");
@@ -395,7 +397,7 @@ DatasetInfo MakeDatasetInfo(const RenderOptions& options, const Scene& scene, co
 // The timing record's samples per pixel.
 void RecordSampling(int spp, const AdaptiveSampling& adaptive, TimingRecord* timing) {
   timing->spp = spp;
-  const bool on = adaptive.enabled && spp > adaptive.min_spp;
+  const bool on = AdaptiveApplies(adaptive, spp);
   timing->min_spp = on ? adaptive.min_spp : spp;
   timing->threshold_codes = on ? std::round(adaptive.threshold * 255.0 * 1e6) / 1e6 : 0.0;
 }
@@ -621,6 +623,13 @@ AdaptiveSampling RenderAdaptiveSampling(const RenderOptions& options, int spp, b
   AdaptiveSampling adaptive;
   adaptive.enabled = options.adaptive == "on" || (options.adaptive == "auto" && defaulted && spp == kDefaultBlurSpp);
   adaptive.min_spp = kDefaultSpp;
+  if (options.adaptive == "on" && !options.timing.Enabled())
+    throw std::invalid_argument(
+        "--adaptive on: needs timing (--shutter-ms, --motion-blur, --rolling-shutter-ms or "
+        "--trigger-offset-ms), whose record in dataset.json states the sampling");
+  if (options.adaptive == "on" && !AdaptiveApplies(adaptive, spp))
+    throw std::invalid_argument("--adaptive on: --spp " + std::to_string(spp) + " must be a power of two in [" +
+                                std::to_string(2 * kDefaultSpp) + ", 64]");
   const double codes =
       options.adaptive_threshold_codes > 0.0 ? options.adaptive_threshold_codes : kAdaptiveThresholdCodes;
   adaptive.threshold = static_cast<float>(codes / 255.0);

@@ -71,7 +71,7 @@ RenderSummary RenderDataset(const RenderOptions& options);
 // 32-spp reference is below one 8-bit code (fixed 2-sample diagonal pattern, trilinear textures,
 // LOD bias -0.5; measured with `rovo bench render --quality`, table in render/README.md).
 inline constexpr int kDefaultSpp = 2;
-// Samples per pixel when RenderOptions::spp is 0 and motion blur is on: eight time strata per
+// Samples per pixel when RenderOptions::spp is 0 and motion blur is on: up to eight time strata per
 // pixel (the blur of a fast pan is several pixels wide; measured in render/README.md).
 inline constexpr int kDefaultBlurSpp = 8;
 // Adaptive sampling's threshold (AdaptiveSampling::threshold x 255): the difference of the means of the two
@@ -80,7 +80,8 @@ inline constexpr int kDefaultBlurSpp = 8;
 inline constexpr double kAdaptiveThresholdCodes = 8.0;
 // The adaptive sampling of a render of `spp` samples per pixel (`defaulted`: spp came from DefaultSpp):
 // per RenderOptions::adaptive, min_spp kDefaultSpp; output_scale 0 (set per camera with the sensor
-// model). Throws std::invalid_argument naming --adaptive for an unknown mode.
+// model). Throws std::invalid_argument naming --adaptive for an unknown mode, and for `on` without timing
+// (dataset.json records the sampling with the timing) or with an spp it does not apply to (AdaptiveApplies).
 AdaptiveSampling RenderAdaptiveSampling(const RenderOptions& options, int spp, bool defaulted);
 // --motion-blur (the sensor's exposure) gets kDefaultBlurSpp only when some exposure of the schedule
 // is at least this long: a point 3 m to the side of a rig at 11.5 m/s moves 0.8 px of a full-size

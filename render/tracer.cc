@@ -234,14 +234,17 @@ void RenderTile(const RenderJob& job, int tile, TileBuffers& tb) {
 
 using tracer_internal::kTile;
 using tracer_internal::PrepareImage;
-using tracer_internal::RadicalInverse2;
 using tracer_internal::RenderJob;
 using tracer_internal::RenderTile;
 using tracer_internal::SetSkyTerms;
-using tracer_internal::Sobol2;
 using tracer_internal::TileBuffers;
 using tracer_internal::ToF;
-using tracer_internal::Wrap01;
+
+bool AdaptiveApplies(const AdaptiveSampling& adaptive, int spp) {
+  const auto power_of_two = [](int k) { return k >= 1 && (k & (k - 1)) == 0; };
+  return adaptive.enabled && power_of_two(spp) && spp <= 64 && adaptive.min_spp >= 2 &&
+         power_of_two(adaptive.min_spp) && adaptive.min_spp < spp;
+}
 
 void SetFlushDenormals() {
   _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
@@ -268,9 +271,7 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
   job.inv_sqrt_spp = 1.0f / std::sqrt(static_cast<float>(spp));
   job.theta_max = static_cast<float>(0.5 * rays.camera.max_fov_deg * M_PI / 180.0);
   const AdaptiveSampling& adaptive = settings.adaptive;
-  const auto power_of_two = [](int k) { return k >= 1 && (k & (k - 1)) == 0; };
-  job.adaptive = adaptive.enabled && !settings.raw_cast_only && !settings.rotate_pattern && power_of_two(spp) &&
-                 spp <= 64 && adaptive.min_spp >= 2 && power_of_two(adaptive.min_spp) && adaptive.min_spp < spp;
+  job.adaptive = AdaptiveApplies(adaptive, spp) && !settings.raw_cast_only && !settings.rotate_pattern;
   job.min_spp = job.adaptive ? adaptive.min_spp : spp;
   job.adaptive_threshold = adaptive.threshold;
   job.output_scale = adaptive.output_scale > 0.0f ? adaptive.output_scale : light.exposure;
@@ -282,9 +283,10 @@ void Tracer::Render(const CameraRays& rays, const Rigid3& world_from_cam, const 
   job.exposure_over_count.assign(spp + 1, 0.0f);
   for (int c = 1; c <= spp; ++c) job.exposure_over_count[c] = light.exposure / static_cast<float>(c);
   for (int s = 0; s < std::min(spp, 64); ++s) {
-    job.offsets[s] = job.adaptive ? Eigen::Vector2f(Wrap01(RadicalInverse2(s) + 0.5f * job.inv_spp) - 0.5f,
-                                                    Wrap01(Sobol2(s) + 0.5f * job.inv_spp) - 0.5f)
-                                  : CameraRays::SampleOffset(s, spp);
+    if (job.adaptive)
+      job.offsets[s] = CameraRays::AdaptiveSample(s, spp, &job.adaptive_stratum[s]);
+    else
+      job.offsets[s] = CameraRays::SampleOffset(s, spp);
   }
   job.tiles_x = (width + kTile - 1) / kTile;
   job.tiles_y = (height + kTile - 1) / kTile;

@@ -114,6 +114,14 @@ struct CameraRays {
   // Offset from the pixel centre, in pixels within [-1/2, 1/2)^2, of sample s of the fixed
   // `spp`-sample pattern (see the file comment); (0, 0) for spp = 1.
   static Eigen::Vector2f SampleOffset(int s, int spp);
+  // Sample s of adaptive sampling's order for a power-of-two spp >= 2 (AdaptiveSampling): offset from
+  // the pixel centre in [-1/2, 1/2)^2 and, in *stratum, its stratum in [0, 1) for the exposure time and
+  // the light choice. Samples come in pairs mirrored through the pixel centre (2j and 2j + 1); on the
+  // grid of N = spp strata per axis, pair j's first sample is at column bitrev_{m-1}(j) xor (N/4 - 1)
+  // and row bitrev_m(j xor j/2) xor (N/4 - 1) (m = log2 N; masks 0 for N = 2), centres of strata. So
+  // every prefix of 2^k samples, and each half of it, has one sample per 1/2^k of each axis and is
+  // centred on the pixel, and the N strata are the fixed pattern's (s + 1/2) / N.
+  static Eigen::Vector2f AdaptiveSample(int s, int spp, float* stratum);
 };
 
 // The camera rays of each camera of a rig; cameras with identical intrinsics share one table.
@@ -133,18 +141,24 @@ inline constexpr int kMaxShadowedLights = 8;
 // sqrt(clamp(output_scale * Y, 0, 1)) (Y the luminance, Rec. 709; output_scale takes linear radiance
 // to the output's full scale, 0: Lighting::exposure, the default path's), or when a 4-neighbour in its
 // 8x8 tile's do. sqrt stands for the output's gamma, so `threshold` is about 8-bit codes / 255.
-// Samples come in the order of a (0,2)-sequence, so every prefix and half of 2^k samples is stratified
-// in the pixel and in the exposure: sample s sits at the offset (frac(radinv2(s) + 1/(2N)) - 1/2,
-// frac(sobol2(s) + 1/(2N)) - 1/2) and, with a shutter, at the exposure fraction frac(radinv2(s) +
-// 1/(2N) + r_p) (N = spp; r_p as in CameraMotion); the light choice's uniform is rotated the same way.
-// Applies when spp is a power of two above min_spp (at most 64), min_spp a power of two >= 2, no rotated
-// pattern and not the raw cast; the decisions are per tile, so images do not depend on the thread count.
+// Samples come in CameraRays::AdaptiveSample's order (offset and stratum of sample s): every prefix and
+// half of 2^k samples is stratified in the pixel and in the exposure and centred on the pixel, so a
+// pixel that stops early is not shifted. With a shutter sample s is at the exposure fraction
+// frac(stratum_s + r_p) (r_p as in CameraMotion); the light choice's uniform is rotated the same way.
+// The texture level of detail stays that of spp samples (pixels that stop early filter less).
+// Applies where AdaptiveApplies, with no rotated pattern and not the raw cast; the decisions are per
+// tile, so images do not depend on the thread count.
 struct AdaptiveSampling {
   bool enabled = false;
   int min_spp = 2;            // a power of two >= 2
   float threshold = 0.0f;     // difference of the halves' means in sqrt-encoded output units
   float output_scale = 0.0f;  // linear radiance -> output full scale; 0: Lighting::exposure
 };
+
+// Whether `adaptive` applies to a render of `spp` samples per pixel: enabled, spp a power of two in
+// (min_spp, 64], min_spp a power of two >= 2 (Tracer::Render also needs no rotated pattern and not the
+// raw cast).
+bool AdaptiveApplies(const AdaptiveSampling& adaptive, int spp);
 
 struct ShadeSettings {
   int spp = 1;
@@ -180,7 +194,8 @@ struct ShadeSettings {
 // the rules are in datasets/FORMAT.md, section "Timing"). Times are ray times in [0, 1], Embree's
 // RTCRay::time, spanning the frame's time window set by Tracer::SetFrameWindow. Row v (0 = top) of
 // the image is exposed around tau_v = time_mid + (v / (H - 1) - 1/2) * readout; sample s of pixel
-// p (spp > 1) is at tau_v + (w - 1/2) * shutter with w = frac((s + 1/2) / spp + r_p), r_p a hashed
+// p (spp > 1) is at tau_v + (w - 1/2) * shutter with w = frac((s + 1/2) / spp + r_p) (with adaptive
+// sampling frac(stratum_s + r_p), AdaptiveSampling), r_p a hashed
 // per-pixel rotation (stratified in time, uncorrelated between pixels); the pixel-centre ray
 // (depth, masks, and the only sample when spp = 1) is at tau_v. The ray at time tau starts at
 // origin(tau) along rotation(tau) * bearing, both linearly interpolated in the table below. With

@@ -279,6 +279,7 @@ struct RenderJob {
   // exposure / (samples of a pixel): a pixel has at most spp samples.
   std::vector<float> exposure_over_count;
   std::array<Eigen::Vector2f, 64> offsets{};
+  std::array<float, 64> adaptive_stratum{};  // adaptive sampling: sample s's time and light-choice stratum
   int tiles_x = 0, tiles_y = 0;
   // Adaptive sampling (AdaptiveSampling) of this call: on, the first stage's sample count, the
   // spread threshold and the factor to output full scale.
@@ -288,11 +289,9 @@ struct RenderJob {
   mutable std::atomic<int64_t> samples{0};  // camera-ray samples traced (CameraImage::samples)
 };
 
-// The stratum of sample s in [0, 1) in the (0,2)-sequence order of adaptive sampling:
-// radinv2(s) + 1 / (2 spp) (else the samples take (s + 1/2) / spp).
-inline float AdaptiveStratum(const RenderJob& job, int s) {
-  return RadicalInverse2(static_cast<uint32_t>(s)) + 0.5f * job.inv_spp;
-}
+// The stratum of sample s in [0, 1) in the order of adaptive sampling (CameraRays::AdaptiveSample; else
+// the samples take (s + 1/2) / spp).
+inline float AdaptiveStratum(const RenderJob& job, int s) { return job.adaptive_stratum[s]; }
 
 // One tile's pixel rectangle.
 struct TileRect {

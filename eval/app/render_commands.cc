@@ -265,7 +265,7 @@ void AddSamplingOptions(CLI::App* cmd, RenderOptions* options) {
   cmd->add_option("--adaptive-threshold", options->adaptive_threshold_codes,
                   "Difference of the means of a pixel's two halves of samples, in 8-bit codes of the output, above "
                   "which it takes more (default " +
-                      std::to_string(kAdaptiveThresholdCodes).substr(0, 3) + ")")
+                      std::to_string(kAdaptiveThresholdCodes).substr(0, 3) + "; 0 = the default)")
       ->check(CLI::Range(0.0, 255.0));
 }
 

@@ -71,8 +71,9 @@ bool RunReusable(const std::string& run_dir, const RunSettings& want, std::strin
 
 namespace {
 
-// Whether the dataset's sensor and timing records are the ones `render` would write, and it has an IMU
-// exactly when `render` adds one (a variant's dataset rendered with other effects is not reused).
+// Whether the dataset's sensor and timing records are the ones `render` would write (the timing's
+// sampling aside), and it has an IMU exactly when `render` adds one (a variant's dataset rendered with
+// other effects is not reused).
 bool EffectsMatch(const DatasetInfo& info, const RenderOptions& render) {
   const int n = info.rig.NumCameras();
   if (render.sensor.enabled != info.sensor.has_value() || render.timing.Enabled() != info.timing.has_value() ||
@@ -82,7 +83,7 @@ bool EffectsMatch(const DatasetInfo& info, const RenderOptions& render) {
       *info.sensor != MakeSensorRecord(render.sensor, CameraSensitivities(render.sensor, n, render.seed)))
     return false;
   return !info.timing ||
-         *info.timing == MakeTimingRecord(render.timing, TriggerOffsetsMs(render.timing, n, render.seed));
+         info.timing->SameExposure(MakeTimingRecord(render.timing, TriggerOffsetsMs(render.timing, n, render.seed)));
 }
 
 // Complete: the first `max_frames` frames (all when <= 0) have every camera's image, and the effects

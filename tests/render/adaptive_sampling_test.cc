@@ -4,9 +4,12 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
+#include <set>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "render/render.h"
 #include "render/timing.h"
@@ -89,6 +92,38 @@ TEST(AdaptiveSampling, SameImageOnAnyThreadCount) {
   EXPECT_EQ(one.samples, two.samples);
 }
 
+// The order of the samples: every prefix of 2^k samples and each half of it has one sample in each
+// 1/2^k of either axis (and of the strata), its offsets average to the pixel centre, and all N strata are
+// the fixed pattern's (s + 1/2) / N.
+TEST(AdaptiveSampling, EveryPrefixIsStratifiedAndCentred) {
+  for (int spp = 2; spp <= 64; spp *= 2) {
+    std::vector<Eigen::Vector2f> offset(spp);
+    std::vector<float> stratum(spp);
+    for (int s = 0; s < spp; ++s) offset[s] = CameraRays::AdaptiveSample(s, spp, &stratum[s]);
+    const auto stratified = [&](int begin, int n) {
+      std::set<int> xs, ys, ts;
+      for (int s = begin; s < begin + n; ++s) {
+        xs.insert(static_cast<int>(std::floor((offset[s].x() + 0.5f) * n)));
+        ys.insert(static_cast<int>(std::floor((offset[s].y() + 0.5f) * n)));
+        ts.insert(static_cast<int>(std::floor(stratum[s] * n)));
+      }
+      return static_cast<int>(xs.size()) == n && static_cast<int>(ys.size()) == n && static_cast<int>(ts.size()) == n;
+    };
+    for (int n = 2; n <= spp; n *= 2) {
+      EXPECT_TRUE(stratified(0, n)) << "spp " << spp << ", prefix " << n;
+      if (n >= 4) {
+        EXPECT_TRUE(stratified(0, n / 2) && stratified(n / 2, n / 2)) << "spp " << spp << ", halves of " << n;
+      }
+      Eigen::Vector2f mean = Eigen::Vector2f::Zero();
+      for (int s = 0; s < n; ++s) mean += offset[s];
+      EXPECT_LT(mean.norm() / n, 1e-6f) << "spp " << spp << ", prefix " << n;
+    }
+    std::vector<float> sorted = stratum;
+    std::sort(sorted.begin(), sorted.end());
+    for (int s = 0; s < spp; ++s) EXPECT_FLOAT_EQ(sorted[s], (s + 0.5f) / spp);
+  }
+}
+
 // rovo render: auto turns it on exactly where motion blur takes the default spp.
 TEST(AdaptiveSampling, RenderModes) {
   RenderOptions options;
@@ -99,19 +134,26 @@ TEST(AdaptiveSampling, RenderModes) {
                   static_cast<float>(kAdaptiveThresholdCodes / 255.0));
   options.adaptive = "on";
   options.adaptive_threshold_codes = 3.0;
+  const auto expect_error = [&](int spp, const std::string& text) {
+    try {
+      RenderAdaptiveSampling(options, spp, false);
+      ADD_FAILURE() << "expected an error naming " << text;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+    }
+  };
+  expect_error(16, "needs timing");  // the record would have nowhere to go
+  options.timing.shutter_ms = 10.0;
   const AdaptiveSampling on = RenderAdaptiveSampling(options, 16, false);
   EXPECT_TRUE(on.enabled);
   EXPECT_EQ(on.min_spp, kDefaultSpp);
   EXPECT_FLOAT_EQ(on.threshold, 3.0f / 255.0f);
+  expect_error(6, "--spp 6");
+  expect_error(128, "--spp 128");
   options.adaptive = "off";
   EXPECT_FALSE(RenderAdaptiveSampling(options, kDefaultBlurSpp, true).enabled);
   options.adaptive = "sometimes";
-  try {
-    RenderAdaptiveSampling(options, kDefaultBlurSpp, true);
-    ADD_FAILURE() << "expected an error";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("--adaptive"), std::string::npos) << e.what();
-  }
+  expect_error(kDefaultBlurSpp, "--adaptive");
 }
 
 }  // namespace
