@@ -246,6 +246,14 @@ TEST(TimingRecord, RoundTripAndValidation) {
       EXPECT_NE(std::string(e.what()).find(pointer), std::string::npos) << e.what();
     }
   };
+  // Resume and the suite's reuse compare the exposure times, not the sampling.
+  TimingRecord fixed = *info.timing;
+  fixed.spp = fixed.min_spp = 0;
+  fixed.threshold_codes = 0.0;
+  EXPECT_TRUE(fixed.SameExposure(*info.timing));
+  EXPECT_NE(fixed, *info.timing);
+  fixed.shutter_ms = 4.0;
+  EXPECT_FALSE(fixed.SameExposure(*info.timing));
   info.timing->min_spp = 16;
   expect_error("/timing/sampling/min_spp");
   info.timing->min_spp = 2;
