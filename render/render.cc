@@ -550,7 +550,8 @@ void RenderFrames(const RenderOptions& options, const Scene& scene, const Rig& r
   arena.execute([&] {
     std::vector<Camera> cameras;
     for (const RigCamera& cam : rig.cameras) cameras.push_back(cam.camera);
-    rays = MakeCameraRays(cameras, 0, spp);
+    // Adaptive sampling takes its own sample positions: no table of the fixed pattern's bearings.
+    rays = MakeCameraRays(cameras, 0, AdaptiveApplies(adaptive, spp) ? 1 : spp);
   });
 
   ShadeSettings settings;
