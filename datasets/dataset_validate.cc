@@ -1,6 +1,5 @@
 #include "datasets/dataset_validate.h"
 
-#include <OpenImageIO/imageio.h>
 
 #include <cctype>
 #include <cmath>
@@ -10,6 +9,7 @@
 
 #include "datasets/dataset.h"
 #include "datasets/dataset_internal.h"
+#include "datasets/image_file.h"
 #include "datasets/io.h"
 #include "datasets/json_check.h"
 
@@ -19,33 +19,28 @@ using nlohmann::json;
 
 namespace {
 
-// Image header check (OpenImageIO reads the header only).
+// Image header check (the header only).
 void CheckImage(const std::string& path, const std::string& field, int width, int height, int max_channels,
                 std::vector<ValidationIssue>* issues) {
-  const std::string png_problem = PngChunkProblem(path);
-  if (!png_problem.empty()) {
-    issues->push_back({path, field, "unreadable image: " + png_problem});
+  ImageHeader header;
+  try {
+    header = ReadImageHeader(path);
+  } catch (const std::runtime_error& e) {
+    std::string why = e.what();
+    if (why.rfind(path + ": ", 0) == 0) why = why.substr(path.size() + 2);
+    issues->push_back({path, field, "unreadable image: " + why});
     return;
   }
-  auto input = OIIO::ImageInput::open(path);
-  if (!input) {
-    std::string error = OIIO::geterror();
-    if (error.empty()) error = "cannot open";
-    issues->push_back({path, field, "unreadable image: " + error});
-    return;
-  }
-  const OIIO::ImageSpec& spec = input->spec();
-  if (spec.width != width || spec.height != height) {
+  if (header.width != width || header.height != height) {
     issues->push_back({path, field,
-                       "image is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                       "image is " + std::to_string(header.width) + "x" + std::to_string(header.height) +
                            " but the rig camera is " + std::to_string(width) + "x" + std::to_string(height)});
   }
-  if (spec.nchannels < 1 || spec.nchannels > max_channels) {
+  if (header.channels < 1 || header.channels > max_channels) {
     issues->push_back({path, field,
-                       "image has " + std::to_string(spec.nchannels) + " channels (expected 1.." +
+                       "image has " + std::to_string(header.channels) + " channels (expected 1.." +
                            std::to_string(max_channels) + ")"});
   }
-  input->close();
 }
 
 // Frame numbers of files named NNNNNN.<extension> in `folder`; other names go to `others`.

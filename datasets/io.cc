@@ -76,18 +76,16 @@ void EnsureWritableDir(const std::string& dir) {
   if (::access(dir.c_str(), W_OK) != 0) throw std::runtime_error(dir + ": folder is not writable");
 }
 
-std::string PngChunkProblem(const std::string& path) {
-  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  std::ifstream in(path, std::ios::binary);
-  unsigned char header[8];
-  if (!in.read(reinterpret_cast<char*>(header), 8) || std::memcmp(header, kSignature, 8) != 0) return "";
-  std::error_code ec;
-  const uint64_t size = fs::file_size(path, ec);
-  if (ec) return "cannot read the file size";
+namespace {
+
+// PngChunkProblem's walk over the chunks of a PNG of `size` bytes; read8(offset, out) reads the 8
+// bytes at `offset` (false when it cannot).
+template <typename Read8>
+std::string WalkPngChunks(uint64_t size, Read8 read8) {
   uint64_t offset = 8;
   for (int index = 0; offset < size; ++index) {
     unsigned char chunk[8];  // length (big-endian), type
-    if (!in.read(reinterpret_cast<char*>(chunk), 8)) return "truncated chunk header at byte " + std::to_string(offset);
+    if (!read8(offset, chunk)) return "truncated chunk header at byte " + std::to_string(offset);
     const uint64_t length =
         (uint64_t{chunk[0]} << 24) | (uint64_t{chunk[1]} << 16) | (uint64_t{chunk[2]} << 8) | chunk[3];
     const std::string type(reinterpret_cast<const char*>(chunk + 4), 4);
@@ -98,9 +96,34 @@ std::string PngChunkProblem(const std::string& path) {
     }
     if (type == "IEND") return "";
     offset += 12 + length;
-    in.seekg(static_cast<std::streamoff>(offset));
   }
   return "";
+}
+
+const unsigned char kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+
+}  // namespace
+
+std::string PngChunkProblem(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char header[8];
+  if (!in.read(reinterpret_cast<char*>(header), 8) || std::memcmp(header, kPngSignature, 8) != 0) return "";
+  std::error_code ec;
+  const uint64_t size = fs::file_size(path, ec);
+  if (ec) return "cannot read the file size";
+  return WalkPngChunks(size, [&](uint64_t offset, unsigned char* out) {
+    in.seekg(static_cast<std::streamoff>(offset));
+    return static_cast<bool>(in.read(reinterpret_cast<char*>(out), 8));
+  });
+}
+
+std::string PngChunkProblem(const uint8_t* data, size_t size) {
+  if (size < 8 || std::memcmp(data, kPngSignature, 8) != 0) return "";
+  return WalkPngChunks(size, [&](uint64_t offset, unsigned char* out) {
+    if (offset + 8 > size) return false;
+    std::memcpy(out, data + offset, 8);
+    return true;
+  });
 }
 
 std::string HashHex(const void* data, size_t size, uint64_t seed) {

@@ -1,7 +1,7 @@
 #pragma once
 // Atomic image writers for the render outputs (a temporary sibling is written, then renamed onto the
 // final name, so a killed process never leaves a partial file under the final name). PNGs are encoded
-// by render/png_encode.h, EXR by OpenImageIO.
+// by datasets/png_encode.h, EXR by OpenEXR (datasets/image_file.h).
 
 #include <cstdint>
 #include <string>

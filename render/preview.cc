@@ -1,5 +1,4 @@
 // `rovo scene preview` (contact sheet). (`rovo bench render` is in render/bench.cc.)
-#include <OpenImageIO/imageio.h>
 #include <sys/resource.h>
 #include <tbb/task_arena.h>
 
@@ -11,10 +10,12 @@
 #include <functional>
 #include <stdexcept>
 
+#include "datasets/image_file.h"
 #include "datasets/io.h"
 #include "render/image_io.h"
 #include "render/render.h"
 #include "render/tracer.h"
+#include "rovo/version.h"
 
 namespace rovo {
 namespace {
@@ -58,21 +59,10 @@ std::vector<uint8_t> DownscaleRgb8(const std::vector<uint8_t>& src, int width, i
   return out;
 }
 
-// A contact sheet is written once and kept: PNG at zlib level 6 (smaller than the datasets'
-// speed-oriented level 1), through a temporary sibling renamed into place.
+// A contact sheet is written once and kept: PNG at compression level 6 (smaller than the datasets'
+// speed-oriented level 1), atomically.
 void WriteCompactPng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {
-  const fs::path parent = fs::path(path).parent_path();
-  if (!parent.empty()) EnsureWritableDir(parent.string());
-  const std::string tmp = TempPathFor(path);
-  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-  spec.attribute("png:compressionLevel", 6);
-  auto out = OIIO::ImageOutput::create("png");
-  if (!out || !out->open(tmp, spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) || !out->close()) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    throw std::runtime_error(path + ": cannot write the contact sheet PNG");
-  }
-  CommitTempFile(tmp, path);
+  WritePng8(path, width, height, 3, rgb, "rovo " ROVO_VERSION, 6);
 }
 
 }  // namespace

@@ -1,6 +1,5 @@
 // Scene folder reader (layout: scenes/FORMAT.md); every error names the file and the field.
 
-#include <OpenImageIO/imageio.h>
 #include <tbb/parallel_for.h>
 
 #include <cmath>
@@ -12,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "datasets/image_file.h"
 #include "datasets/io.h"
 #include "scenes/scene.h"
 #include "scenes/scene_io_internal.h"
@@ -157,31 +157,18 @@ void CopyFromBuffer(const std::string& buffer, int64_t offset, size_t count, siz
 // ---- textures ----
 
 void ReadPng(const std::string& path, Texture& texture, const std::string& json_file, const std::string& field) {
-  const std::string png_problem = PngChunkProblem(path);
-  if (!png_problem.empty()) Fail(json_file, field, "cannot read texture '" + path + "': " + png_problem);
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) Fail(json_file, field, "cannot read texture '" + path + "': " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width != texture.width || spec.height != texture.height) {
+  Image8 image;
+  try {
+    image = ReadPng8(path, {3, true});  // gray (+ alpha) replicated, alpha dropped
+  } catch (const std::runtime_error& e) {
+    Fail(json_file, field, std::string("cannot read texture: ") + e.what());
+  }
+  if (image.width != texture.width || image.height != texture.height) {
     Fail(json_file, field,
-         "texture '" + path + "' is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+         "texture '" + path + "' is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
              ", scene.json says " + std::to_string(texture.width) + "x" + std::to_string(texture.height));
   }
-  const int channels = spec.nchannels;
-  if (channels < 1 || channels > 4) Fail(json_file, field, "texture '" + path + "' has unsupported channel count");
-  std::vector<uint8_t> raw(static_cast<size_t>(spec.width) * spec.height * channels);
-  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, raw.data())) {
-    Fail(json_file, field, "cannot decode texture '" + path + "': " + in->geterror());
-  }
-  in->close();
-  const size_t pixels = static_cast<size_t>(spec.width) * spec.height;
-  texture.rgb.resize(pixels * 3);
-  for (size_t i = 0; i < pixels; ++i) {
-    for (int c = 0; c < 3; ++c) {
-      // Gray (+alpha) replicates channel 0; RGB(A) drops alpha.
-      texture.rgb[i * 3 + c] = raw[i * channels + (channels >= 3 ? c : 0)];
-    }
-  }
+  texture.rgb = std::move(image.pixels);
 }
 
 // ---- scene.json sections ----

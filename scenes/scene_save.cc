@@ -1,7 +1,6 @@
 // Scene folder writer (layout: scenes/FORMAT.md): textures as PNG, mesh arrays in geometry.bin,
 // per-frame object poses in motion.bin, the rig trajectory, and scene.json last.
 
-#include <OpenImageIO/imageio.h>
 #include <tbb/parallel_for.h>
 
 #include <cstdio>
@@ -11,8 +10,10 @@
 #include <string>
 #include <vector>
 
+#include "datasets/image_file.h"
 #include "datasets/io.h"
 #include "scenes/scene.h"
+#include "rovo/version.h"
 #include "scenes/scene_io_internal.h"
 
 namespace rovo {
@@ -40,17 +41,7 @@ void AppendBytes(std::string& buffer, const void* data, size_t bytes) {
 }
 
 void WritePng(const std::string& path, const Texture& texture) {
-  const std::string tmp = TempPathFor(path);
-  auto out = OIIO::ImageOutput::create("png");
-  if (!out) throw std::runtime_error(path + ": cannot create PNG writer: " + OIIO::geterror());
-  OIIO::ImageSpec spec(texture.width, texture.height, 3, OIIO::TypeDesc::UINT8);
-  spec.attribute("png:compressionLevel", 1);
-  if (!out->open(tmp, spec) || !out->write_image(OIIO::TypeDesc::UINT8, texture.rgb.data()) || !out->close()) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    throw std::runtime_error(path + ": cannot write PNG: " + out->geterror());
-  }
-  CommitTempFile(tmp, path);
+  WritePng8(path, texture.width, texture.height, 3, texture.rgb, "rovo " ROVO_VERSION);
 }
 
 json LightsJson(const Scene& scene) {

@@ -3,7 +3,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 #include <utility>
 
@@ -26,7 +25,7 @@ cv::Mat FrameReader::ReadView(int camera, const std::string& path) const {
   if (lateral_colour_.empty()) {
     image = ReadGrayImage(path);
   } else {
-    image = cv::imread(path, cv::IMREAD_ANYCOLOR);  // 8-bit; gray stays gray, alpha is dropped
+    image = ReadImageAnyColour(path);  // 8-bit; gray stays gray, alpha is dropped
     const LateralColourCorrection& correction = lateral_colour_[static_cast<size_t>(camera)];
     if (image.channels() == 3 && image.cols == correction.width() && image.rows == correction.height())
       image = correction.ToGray(image);
@@ -89,7 +88,7 @@ std::vector<cv::Mat> LoadStaticMasks(const std::string& dataset_dir, const Rig& 
   if (!has_static_masks) return masks;
   for (const RigCamera& cam : rig.cameras) {
     const std::string path = StaticMaskPath(dataset_dir, cam.name);
-    cv::Mat mask = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    cv::Mat mask = ReadGrayImage(path);
     if (mask.empty())
       throw std::runtime_error(path + ": static mask missing or unreadable (dataset.json has_static_masks)");
     if (mask.cols != cam.camera.width || mask.rows != cam.camera.height) {

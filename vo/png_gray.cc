@@ -7,14 +7,16 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <vector>
+
+#include "datasets/image_file.h"
 
 namespace rovo {
 namespace {
 
 constexpr std::array<uint8_t, 8> kSignature = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-// Larger images go to OpenCV (whose own limits then apply).
+// Larger images go to libpng (datasets/image_file.h, whose own limits then apply).
 constexpr uint64_t kMaxPixels = uint64_t{1} << 28;
 
 uint32_t ReadBe32(const uint8_t* p) {
@@ -77,7 +79,7 @@ bool ParseChunks(const uint8_t* data, size_t size, PngLayout* png) {
       idat_done = idat_done || in_idat;
       in_idat = false;
     } else {
-      return false;  // PLTE, colour management, an unknown chunk: OpenCV decides
+      return false;  // PLTE, colour management, an unknown chunk: libpng decides
     }
   }
   return false;  // no IEND
@@ -168,7 +170,10 @@ std::optional<cv::Mat> DecodePngGrayFast(const uint8_t* data, size_t size) {
   return gray;
 }
 
-cv::Mat ReadGrayImage(const std::string& path) {
+namespace {
+
+// The whole file, or nothing when it cannot be read.
+std::vector<uint8_t> FileBytes(const std::string& path) {
   std::vector<uint8_t> bytes;
   if (FILE* file = std::fopen(path.c_str(), "rb")) {
     if (std::fseek(file, 0, SEEK_END) == 0) {
@@ -180,8 +185,33 @@ cv::Mat ReadGrayImage(const std::string& path) {
     }
     std::fclose(file);
   }
+  return bytes;
+}
+
+// libpng's decoding as OpenCV sets it up (16-bit samples to their high byte) into a cv::Mat of
+// `channels` (0: as stored), or an empty one when the bytes are not a readable PNG.
+cv::Mat DecodeOrEmpty(const std::vector<uint8_t>& bytes, int channels, const std::string& path) {
+  Image8 image;
+  try {
+    image = DecodePng8(bytes.data(), bytes.size(), {channels, false}, path);
+  } catch (const std::runtime_error&) {
+    return cv::Mat();
+  }
+  return cv::Mat(image.height, image.width, CV_8UC(image.channels), image.pixels.data()).clone();
+}
+
+}  // namespace
+
+cv::Mat ReadGrayImage(const std::string& path) {
+  const std::vector<uint8_t> bytes = FileBytes(path);
   if (auto gray = DecodePngGrayFast(bytes.data(), bytes.size())) return *gray;
-  return cv::imread(path, cv::IMREAD_GRAYSCALE);
+  return DecodeOrEmpty(bytes, 1, path);
+}
+
+cv::Mat ReadImageAnyColour(const std::string& path) {
+  cv::Mat image = DecodeOrEmpty(FileBytes(path), 0, path);
+  if (image.channels() == 3) cv::cvtColor(image, image, cv::COLOR_RGB2BGR);
+  return image;
 }
 
 }  // namespace rovo

@@ -1,5 +1,4 @@
 // EuRoC/ASL files: camera sensor.yaml, image lists, the ground-truth csv.
-#include <OpenImageIO/imageio.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -10,7 +9,9 @@
 #include <stdexcept>
 
 #include "datasets/exchange/exchange.h"
+#include "datasets/image_file.h"
 #include "datasets/io.h"
+#include "rovo/version.h"
 
 namespace rovo {
 namespace {
@@ -55,34 +56,20 @@ void WriteGrayPng(const std::string& from, const std::string& to) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (fs::exists(to, ec)) {  // resumable: a finished grey image is kept
-    auto done = OIIO::ImageInput::open(to);
-    if (done && done->spec().nchannels == 1) return;
+    try {
+      if (ReadImageHeader(to).channels == 1) return;
+    } catch (const std::runtime_error&) {
+      // written again below
+    }
   }
-  auto in = OIIO::ImageInput::open(from);
-  if (!in) throw std::runtime_error(from + ": cannot read image: " + OIIO::geterror());
-  const OIIO::ImageSpec spec = in->spec();
-  const int channels = spec.nchannels;
-  std::vector<uint8_t> pixels(static_cast<size_t>(spec.width) * spec.height * channels);
-  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, pixels.data())) {
-    throw std::runtime_error(from + ": cannot read image: " + in->geterror());
-  }
-  in->close();
-  std::vector<uint8_t> gray(static_cast<size_t>(spec.width) * spec.height);
+  const bool colour = ReadImageHeader(from).channels >= 3;
+  const Image8 image = ReadPng8(from, {colour ? 3 : 1, true});  // alpha dropped
+  std::vector<uint8_t> gray(static_cast<size_t>(image.width) * image.height);
   for (size_t i = 0; i < gray.size(); ++i) {
-    const uint8_t* p = &pixels[i * static_cast<size_t>(channels)];
-    gray[i] = channels >= 3 ? GrayFromSrgb8(p[0], p[1], p[2]) : p[0];
+    const uint8_t* p = &image.pixels[i * static_cast<size_t>(image.channels)];
+    gray[i] = colour ? GrayFromSrgb8(p[0], p[1], p[2]) : p[0];
   }
-  fs::create_directories(fs::path(to).parent_path());
-  const std::string tmp = TempPathFor(to);
-  auto out = OIIO::ImageOutput::create("png");
-  OIIO::ImageSpec out_spec(spec.width, spec.height, 1, OIIO::TypeDesc::UINT8);
-  out_spec.attribute("png:compressionLevel", 1);  // as the renderer writes its PNGs (render/image_io.cc)
-  out_spec.attribute("png:filter", 0x20);         // libpng's "Up" filter only
-  if (!out || !out->open(tmp, out_spec) || !out->write_image(OIIO::TypeDesc::UINT8, gray.data())) {
-    throw std::runtime_error(to + ": cannot write the grey image: " + (out ? out->geterror() : OIIO::geterror()));
-  }
-  out->close();
-  CommitTempFile(tmp, to);
+  WritePng8(to, image.width, image.height, 1, gray, "rovo " ROVO_VERSION);  // as the renderer writes its PNGs
 }
 
 int64_t SecondsToNs(double seconds) { return std::llround(seconds * 1e9); }

@@ -1,5 +1,4 @@
 // Export of rovo datasets as ROS 2 bags (ros2_bag.h).
-#include <OpenImageIO/imageio.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -13,6 +12,7 @@
 #include "datasets/exchange/ros2_bag.h"
 #include "datasets/exchange/ros2_bag_internal.h"
 #include "datasets/exchange/ros2_messages.h"
+#include "datasets/image_file.h"
 #include "datasets/io.h"
 #include "rovo/version.h"
 
@@ -116,24 +116,17 @@ std::string MetadataYaml(const BagWriter& bag, const std::string& file, const Mc
 
 // An 8-bit image as mono8 (1 channel) or rgb8 (3; a 4th channel is dropped).
 RosImage ReadRosImage(const std::string& path) {
-  const std::string problem = PngChunkProblem(path);
-  if (!problem.empty()) throw std::runtime_error(path + ": unreadable image: " + problem);
-  auto input = OIIO::ImageInput::open(path);
-  if (!input) throw std::runtime_error(path + ": unreadable image: " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = input->spec();
-  if (spec.nchannels != 1 && spec.nchannels != 3 && spec.nchannels != 4) {
-    throw std::runtime_error(path + ": " + std::to_string(spec.nchannels) + " channels (mono8 or rgb8 wanted)");
+  const ImageHeader header = ReadImageHeader(path);
+  if (header.channels != 1 && header.channels != 3 && header.channels != 4) {
+    throw std::runtime_error(path + ": " + std::to_string(header.channels) + " channels (mono8 or rgb8 wanted)");
   }
+  Image8 pixels = ReadPng8(path, {header.channels == 1 ? 1 : 3, true});
   RosImage image;
-  const int channels = spec.nchannels == 1 ? 1 : 3;
-  image.width = static_cast<uint32_t>(spec.width);
-  image.height = static_cast<uint32_t>(spec.height);
-  image.encoding = channels == 1 ? "mono8" : "rgb8";
-  image.step = image.width * static_cast<uint32_t>(channels);
-  image.data.resize(static_cast<size_t>(image.step) * image.height);
-  if (!input->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, image.data.data())) {
-    throw std::runtime_error(path + ": unreadable image: " + input->geterror());
-  }
+  image.width = static_cast<uint32_t>(pixels.width);
+  image.height = static_cast<uint32_t>(pixels.height);
+  image.encoding = pixels.channels == 1 ? "mono8" : "rgb8";
+  image.step = image.width * static_cast<uint32_t>(pixels.channels);
+  image.data = std::move(pixels.pixels);
   return image;
 }
 

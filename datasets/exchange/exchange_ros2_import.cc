@@ -1,5 +1,4 @@
 // Import of ROS 2 bags (MCAP storage) as rovo datasets (ros2_bag.h).
-#include <OpenImageIO/imageio.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -13,7 +12,9 @@
 #include "datasets/exchange/ros2_bag.h"
 #include "datasets/exchange/ros2_bag_internal.h"
 #include "datasets/exchange/ros2_messages.h"
+#include "datasets/image_file.h"
 #include "datasets/io.h"
+#include "rovo/version.h"
 
 namespace rovo {
 namespace fs = std::filesystem;
@@ -78,15 +79,8 @@ void WritePng(const RosImage& image, const std::string& where, const std::string
   if (image.encoding == "bgr8") {
     for (size_t i = 0; i < pixels.size(); i += 3) std::swap(pixels[i], pixels[i + 2]);
   }
-  fs::create_directories(fs::path(path).parent_path());
-  const std::string tmp = TempPathFor(path);
-  auto out = OIIO::ImageOutput::create("png");
-  const OIIO::ImageSpec spec(static_cast<int>(image.width), static_cast<int>(image.height), channels,
-                             OIIO::TypeDesc::UINT8);
-  if (!out || !out->open(tmp, spec) || !out->write_image(OIIO::TypeDesc::UINT8, pixels.data()) || !out->close()) {
-    throw std::runtime_error(path + ": cannot write the image: " + (out ? out->geterror() : OIIO::geterror()));
-  }
-  CommitTempFile(tmp, path);
+  WritePng8(path, static_cast<int>(image.width), static_cast<int>(image.height), channels, pixels,
+            "rovo " ROVO_VERSION);
 }
 
 std::vector<std::string> ImageTopics(const McapContents& contents, const std::string& what) {

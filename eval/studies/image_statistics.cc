@@ -4,10 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <stdexcept>
+
+#include "datasets/image_file.h"
 
 namespace rovo {
 
@@ -159,10 +160,9 @@ std::vector<ImageStatistics> ComputeImageFileStatistics(const std::vector<std::s
                                                         const ImageStatisticsOptions& options) {
   std::vector<ImageStatistics> out;
   for (const std::string& path : paths) {
-    cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
-    if (image.empty()) throw std::runtime_error(path + ": cannot read the image");
-    if (image.depth() == CV_16U) image.convertTo(image, CV_8U, 1.0 / 257.0);
-    if (image.depth() != CV_8U) throw std::runtime_error(path + ": not an 8- or 16-bit image");
+    Image8 file = ReadPng8(path);  // 16-bit samples rounded to 8 bits
+    cv::Mat image(file.height, file.width, CV_8UC(file.channels), file.pixels.data());
+    if (image.channels() == 3) cv::cvtColor(image, image, cv::COLOR_RGB2BGR);  // in place
     try {
       out.push_back(ComputeImageStatistics(image, options));
     } catch (const std::invalid_argument& e) {

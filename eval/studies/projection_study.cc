@@ -1,6 +1,5 @@
 #include "eval/studies/projection_study.h"
 
-#include <OpenImageIO/imageio.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -10,7 +9,6 @@
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <set>
@@ -19,19 +17,21 @@
 #include <unordered_map>
 
 #include "datasets/dataset.h"
+#include "datasets/image_file.h"
 #include "datasets/io.h"
 #include "datasets/progress.h"
 #include "rovo/version.h"
 #include "vo/frontend.h"
 #include "vo/hybrid_projection.h"
 #include "vo/interview_matching.h"
+#include "vo/png_gray.h"
 #include "vo/tracking.h"
 
 namespace rovo {
 namespace {
 
 cv::Mat ReadGray(const std::string& path) {
-  cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  cv::Mat image = ReadGrayImage(path);
   if (image.empty()) throw std::runtime_error(path + ": cannot read image");
   return image;
 }
@@ -39,19 +39,10 @@ cv::Mat ReadGray(const std::string& path) {
 }  // namespace
 
 cv::Mat ReadDepthImage(const std::string& path) {
-  auto input = OIIO::ImageInput::open(path);
-  if (!input) throw std::runtime_error(path + ": cannot read depth: " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = input->spec();
-  std::vector<float> pixels(static_cast<size_t>(spec.width) * spec.height * spec.nchannels);
-  if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data())) {
-    throw std::runtime_error(path + ": cannot read depth pixels: " + input->geterror());
-  }
-  cv::Mat depth(spec.height, spec.width, CV_32F);
-  for (int v = 0; v < spec.height; ++v) {
-    for (int u = 0; u < spec.width; ++u) {
-      depth.at<float>(v, u) = pixels[(static_cast<size_t>(v) * spec.width + u) * spec.nchannels];
-    }
-  }
+  const FloatImage exr = ReadExr(path);
+  if (exr.planes.empty()) throw std::runtime_error(path + ": no channel to read depth from");
+  cv::Mat depth(exr.height, exr.width, CV_32F);
+  std::copy(exr.planes[0].begin(), exr.planes[0].end(), depth.ptr<float>(0));
   return depth;
 }
 
@@ -141,9 +132,9 @@ void WriteMatchesPng(const std::string& path, const cv::Mat& image_a, const cv::
   }
   cv::putText(canvas, caption, cv::Point(8, 21), cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1,
               cv::LINE_AA);
-  std::vector<uchar> png;
-  if (!cv::imencode(".png", canvas, png)) throw std::runtime_error(path + ": PNG encoding failed");
-  WriteFileAtomic(path, std::string(png.begin(), png.end()));
+  cv::cvtColor(canvas, canvas, cv::COLOR_BGR2RGB);
+  WritePng8(path, canvas.cols, canvas.rows, 3, std::vector<uint8_t>(canvas.datastart, canvas.dataend),
+            "rovo " ROVO_VERSION);
 }
 
 bool MaskAt(const cv::Mat& mask, const Eigen::Vector2d& px) {

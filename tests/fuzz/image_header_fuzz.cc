@@ -1,4 +1,4 @@
-// Fuzz target: image headers read through OpenImageIO by ValidateDataset. The input becomes
+// Fuzz target: image headers read by ValidateDataset (datasets/image_file.h). The input becomes
 // cam0/000000.png, depth/cam0/000000.exr, masks/cam0/000000.png and static_masks/cam0.png of a
 // one-camera, one-frame dataset whose dataset.json is fixed.
 #include "datasets/dataset.h"

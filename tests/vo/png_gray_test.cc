@@ -74,11 +74,15 @@ TEST_F(PngGray, GrayAndRgbEqualOpenCvByteForByte) {
   }
 }
 
-TEST_F(PngGray, OtherKindsGoToOpenCv) {
-  cv::Mat wide;
+// Other PNGs go to libpng, set up as OpenCV sets it up: the same image as OpenCV's; other formats
+// (dataset images are PNG) are not read.
+TEST_F(PngGray, OtherKindsGoToLibpngAsOpenCvReadsThem) {
+  cv::Mat wide, gray_wide;
   TestImage(3, 3).convertTo(wide, CV_16UC3, 257.0);
+  TestImage(1, 4).convertTo(gray_wide, CV_16UC1, 251.0);
   const std::vector<std::string> paths = {Write("rgba.png", TestImage(4, 1)), Write("wide.png", wide),
-                                          Write("image.jpg", TestImage(3, 2))};
+                                          Write("gray_wide.png", gray_wide)};
+  EXPECT_TRUE(ReadGrayImage(Write("image.jpg", TestImage(3, 2))).empty());
   for (const std::string& path : paths) {
     const std::vector<uint8_t> bytes = ReadBytes(path);
     EXPECT_FALSE(DecodePngGrayFast(bytes.data(), bytes.size()).has_value()) << path;
@@ -86,6 +90,9 @@ TEST_F(PngGray, OtherKindsGoToOpenCv) {
     const cv::Mat read = ReadGrayImage(path);
     ASSERT_EQ(read.size(), expected.size()) << path;
     EXPECT_EQ(cv::countNonZero(read != expected), 0) << path;
+    const cv::Mat colour = ReadImageAnyColour(path), expected_colour = cv::imread(path, cv::IMREAD_ANYCOLOR);
+    ASSERT_EQ(colour.type(), expected_colour.type()) << path;
+    EXPECT_EQ(cv::norm(colour, expected_colour, cv::NORM_INF), 0.0) << path;
   }
 }
 

@@ -12,7 +12,6 @@
 //
 // Needs `blender` (Debian package) on PATH.
 
-#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -30,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "datasets/image_file.h"
 #include "datasets/io.h"
 #include "datasets/rig_json.h"
 #include "scenes/city.h"
@@ -63,17 +63,20 @@ Rig EquidistantRovo4() {
   return rig;
 }
 
-// One float channel of an image (PNG: decoded to [0, 1]; EXR: by name).
+// One float channel of an image (PNG: RGB decoded to [0, 1], channel `index`; EXR: by name, or
+// the first channel when `channel` is empty).
 std::vector<float> ReadChannel(const std::string& path, const std::string& channel, int index = 0) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw std::runtime_error(path + ": " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = in->spec();
-  if (!channel.empty()) index = spec.channelindex(channel);
-  if (index < 0) throw std::runtime_error(path + ": no channel " + channel);
-  std::vector<float> data(static_cast<size_t>(spec.width) * spec.height);
-  if (!in->read_image(0, 0, index, index + 1, OIIO::TypeDesc::FLOAT, data.data()))
-    throw std::runtime_error(path + ": " + in->geterror());
-  return data;
+  if (path.size() > 4 && path.compare(path.size() - 4, 4, ".png") == 0) {
+    const Image8 png = ReadPng8(path, {3, true});
+    std::vector<float> data(static_cast<size_t>(png.width) * png.height);
+    for (size_t i = 0; i < data.size(); ++i) data[i] = png.pixels[3 * i + static_cast<size_t>(index)] / 255.0f;
+    return data;
+  }
+  FloatImage exr = ReadExr(path);
+  if (!channel.empty()) index = exr.Channel(channel);
+  if (index < 0 || index >= static_cast<int>(exr.planes.size()))
+    throw std::runtime_error(path + ": no channel " + channel);
+  return std::move(exr.planes[static_cast<size_t>(index)]);
 }
 
 struct Pipeline {

@@ -7,7 +7,6 @@
 //
 // Needs `blender` (Debian package) and `oiiotool` (openimageio-tools) on PATH.
 
-#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -22,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "datasets/image_file.h"
 #include "datasets/rig_json.h"
 #include "scenes/scene.h"
 #include "tests/scenes/integration/shell_log.h"
@@ -40,20 +40,12 @@ constexpr int kCameras = 4;
 
 // One float channel of an EXR (by exact name, or the first channel when `channel` is empty).
 std::vector<float> ReadExrChannel(const std::string& path, const std::string& channel, int* width, int* height) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw std::runtime_error(path + ": " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = in->spec();
-  int index = 0;
-  if (!channel.empty()) {
-    index = spec.channelindex(channel);
-    if (index < 0) throw std::runtime_error(path + ": no channel " + channel);
-  }
-  *width = spec.width;
-  *height = spec.height;
-  std::vector<float> data(static_cast<size_t>(spec.width) * spec.height);
-  if (!in->read_image(0, 0, index, index + 1, OIIO::TypeDesc::FLOAT, data.data()))
-    throw std::runtime_error(path + ": " + in->geterror());
-  return data;
+  FloatImage exr = ReadExr(path);
+  const int index = channel.empty() ? 0 : exr.Channel(channel);
+  if (index < 0 || exr.planes.empty()) throw std::runtime_error(path + ": no channel " + channel);
+  *width = exr.width;
+  *height = exr.height;
+  return std::move(exr.planes[static_cast<size_t>(index)]);
 }
 
 // The pipeline's folders; Run() makes the scene, exports it and renders it both ways.
@@ -214,14 +206,14 @@ std::vector<float> Luminance(const std::string& path, bool cycles) {
     if (cycles) {
       rgb[c] = ReadExrChannel(path, std::string("ViewLayer.Combined.") + "RGB"[c], &w, &h);
     } else {
-      auto in = OIIO::ImageInput::open(path);
-      if (!in) throw std::runtime_error(path + ": " + OIIO::geterror());
-      w = in->spec().width;
-      h = in->spec().height;
+      const Image8 png = ReadPng8(path, {3, true});
+      w = png.width;
+      h = png.height;
       rgb[c].resize(static_cast<size_t>(w) * h);
-      if (!in->read_image(0, 0, c, c + 1, OIIO::TypeDesc::FLOAT, rgb[c].data()))
-        throw std::runtime_error(path + ": " + in->geterror());
-      for (float& v : rgb[c]) v = v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+      for (size_t i = 0; i < rgb[c].size(); ++i) {
+        const float v = png.pixels[3 * i + static_cast<size_t>(c)] / 255.0f;
+        rgb[c][i] = v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+      }
     }
   }
   std::vector<float> y(rgb[0].size());

@@ -1,4 +1,4 @@
-#include "render/png_encode.h"
+#include "datasets/png_encode.h"
 
 #include <libdeflate.h>
 
@@ -67,21 +67,25 @@ struct CompressorDeleter {
 }  // namespace
 
 std::string EncodePng(int width, int height, int channels, int bit_depth, const void* pixels,
-                      const std::string& software) {
+                      const std::string& software, int level) {
   if (width <= 0 || height <= 0 || !(channels == 1 || channels == 3) ||
-      !(bit_depth == 8 || (bit_depth == 16 && channels == 1))) {
+      !(bit_depth == 8 || (bit_depth == 16 && channels == 1)) || level < 1 || level > 12) {
     throw std::invalid_argument("EncodePng: unsupported layout " + std::to_string(width) + "x" +
                                 std::to_string(height) + ", " + std::to_string(channels) + " channel(s) of " +
-                                std::to_string(bit_depth) + " bits");
+                                std::to_string(bit_depth) + " bits at level " + std::to_string(level));
   }
   const size_t row_bytes = static_cast<size_t>(width) * channels * (bit_depth / 8);
   const size_t filtered_size = static_cast<size_t>(height) * (row_bytes + 1);
   static thread_local std::vector<uint8_t> filtered_buffer, zlib_buffer;
   uint8_t* filtered = Scratch(&filtered_buffer, filtered_size);
   UpFiltered(row_bytes, height, bit_depth, pixels, filtered);
-  // One compressor per thread: its tables are allocated once.
-  static thread_local std::unique_ptr<libdeflate_compressor, CompressorDeleter> compressor(
-      libdeflate_alloc_compressor(1));
+  // One compressor per thread: its tables are allocated once (again when the level changes).
+  static thread_local std::unique_ptr<libdeflate_compressor, CompressorDeleter> compressor;
+  static thread_local int compressor_level = 0;
+  if (!compressor || compressor_level != level) {
+    compressor.reset(libdeflate_alloc_compressor(level));
+    compressor_level = level;
+  }
   if (!compressor) throw std::runtime_error("EncodePng: libdeflate cannot allocate a compressor");
   const size_t zlib_bound = libdeflate_zlib_compress_bound(compressor.get(), filtered_size);
   uint8_t* zlib = Scratch(&zlib_buffer, zlib_bound);

@@ -1,0 +1,302 @@
+#include "datasets/image_file.h"
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <png.h>
+
+#include <algorithm>
+#include <csetjmp>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "datasets/io.h"
+#include "datasets/png_encode.h"
+
+namespace rovo {
+namespace {
+namespace fs = std::filesystem;
+
+constexpr uint8_t kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+constexpr uint8_t kExrMagic[4] = {0x76, 0x2f, 0x31, 0x01};
+// Deflate expands at most 1032-fold: a stated size beyond this many bytes per byte of file cannot be
+// in the file, so it is refused before anything of that size is allocated.
+constexpr size_t kMaxExpansion = 1100;
+constexpr size_t kMaxPixels = size_t{1} << 28;
+
+std::vector<uint8_t> FileBytes(const std::string& path, size_t limit = SIZE_MAX) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot open the image");
+  std::vector<uint8_t> bytes;
+  char buffer[65536];
+  while (bytes.size() < limit && in.read(buffer, sizeof(buffer)).gcount() > 0) {
+    bytes.insert(bytes.end(), buffer, buffer + in.gcount());
+  }
+  if (bytes.size() > limit) bytes.resize(limit);
+  return bytes;
+}
+
+uint32_t BigEndian32(const uint8_t* p) {
+  return (uint32_t{p[0]} << 24) | (uint32_t{p[1]} << 16) | (uint32_t{p[2]} << 8) | p[3];
+}
+
+// Channels of a PNG colour type as stored (a palette counts as RGB).
+int PngChannels(int colour_type) {
+  switch (colour_type) {
+    case 0: return 1;
+    case 4: return 2;
+    case 6: return 4;
+    default: return 3;
+  }
+}
+
+// ---- libpng, from memory, errors by longjmp ----
+
+struct PngSource {
+  const uint8_t* data;
+  size_t size;
+  size_t offset;
+  char error[200];
+};
+
+void ReadFromSource(png_structp png, png_bytep out, png_size_t count) {
+  auto* source = static_cast<PngSource*>(png_get_io_ptr(png));
+  if (count > source->size - source->offset) png_error(png, "the file ends early");
+  std::memcpy(out, source->data + source->offset, count);
+  source->offset += count;
+}
+
+void OnPngError(png_structp png, png_const_charp message) {
+  auto* source = static_cast<PngSource*>(png_get_error_ptr(png));
+  std::snprintf(source->error, sizeof(source->error), "%s", message);
+  png_longjmp(png, 1);
+}
+
+void OnPngWarning(png_structp, png_const_charp) {}
+
+// The transforms of PngReadOptions on a read struct whose header has been read; returns the
+// channels of the result.
+int SetPngTransforms(png_structp png, png_infop info, const PngReadOptions& options) {
+  const int colour_type = png_get_color_type(png, info);
+  const int bit_depth = png_get_bit_depth(png, info);
+  if (bit_depth == 16) {
+    if (options.round_16_bit) {
+      png_set_scale_16(png);
+    } else {
+      png_set_strip_16(png);
+    }
+  }
+  png_set_strip_alpha(png);
+  if (colour_type == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
+  const bool colour = (colour_type & PNG_COLOR_MASK_COLOR) != 0;
+  if (!colour && bit_depth < 8) png_set_expand_gray_1_2_4_to_8(png);
+  const int channels = options.channels != 0 ? options.channels : (colour_type == PNG_COLOR_TYPE_GRAY ? 1 : 3);
+  if (channels == 1 && colour) png_set_rgb_to_gray(png, 1, 0.299, 0.587);
+  if (channels == 3 && !colour) png_set_gray_to_rgb(png);
+  png_set_interlace_handling(png);
+  png_read_update_info(png, info);
+  return channels;
+}
+
+// Decodes into `image` (sized by the caller's header check); false with source->error set on failure.
+// No C++ object is created between setjmp and a longjmp back to it.
+bool DecodeWithLibpng(PngSource* source, const PngReadOptions& options, Image8* image,
+                      std::vector<png_bytep>* rows) {
+  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, source, OnPngError, OnPngWarning);
+  if (png == nullptr) {
+    std::snprintf(source->error, sizeof(source->error), "libpng cannot start");
+    return false;
+  }
+  png_infop info = png_create_info_struct(png);
+  png_infop end_info = png_create_info_struct(png);
+  volatile bool ok = false;
+  if (info != nullptr && end_info != nullptr && setjmp(png_jmpbuf(png)) == 0) {
+    png_set_read_fn(png, source, ReadFromSource);
+    png_read_info(png, info);
+    const int channels = SetPngTransforms(png, info, options);
+    if (static_cast<int>(png_get_rowbytes(png, info)) != image->width * channels) {
+      png_error(png, "unexpected row size after the transforms");
+    }
+    image->channels = channels;
+    for (int y = 0; y < image->height; ++y) (*rows)[y] = image->pixels.data() + static_cast<size_t>(y) * image->width * channels;
+    png_read_image(png, rows->data());
+    png_read_end(png, end_info);
+    ok = true;
+  }
+  png_destroy_read_struct(&png, &info, &end_info);
+  return ok;
+}
+
+// ---- OpenEXR ----
+
+template <typename Fn>
+auto WithExrErrors(const std::string& path, Fn fn) -> decltype(fn()) {
+  try {
+    return fn();
+  } catch (const std::runtime_error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": unreadable OpenEXR file: " + e.what());
+  }
+}
+
+ImageHeader ExrHeader(const std::string& path) {
+  return WithExrErrors(path, [&] {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i window = file.header().dataWindow();
+    ImageHeader header;
+    header.width = window.max.x - window.min.x + 1;
+    header.height = window.max.y - window.min.y + 1;
+    for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it) {
+      ++header.channels;
+      header.bit_depth = std::max(header.bit_depth, it.channel().type == Imf::HALF ? 16 : 32);
+    }
+    return header;
+  });
+}
+
+}  // namespace
+
+ImageHeader ReadImageHeader(const std::string& path) {
+  const std::vector<uint8_t> start = FileBytes(path, 33);  // PNG signature + IHDR chunk
+  if (start.size() >= 8 && std::memcmp(start.data(), kPngSignature, 8) == 0) {
+    const std::string problem = PngChunkProblem(path);
+    if (!problem.empty()) throw std::runtime_error(path + ": unreadable PNG: " + problem);
+    if (start.size() < 33) throw std::runtime_error(path + ": unreadable PNG: the IHDR chunk is cut short");
+    ImageHeader header;
+    const uint32_t width = BigEndian32(start.data() + 16), height = BigEndian32(start.data() + 20);
+    if (width == 0 || height == 0 || width > 0x7fffffffu || height > 0x7fffffffu) {
+      throw std::runtime_error(path + ": unreadable PNG: IHDR size " + std::to_string(width) + "x" +
+                               std::to_string(height));
+    }
+    header.width = static_cast<int>(width);
+    header.height = static_cast<int>(height);
+    header.bit_depth = start[24];
+    header.channels = PngChannels(start[25]);
+    return header;
+  }
+  if (start.size() >= 4 && std::memcmp(start.data(), kExrMagic, 4) == 0) return ExrHeader(path);
+  throw std::runtime_error(path + ": not a PNG or OpenEXR file");
+}
+
+Image8 DecodePng8(const uint8_t* data, size_t size, const PngReadOptions& options, const std::string& name) {
+  if (options.channels != 0 && options.channels != 1 && options.channels != 3) {
+    throw std::invalid_argument(name + ": PngReadOptions::channels must be 0, 1 or 3");
+  }
+  if (size < 33 || std::memcmp(data, kPngSignature, 8) != 0) throw std::runtime_error(name + ": not a PNG file");
+  const std::string problem = PngChunkProblem(data, size);
+  if (!problem.empty()) throw std::runtime_error(name + ": unreadable PNG: " + problem);
+  Image8 image;
+  const uint32_t width = BigEndian32(data + 16), height = BigEndian32(data + 20);
+  const uint64_t pixels = uint64_t{width} * height;
+  if (width == 0 || height == 0 || pixels > kMaxPixels || pixels * 3 > kMaxExpansion * uint64_t{size}) {
+    throw std::runtime_error(name + ": unreadable PNG: IHDR states " + std::to_string(width) + "x" +
+                             std::to_string(height) + " pixels, more than " + std::to_string(size) +
+                             " bytes can hold");
+  }
+  image.width = static_cast<int>(width);
+  image.height = static_cast<int>(height);
+  image.pixels.resize(static_cast<size_t>(pixels) * 3);  // room for RGB; trimmed to the result's channels
+  std::vector<png_bytep> rows(height);
+  PngSource source{data, size, 0, {0}};
+  if (!DecodeWithLibpng(&source, options, &image, &rows)) {
+    throw std::runtime_error(name + ": unreadable PNG: " + source.error);
+  }
+  image.pixels.resize(static_cast<size_t>(pixels) * image.channels);
+  return image;
+}
+
+Image8 ReadPng8(const std::string& path, const PngReadOptions& options) {
+  const std::vector<uint8_t> bytes = FileBytes(path);
+  return DecodePng8(bytes.data(), bytes.size(), options, path);
+}
+
+int FloatImage::Channel(const std::string& name) const {
+  const auto it = std::find(channel_names.begin(), channel_names.end(), name);
+  return it == channel_names.end() ? -1 : static_cast<int>(it - channel_names.begin());
+}
+
+FloatImage ReadExr(const std::string& path) {
+  std::error_code ec;
+  const uint64_t file_size = fs::file_size(path, ec);
+  if (ec) throw std::runtime_error(path + ": cannot open the image: " + ec.message());
+  return WithExrErrors(path, [&] {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i window = file.header().dataWindow();
+    FloatImage image;
+    image.width = window.max.x - window.min.x + 1;
+    image.height = window.max.y - window.min.y + 1;
+    const Imf::ChannelList& channels = file.header().channels();
+    size_t count = 0;
+    for (auto it = channels.begin(); it != channels.end(); ++it) ++count;
+    const uint64_t pixels = uint64_t(image.width) * uint64_t(image.height);
+    if (image.width <= 0 || image.height <= 0 || pixels > kMaxPixels ||
+        pixels * std::max<size_t>(count, 1) * 2 > kMaxExpansion * file_size) {
+      throw std::runtime_error(path + ": unreadable OpenEXR file: a data window of " + std::to_string(image.width) +
+                               "x" + std::to_string(image.height) + " pixels in " + std::to_string(file_size) +
+                               " bytes");
+    }
+    Imf::FrameBuffer frame;
+    image.planes.reserve(count);
+    for (auto it = channels.begin(); it != channels.end(); ++it) {
+      if (it.channel().xSampling != 1 || it.channel().ySampling != 1) {
+        throw std::runtime_error(path + ": channel " + it.name() + " is subsampled (not supported)");
+      }
+      image.channel_names.push_back(it.name());
+      image.planes.emplace_back(static_cast<size_t>(pixels), 0.0f);
+      // OpenEXR addresses a slice from the data window's origin: base + x * xstride + y * ystride.
+      char* origin = reinterpret_cast<char*>(image.planes.back().data());
+      const ptrdiff_t shift = (ptrdiff_t(window.min.x) + ptrdiff_t(window.min.y) * image.width) * ptrdiff_t(sizeof(float));
+      frame.insert(it.name(), Imf::Slice(Imf::FLOAT, origin - shift, sizeof(float), sizeof(float) * image.width));
+    }
+    file.setFrameBuffer(frame);
+    file.readPixels(window.min.y, window.max.y);
+    return image;
+  });
+}
+
+void WriteExrFloat(const std::string& path, int width, int height, const std::vector<float>& values,
+                   const std::string& channel, const std::string& software) {
+  if (width <= 0 || height <= 0 || values.size() != static_cast<size_t>(width) * height) {
+    throw std::invalid_argument(path + ": " + std::to_string(values.size()) + " values for a " +
+                                std::to_string(width) + "x" + std::to_string(height) + " image");
+  }
+  const fs::path parent = fs::path(path).parent_path();
+  if (!parent.empty()) EnsureWritableDir(parent.string());
+  const std::string tmp = TempPathFor(path);
+  try {
+    Imf::Header header(width, height);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    header.channels().insert(channel, Imf::Channel(Imf::FLOAT));
+    header.insert("software", Imf::StringAttribute(software));
+    Imf::OutputFile file(tmp.c_str(), header);
+    Imf::FrameBuffer frame;
+    frame.insert(channel, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(values.data())),
+                                     sizeof(float), sizeof(float) * static_cast<size_t>(width)));
+    file.setFrameBuffer(frame);
+    file.writePixels(height);
+  } catch (const std::exception& e) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw std::runtime_error(path + ": cannot write image: " + e.what());
+  }
+  CommitTempFile(tmp, path);
+}
+
+void WritePng8(const std::string& path, int width, int height, int channels, const std::vector<uint8_t>& pixels,
+               const std::string& software, int level) {
+  if (width <= 0 || height <= 0 || pixels.size() != static_cast<size_t>(width) * height * channels) {
+    throw std::invalid_argument(path + ": " + std::to_string(pixels.size()) + " samples for a " +
+                                std::to_string(width) + "x" + std::to_string(height) + " image of " +
+                                std::to_string(channels) + " channel(s)");
+  }
+  WriteFileAtomic(path, EncodePng(width, height, channels, 8, pixels.data(), software, level));
+}
+
+}  // namespace rovo
