@@ -3,12 +3,12 @@
 # alone, so a second run costs one dpkg query.
 # Usage: ci/install-deps.sh [build|plots|all]   (default all)
 #   build: what configuring and building rovo need (ci/demo.sh installs these before it builds). OpenCV
-#          comes as the six modules rovo uses, not libopencv-dev, which pulls every module (VTK, contrib, dnn);
-#          ccache is left out: a first build gains nothing from an empty cache. openimageio-tools is here
-#          because OpenImageIO's CMake package checks that its tools exist.
+#          comes as the modules rovo uses (and imgcodecs, the tests' independent image codecs), not
+#          libopencv-dev, which pulls every module (VTK, contrib, dnn); image files go through libpng and
+#          OpenEXR; ccache is left out: a first build gains nothing from an empty cache.
 #   plots: Python's matplotlib, for the plots of report.html (ci/demo.sh installs it after the table).
 #   all:   build and plots, and what the tests use: ccache, lint tools,
-#          Blender (exporter and Cycles cross-checks), Chromium (report screenshots), Slurm (batch tests),
+#          Blender (exporter and Cycles cross-checks) with oiiotool (reads Cycles' EXRs), Chromium (report screenshots), Slurm (batch tests),
 #          COLMAP (the third-party system of the suite tests).
 set -euo pipefail
 what=${1:-all}
@@ -16,7 +16,7 @@ what=${1:-all}
 BUILD=(
   build-essential cmake ninja-build git
   libembree-dev libtbb-dev
-  libopenimageio-dev openimageio-tools
+  libpng-dev libopenexr-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-features2d-dev libopencv-video-dev libopencv-calib3d-dev
   libopencv-imgcodecs-dev
   libeigen3-dev libceres-dev libopengv-dev
@@ -29,7 +29,7 @@ case "$what" in
   plots) PACKAGES=("${PLOTS[@]}") ;;
   all)
     PACKAGES=("${BUILD[@]}" "${PLOTS[@]}" ccache pkg-config python3-numpy python3-yaml
-              clang-format clang-tidy blender chromium slurm-wlm munge colmap)
+              clang-format clang-tidy blender openimageio-tools chromium slurm-wlm munge colmap)
     ;;
   *) echo "install-deps: unknown set '$what' (build, plots or all)" >&2; exit 2 ;;
 esac

@@ -1,6 +1,5 @@
 #include "datasets/dataset_validate.h"
 
-
 #include <cctype>
 #include <cmath>
 #include <filesystem>

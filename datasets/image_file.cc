@@ -49,10 +49,14 @@ uint32_t BigEndian32(const uint8_t* p) {
 // Channels of a PNG colour type as stored (a palette counts as RGB).
 int PngChannels(int colour_type) {
   switch (colour_type) {
-    case 0: return 1;
-    case 4: return 2;
-    case 6: return 4;
-    default: return 3;
+    case 0:
+      return 1;
+    case 4:
+      return 2;
+    case 6:
+      return 4;
+    default:
+      return 3;
   }
 }
 
@@ -106,8 +110,7 @@ int SetPngTransforms(png_structp png, png_infop info, const PngReadOptions& opti
 
 // Decodes into `image` (sized by the caller's header check); false with source->error set on failure.
 // No C++ object is created between setjmp and a longjmp back to it.
-bool DecodeWithLibpng(PngSource* source, const PngReadOptions& options, Image8* image,
-                      std::vector<png_bytep>* rows) {
+bool DecodeWithLibpng(PngSource* source, const PngReadOptions& options, Image8* image, std::vector<png_bytep>* rows) {
   png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, source, OnPngError, OnPngWarning);
   if (png == nullptr) {
     std::snprintf(source->error, sizeof(source->error), "libpng cannot start");
@@ -124,7 +127,8 @@ bool DecodeWithLibpng(PngSource* source, const PngReadOptions& options, Image8* 
       png_error(png, "unexpected row size after the transforms");
     }
     image->channels = channels;
-    for (int y = 0; y < image->height; ++y) (*rows)[y] = image->pixels.data() + static_cast<size_t>(y) * image->width * channels;
+    for (int y = 0; y < image->height; ++y)
+      (*rows)[y] = image->pixels.data() + static_cast<size_t>(y) * image->width * channels;
     png_read_image(png, rows->data());
     png_read_end(png, end_info);
     ok = true;
@@ -197,8 +201,7 @@ Image8 DecodePng8(const uint8_t* data, size_t size, const PngReadOptions& option
   const uint64_t pixels = uint64_t{width} * height;
   if (width == 0 || height == 0 || pixels > kMaxPixels || pixels * 3 > kMaxExpansion * uint64_t{size}) {
     throw std::runtime_error(name + ": unreadable PNG: IHDR states " + std::to_string(width) + "x" +
-                             std::to_string(height) + " pixels, more than " + std::to_string(size) +
-                             " bytes can hold");
+                             std::to_string(height) + " pixels, more than " + std::to_string(size) + " bytes can hold");
   }
   image.width = static_cast<int>(width);
   image.height = static_cast<int>(height);
@@ -252,7 +255,8 @@ FloatImage ReadExr(const std::string& path) {
       image.planes.emplace_back(static_cast<size_t>(pixels), 0.0f);
       // OpenEXR addresses a slice from the data window's origin: base + x * xstride + y * ystride.
       char* origin = reinterpret_cast<char*>(image.planes.back().data());
-      const ptrdiff_t shift = (ptrdiff_t(window.min.x) + ptrdiff_t(window.min.y) * image.width) * ptrdiff_t(sizeof(float));
+      const ptrdiff_t shift =
+          (ptrdiff_t(window.min.x) + ptrdiff_t(window.min.y) * image.width) * ptrdiff_t(sizeof(float));
       frame.insert(it.name(), Imf::Slice(Imf::FLOAT, origin - shift, sizeof(float), sizeof(float) * image.width));
     }
     file.setFrameBuffer(frame);
@@ -264,8 +268,8 @@ FloatImage ReadExr(const std::string& path) {
 void WriteExrFloat(const std::string& path, int width, int height, const std::vector<float>& values,
                    const std::string& channel, const std::string& software) {
   if (width <= 0 || height <= 0 || values.size() != static_cast<size_t>(width) * height) {
-    throw std::invalid_argument(path + ": " + std::to_string(values.size()) + " values for a " +
-                                std::to_string(width) + "x" + std::to_string(height) + " image");
+    throw std::invalid_argument(path + ": " + std::to_string(values.size()) + " values for a " + std::to_string(width) +
+                                "x" + std::to_string(height) + " image");
   }
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty()) EnsureWritableDir(parent.string());

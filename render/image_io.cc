@@ -24,8 +24,8 @@ void WritePngGray8(const std::string& path, int width, int height, const std::ve
 
 void WritePngGray16(const std::string& path, int width, int height, const std::vector<uint16_t>& values) {
   if (width <= 0 || height <= 0 || values.size() != static_cast<size_t>(width) * height) {
-    throw std::invalid_argument(path + ": " + std::to_string(values.size()) + " values for a " +
-                                std::to_string(width) + "x" + std::to_string(height) + " image");
+    throw std::invalid_argument(path + ": " + std::to_string(values.size()) + " values for a " + std::to_string(width) +
+                                "x" + std::to_string(height) + " image");
   }
   WriteFileAtomic(path, EncodePng(width, height, 1, 16, values.data(), "rovo " ROVO_VERSION));
 }

@@ -12,8 +12,8 @@
 
 #include "datasets/image_file.h"
 #include "datasets/io.h"
-#include "scenes/scene.h"
 #include "rovo/version.h"
+#include "scenes/scene.h"
 #include "scenes/scene_io_internal.h"
 
 namespace rovo {

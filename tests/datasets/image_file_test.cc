@@ -49,9 +49,11 @@ bool Equal(const cv::Mat& a, const cv::Mat& b) {
 }
 
 TEST_F(ImageFileTest, GrayReadsAsOpenCvReadsItFromEveryKindOfPng) {
-  for (const auto& [name, type] : std::vector<std::pair<std::string, int>>{
-           {"gray.png", CV_8UC1}, {"bgr.png", CV_8UC3}, {"bgra.png", CV_8UC4}, {"gray16.png", CV_16UC1},
-           {"bgr16.png", CV_16UC3}}) {
+  for (const auto& [name, type] : std::vector<std::pair<std::string, int>>{{"gray.png", CV_8UC1},
+                                                                           {"bgr.png", CV_8UC3},
+                                                                           {"bgra.png", CV_8UC4},
+                                                                           {"gray16.png", CV_16UC1},
+                                                                           {"bgr16.png", CV_16UC3}}) {
     const std::string path = WriteNoise(name, type, 7);
     const cv::Mat expected = cv::imread(path, cv::IMREAD_GRAYSCALE);
     EXPECT_TRUE(Equal(AsMat(ReadPng8(path, {1, false})), expected)) << name;
@@ -141,8 +143,9 @@ TEST_F(ImageFileTest, BadFilesNameTheFileAndTheProblem) {
   // A header that states far more pixels than the file can hold.
   std::string huge = bytes;
   huge[16] = 0x7f;  // width 2^30 and more
-  EXPECT_NE(message([&] { DecodePng8(reinterpret_cast<const uint8_t*>(huge.data()), huge.size(), {}, "huge"); })
-                .find("more than"),
+  EXPECT_NE(message([&] {
+              DecodePng8(reinterpret_cast<const uint8_t*>(huge.data()), huge.size(), {}, "huge");
+            }).find("more than"),
             std::string::npos);
   std::ofstream(Path("cut.exr"), std::ios::binary).write("\x76\x2f\x31\x01\x02\x00", 6);
   EXPECT_EQ(message([&] { ReadExr(Path("cut.exr")); }).rfind(Path("cut.exr") + ": unreadable OpenEXR file", 0), 0u);

@@ -25,8 +25,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
           rovo::fuzz::Finding("decoded PNG of the wrong size", png);
         }
         if (channels == 1 && !round) {
-          const cv::Mat expected = cv::imdecode(
-              cv::Mat(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(data)), cv::IMREAD_GRAYSCALE);
+          const cv::Mat expected = cv::imdecode(cv::Mat(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(data)),
+                                                cv::IMREAD_GRAYSCALE);
           const cv::Mat ours(image.height, image.width, CV_8UC1, const_cast<uint8_t*>(image.pixels.data()));
           if (!expected.empty() && (expected.size() != ours.size() || cv::countNonZero(expected != ours) != 0)) {
             rovo::fuzz::Finding("gray PNG differs from OpenCV's", png);

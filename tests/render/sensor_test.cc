@@ -3,7 +3,6 @@
 // the dataset record and exposure.csv; `rovo render --sensor` end to end on small scenes.
 #include "render/sensor.h"
 
-#include <opencv2/imgcodecs.hpp>
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 #include <unistd.h>
@@ -13,6 +12,7 @@
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "datasets/dataset.h"
 #include "datasets/io.h"

@@ -1,13 +1,13 @@
 // `rovo dataset export --format ros2` read by readers that no one here wrote: Foxglove's @mcap/core
 // and @foxglove/rosmsg2-serialization from npm (installed by the test; it fails when npm does),
 // run by ros2_bag_check.mjs; and the round trip export -> import.
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "datasets/dataset.h"
 #include "datasets/exchange/lens_fit.h"

@@ -1,6 +1,5 @@
 // `rovo render` as a process: SIGKILL mid-run then rerun equals an uninterrupted run; CLI errors;
 // the quick preset end to end; `rovo scene preview`; the scene folder's rig.json as the default rig.
-#include <opencv2/imgcodecs.hpp>
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -11,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <opencv2/imgcodecs.hpp>
 #include <thread>
 
 #include "datasets/dataset.h"
