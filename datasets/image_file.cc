@@ -29,6 +29,9 @@ constexpr uint8_t kExrMagic[4] = {0x76, 0x2f, 0x31, 0x01};
 // in the file, so it is refused before anything of that size is allocated.
 constexpr size_t kMaxExpansion = 1100;
 constexpr size_t kMaxPixels = size_t{1} << 28;
+// OpenEXR's DWA compression keeps one DC value of an 8x8 block of a flat image and deflates them:
+// at most 64 x 1032 samples per byte.
+constexpr size_t kMaxExrSamplesPerByte = 64 * kMaxExpansion;
 
 std::vector<uint8_t> FileBytes(const std::string& path, size_t limit = SIZE_MAX) {
   std::ifstream in(path, std::ios::binary);
@@ -150,19 +153,22 @@ auto WithExrErrors(const std::string& path, Fn fn) -> decltype(fn()) {
   }
 }
 
+ImageHeader HeaderOf(const Imf::Header& exr) {
+  const Imath::Box2i window = exr.dataWindow();
+  const int64_t width = int64_t{window.max.x} - window.min.x + 1, height = int64_t{window.max.y} - window.min.y + 1;
+  ImageHeader header;
+  // A window beyond 2^31 - 1 pixels a side reads as 0 (refused by the readers).
+  header.width = width > 0 && width <= INT32_MAX ? static_cast<int>(width) : 0;
+  header.height = height > 0 && height <= INT32_MAX ? static_cast<int>(height) : 0;
+  for (auto it = exr.channels().begin(); it != exr.channels().end(); ++it) {
+    ++header.channels;
+    header.bit_depth = std::max(header.bit_depth, it.channel().type == Imf::HALF ? 16 : 32);
+  }
+  return header;
+}
+
 ImageHeader ExrHeader(const std::string& path) {
-  return WithExrErrors(path, [&] {
-    Imf::InputFile file(path.c_str());
-    const Imath::Box2i window = file.header().dataWindow();
-    ImageHeader header;
-    header.width = window.max.x - window.min.x + 1;
-    header.height = window.max.y - window.min.y + 1;
-    for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it) {
-      ++header.channels;
-      header.bit_depth = std::max(header.bit_depth, it.channel().type == Imf::HALF ? 16 : 32);
-    }
-    return header;
-  });
+  return WithExrErrors(path, [&] { return HeaderOf(Imf::InputFile(path.c_str()).header()); });
 }
 
 }  // namespace
@@ -232,32 +238,29 @@ FloatImage ReadExr(const std::string& path) {
   return WithExrErrors(path, [&] {
     Imf::InputFile file(path.c_str());
     const Imath::Box2i window = file.header().dataWindow();
+    const ImageHeader header = HeaderOf(file.header());
     FloatImage image;
-    image.width = window.max.x - window.min.x + 1;
-    image.height = window.max.y - window.min.y + 1;
+    image.width = header.width;
+    image.height = header.height;
     const Imf::ChannelList& channels = file.header().channels();
-    size_t count = 0;
-    for (auto it = channels.begin(); it != channels.end(); ++it) ++count;
     const uint64_t pixels = uint64_t(image.width) * uint64_t(image.height);
     if (image.width <= 0 || image.height <= 0 || pixels > kMaxPixels ||
-        pixels * std::max<size_t>(count, 1) * 2 > kMaxExpansion * file_size) {
+        pixels * uint64_t(std::max(header.channels, 1)) > kMaxExrSamplesPerByte * file_size) {
       throw std::runtime_error(path + ": unreadable OpenEXR file: a data window of " + std::to_string(image.width) +
                                "x" + std::to_string(image.height) + " pixels in " + std::to_string(file_size) +
                                " bytes");
     }
     Imf::FrameBuffer frame;
-    image.planes.reserve(count);
+    image.planes.reserve(static_cast<size_t>(header.channels));
     for (auto it = channels.begin(); it != channels.end(); ++it) {
       if (it.channel().xSampling != 1 || it.channel().ySampling != 1) {
         throw std::runtime_error(path + ": channel " + it.name() + " is subsampled (not supported)");
       }
       image.channel_names.push_back(it.name());
       image.planes.emplace_back(static_cast<size_t>(pixels), 0.0f);
-      // OpenEXR addresses a slice from the data window's origin: base + x * xstride + y * ystride.
-      char* origin = reinterpret_cast<char*>(image.planes.back().data());
-      const ptrdiff_t shift =
-          (ptrdiff_t(window.min.x) + ptrdiff_t(window.min.y) * image.width) * ptrdiff_t(sizeof(float));
-      frame.insert(it.name(), Imf::Slice(Imf::FLOAT, origin - shift, sizeof(float), sizeof(float) * image.width));
+      // Addressed from the data window's origin (Slice::Make does the offset arithmetic).
+      frame.insert(it.name(), Imf::Slice::Make(Imf::FLOAT, image.planes.back().data(), window, sizeof(float),
+                                               sizeof(float) * static_cast<size_t>(image.width)));
     }
     file.setFrameBuffer(frame);
     file.readPixels(window.min.y, window.max.y);
