@@ -23,7 +23,7 @@ namespace rovo {
 namespace {
 namespace fs = std::filesystem;
 
-constexpr uint8_t kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+constexpr uint8_t kPngMagic[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
 constexpr uint8_t kExrMagic[4] = {0x76, 0x2f, 0x31, 0x01};
 // Deflate expands at most 1032-fold: a stated size beyond this many bytes per byte of file cannot be
 // in the file, so it is refused before anything of that size is allocated.
@@ -175,7 +175,7 @@ ImageHeader ExrHeader(const std::string& path) {
 
 ImageHeader ReadImageHeader(const std::string& path) {
   const std::vector<uint8_t> start = FileBytes(path, 33);  // PNG signature + IHDR chunk
-  if (start.size() >= 8 && std::memcmp(start.data(), kPngSignature, 8) == 0) {
+  if (start.size() >= 8 && std::memcmp(start.data(), kPngMagic, 8) == 0) {
     const std::string problem = PngChunkProblem(path);
     if (!problem.empty()) throw std::runtime_error(path + ": unreadable PNG: " + problem);
     if (start.size() < 33) throw std::runtime_error(path + ": unreadable PNG: the IHDR chunk is cut short");
@@ -199,7 +199,7 @@ Image8 DecodePng8(const uint8_t* data, size_t size, const PngReadOptions& option
   if (options.channels != 0 && options.channels != 1 && options.channels != 3) {
     throw std::invalid_argument(name + ": PngReadOptions::channels must be 0, 1 or 3");
   }
-  if (size < 33 || std::memcmp(data, kPngSignature, 8) != 0) throw std::runtime_error(name + ": not a PNG file");
+  if (size < 33 || std::memcmp(data, kPngMagic, 8) != 0) throw std::runtime_error(name + ": not a PNG file");
   const std::string problem = PngChunkProblem(data, size);
   if (!problem.empty()) throw std::runtime_error(name + ": unreadable PNG: " + problem);
   Image8 image;
