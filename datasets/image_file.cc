@@ -154,7 +154,7 @@ auto WithExrErrors(const std::string& path, Fn fn) -> decltype(fn()) {
 }
 
 ImageHeader HeaderOf(const Imf::Header& exr) {
-  const Imath::Box2i window = exr.dataWindow();
+  const Imath::Box2i& window = exr.dataWindow();
   const int64_t width = int64_t{window.max.x} - window.min.x + 1, height = int64_t{window.max.y} - window.min.y + 1;
   ImageHeader header;
   // A window beyond 2^31 - 1 pixels a side reads as 0 (refused by the readers).
@@ -237,7 +237,7 @@ FloatImage ReadExr(const std::string& path) {
   if (ec) throw std::runtime_error(path + ": cannot open the image: " + ec.message());
   return WithExrErrors(path, [&] {
     Imf::InputFile file(path.c_str());
-    const Imath::Box2i window = file.header().dataWindow();
+    const Imath::Box2i& window = file.header().dataWindow();
     const ImageHeader header = HeaderOf(file.header());
     FloatImage image;
     image.width = header.width;
