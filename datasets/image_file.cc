@@ -3,9 +3,11 @@
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfIO.h>
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStringAttribute.h>
+#include <libdeflate.h>
 #include <png.h>
 
 #include <algorithm>
@@ -16,6 +18,10 @@
 #include <fstream>
 #include <stdexcept>
 
+// clang-format off
+#include <jpeglib.h>  // after <cstdio>: it uses FILE without including it
+// clang-format on
+
 #include "datasets/io.h"
 #include "datasets/png_encode.h"
 
@@ -25,10 +31,11 @@ namespace fs = std::filesystem;
 
 constexpr uint8_t kPngMagic[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
 constexpr uint8_t kExrMagic[4] = {0x76, 0x2f, 0x31, 0x01};
-// Deflate expands at most 1032-fold: a stated size beyond this many bytes per byte of file cannot be
-// in the file, so it is refused before anything of that size is allocated.
+// Deflate expands at most 1032-fold: image data (filtered rows as stored) beyond this many bytes per
+// byte of file cannot be in the file, so it is refused before anything of that size is allocated.
 constexpr size_t kMaxExpansion = 1100;
 constexpr size_t kMaxPixels = size_t{1} << 28;
+constexpr uint32_t kMaxPngSide = 1000000;  // libpng's default limit of either side
 // OpenEXR's DWA compression keeps one DC value of an 8x8 block of a flat image and deflates them:
 // at most 64 x 1032 samples per byte.
 constexpr size_t kMaxExrSamplesPerByte = 64 * kMaxExpansion;
@@ -49,18 +56,67 @@ uint32_t BigEndian32(const uint8_t* p) {
   return (uint32_t{p[0]} << 24) | (uint32_t{p[1]} << 16) | (uint32_t{p[2]} << 8) | p[3];
 }
 
-// Channels of a PNG colour type as stored (a palette counts as RGB).
-int PngChannels(int colour_type) {
-  switch (colour_type) {
-    case 0:
-      return 1;
-    case 4:
-      return 2;
-    case 6:
-      return 4;
-    default:
-      return 3;
+// The IHDR chunk of a PNG (bytes 8-32 of a file whose chunk list is sound).
+struct PngIhdr {
+  uint32_t width = 0, height = 0;
+  int bit_depth = 0, colour_type = 0;
+  bool interlaced = false;
+  // Samples per pixel as stored (a palette index is one) and as read (a palette counts as RGB).
+  int StoredSamples() const { return colour_type == 2 ? 3 : colour_type == 4 ? 2 : colour_type == 6 ? 4 : 1; }
+  int Channels() const { return colour_type == 3 ? 3 : StoredSamples(); }
+  // Bytes of the filtered rows the zlib stream inflates to (Adam7's passes add at most as much again).
+  uint64_t StoredBytes() const {
+    const uint64_t row = (uint64_t{width} * StoredSamples() * bit_depth + 7) / 8 + 1;
+    return row * height * (interlaced ? 2 : 1);
   }
+};
+
+// Checks the IHDR as libpng does (length, CRC, sizes, bit depth for the colour type, methods);
+// returns "" when sound, else the reason.
+std::string ParseIhdr(const uint8_t* file, PngIhdr* ihdr) {
+  const uint8_t* data = file + 16;
+  if (BigEndian32(file + 8) != 13) return "IHDR is not 13 bytes long";
+  if (libdeflate_crc32(0, file + 12, 17) != BigEndian32(file + 29)) return "IHDR CRC error";
+  ihdr->width = BigEndian32(data);
+  ihdr->height = BigEndian32(data + 4);
+  ihdr->bit_depth = data[8];
+  ihdr->colour_type = data[9];
+  ihdr->interlaced = data[12] == 1;
+  if (ihdr->width == 0 || ihdr->height == 0 || ihdr->width > kMaxPngSide || ihdr->height > kMaxPngSide) {
+    return "IHDR size " + std::to_string(ihdr->width) + "x" + std::to_string(ihdr->height) + " (1 to " +
+           std::to_string(kMaxPngSide) + " a side)";
+  }
+  const int d = ihdr->bit_depth;
+  bool depth_ok = false;
+  switch (ihdr->colour_type) {
+    case 0:
+      depth_ok = d == 1 || d == 2 || d == 4 || d == 8 || d == 16;
+      break;
+    case 3:
+      depth_ok = d == 1 || d == 2 || d == 4 || d == 8;
+      break;
+    case 2:
+    case 4:
+    case 6:
+      depth_ok = d == 8 || d == 16;
+      break;
+    default:
+      return "IHDR colour type " + std::to_string(ihdr->colour_type);
+  }
+  if (!depth_ok) return "IHDR bit depth " + std::to_string(d) + " for colour type " + std::to_string(ihdr->colour_type);
+  if (data[10] != 0 || data[11] != 0 || data[12] > 1) return "IHDR compression, filter or interlace method unknown";
+  return "";
+}
+
+// The IHDR of a PNG's first 33 bytes, after the whole chunk list was checked (`chunk_problem`);
+// throws naming `name`.
+PngIhdr CheckedIhdr(const uint8_t* file, size_t size, const std::string& chunk_problem, const std::string& name) {
+  if (!chunk_problem.empty()) throw std::runtime_error(name + ": unreadable PNG: " + chunk_problem);
+  if (size < 33) throw std::runtime_error(name + ": unreadable PNG: the IHDR chunk is cut short");
+  PngIhdr ihdr;
+  const std::string problem = ParseIhdr(file, &ihdr);
+  if (!problem.empty()) throw std::runtime_error(name + ": unreadable PNG: " + problem);
+  return ihdr;
 }
 
 // ---- libpng, from memory, errors by longjmp ----
@@ -122,7 +178,9 @@ bool DecodeWithLibpng(PngSource* source, const PngReadOptions& options, Image8* 
   png_infop info = png_create_info_struct(png);
   png_infop end_info = png_create_info_struct(png);
   volatile bool ok = false;
-  if (info != nullptr && end_info != nullptr && setjmp(png_jmpbuf(png)) == 0) {
+  if (info == nullptr || end_info == nullptr) {
+    std::snprintf(source->error, sizeof(source->error), "libpng cannot start");
+  } else if (setjmp(png_jmpbuf(png)) == 0) {
     png_set_read_fn(png, source, ReadFromSource);
     png_read_info(png, info);
     const int channels = SetPngTransforms(png, info, options);
@@ -137,6 +195,63 @@ bool DecodeWithLibpng(PngSource* source, const PngReadOptions& options, Image8* 
     ok = true;
   }
   png_destroy_read_struct(&png, &info, &end_info);
+  return ok;
+}
+
+// ---- libjpeg, from memory, errors by longjmp ----
+
+struct JpegErrors {
+  jpeg_error_mgr manager;
+  std::jmp_buf jump;
+  char message[JMSG_LENGTH_MAX];
+};
+
+void OnJpegError(j_common_ptr cinfo) {
+  auto* errors = reinterpret_cast<JpegErrors*>(cinfo->err);
+  (*cinfo->err->format_message)(cinfo, errors->message);
+  std::longjmp(errors->jump, 1);
+}
+
+void OnJpegMessage(j_common_ptr, int) {}
+
+// Decodes a JPEG into `image` (1 channel for gray, 3 for colour); false with errors->message set.
+// `pixels` is sized here only after the header stated a size that passes `max_pixels`; no C++ object
+// is created between setjmp and a longjmp back to it.
+bool DecodeWithLibjpeg(const uint8_t* data, size_t size, uint64_t max_pixels, JpegErrors* errors, Image8* image) {
+  jpeg_decompress_struct cinfo;
+  cinfo.err = jpeg_std_error(&errors->manager);
+  errors->manager.error_exit = OnJpegError;
+  errors->manager.emit_message = OnJpegMessage;
+  volatile bool ok = false;
+  if (setjmp(errors->jump) == 0) {
+    jpeg_create_decompress(&cinfo);
+    jpeg_mem_src(&cinfo, data, static_cast<unsigned long>(size));
+    jpeg_read_header(&cinfo, TRUE);
+    if (cinfo.jpeg_color_space == JCS_CMYK || cinfo.jpeg_color_space == JCS_YCCK) {
+      std::snprintf(errors->message, sizeof(errors->message), "CMYK JPEG (gray or colour wanted)");
+    } else {
+      cinfo.out_color_space = cinfo.num_components == 1 ? JCS_GRAYSCALE : JCS_RGB;
+      jpeg_start_decompress(&cinfo);
+      const uint64_t pixels = uint64_t{cinfo.output_width} * cinfo.output_height;
+      if (pixels == 0 || pixels > max_pixels) {
+        std::snprintf(errors->message, sizeof(errors->message), "a JPEG of %ux%u pixels in %zu bytes",
+                      cinfo.output_width, cinfo.output_height, size);
+      } else {
+        image->width = static_cast<int>(cinfo.output_width);
+        image->height = static_cast<int>(cinfo.output_height);
+        image->channels = cinfo.output_components;
+        image->pixels.resize(static_cast<size_t>(pixels) * static_cast<size_t>(image->channels));
+        while (cinfo.output_scanline < cinfo.output_height) {
+          JSAMPROW row = image->pixels.data() + static_cast<size_t>(cinfo.output_scanline) * image->width *
+                                                    static_cast<size_t>(image->channels);
+          jpeg_read_scanlines(&cinfo, &row, 1);
+        }
+        jpeg_finish_decompress(&cinfo);
+        ok = true;
+      }
+    }
+  }
+  jpeg_destroy_decompress(&cinfo);
   return ok;
 }
 
@@ -171,24 +286,33 @@ ImageHeader ExrHeader(const std::string& path) {
   return WithExrErrors(path, [&] { return HeaderOf(Imf::InputFile(path.c_str()).header()); });
 }
 
+// An in-memory OpenEXR output stream: OutputFile's destructor writes the line-offset table without
+// reporting errors, so the file is encoded here and written to disk by WriteFileAtomic, which checks.
+struct MemoryOStream : public Imf::OStream {
+  MemoryOStream() : Imf::OStream("memory") {}
+  void write(const char c[], int n) override {
+    if (position + static_cast<uint64_t>(n) > bytes.size()) bytes.resize(position + static_cast<uint64_t>(n));
+    std::memcpy(&bytes[position], c, static_cast<size_t>(n));
+    position += static_cast<uint64_t>(n);
+  }
+  uint64_t tellp() override { return position; }
+  void seekp(uint64_t pos) override { position = pos; }
+
+  std::string bytes;
+  uint64_t position = 0;
+};
+
 }  // namespace
 
 ImageHeader ReadImageHeader(const std::string& path) {
   const std::vector<uint8_t> start = FileBytes(path, 33);  // PNG signature + IHDR chunk
   if (start.size() >= 8 && std::memcmp(start.data(), kPngMagic, 8) == 0) {
-    const std::string problem = PngChunkProblem(path);
-    if (!problem.empty()) throw std::runtime_error(path + ": unreadable PNG: " + problem);
-    if (start.size() < 33) throw std::runtime_error(path + ": unreadable PNG: the IHDR chunk is cut short");
+    const PngIhdr ihdr = CheckedIhdr(start.data(), start.size(), PngChunkProblem(path), path);
     ImageHeader header;
-    const uint32_t width = BigEndian32(start.data() + 16), height = BigEndian32(start.data() + 20);
-    if (width == 0 || height == 0 || width > 0x7fffffffu || height > 0x7fffffffu) {
-      throw std::runtime_error(path + ": unreadable PNG: IHDR size " + std::to_string(width) + "x" +
-                               std::to_string(height));
-    }
-    header.width = static_cast<int>(width);
-    header.height = static_cast<int>(height);
-    header.bit_depth = start[24];
-    header.channels = PngChannels(start[25]);
+    header.width = static_cast<int>(ihdr.width);
+    header.height = static_cast<int>(ihdr.height);
+    header.bit_depth = ihdr.bit_depth;
+    header.channels = ihdr.Channels();
     return header;
   }
   if (start.size() >= 4 && std::memcmp(start.data(), kExrMagic, 4) == 0) return ExrHeader(path);
@@ -199,20 +323,19 @@ Image8 DecodePng8(const uint8_t* data, size_t size, const PngReadOptions& option
   if (options.channels != 0 && options.channels != 1 && options.channels != 3) {
     throw std::invalid_argument(name + ": PngReadOptions::channels must be 0, 1 or 3");
   }
-  if (size < 33 || std::memcmp(data, kPngMagic, 8) != 0) throw std::runtime_error(name + ": not a PNG file");
-  const std::string problem = PngChunkProblem(data, size);
-  if (!problem.empty()) throw std::runtime_error(name + ": unreadable PNG: " + problem);
-  Image8 image;
-  const uint32_t width = BigEndian32(data + 16), height = BigEndian32(data + 20);
-  const uint64_t pixels = uint64_t{width} * height;
-  if (width == 0 || height == 0 || pixels > kMaxPixels || pixels * 3 > kMaxExpansion * uint64_t{size}) {
-    throw std::runtime_error(name + ": unreadable PNG: IHDR states " + std::to_string(width) + "x" +
-                             std::to_string(height) + " pixels, more than " + std::to_string(size) + " bytes can hold");
+  if (size < 8 || std::memcmp(data, kPngMagic, 8) != 0) throw std::runtime_error(name + ": not a PNG file");
+  const PngIhdr ihdr = CheckedIhdr(data, size, PngChunkProblem(data, size), name);
+  const uint64_t pixels = uint64_t{ihdr.width} * ihdr.height;
+  if (pixels > kMaxPixels || ihdr.StoredBytes() > kMaxExpansion * uint64_t{size}) {
+    throw std::runtime_error(name + ": unreadable PNG: IHDR states " + std::to_string(ihdr.width) + "x" +
+                             std::to_string(ihdr.height) + " pixels, more than " + std::to_string(size) +
+                             " bytes can hold");
   }
-  image.width = static_cast<int>(width);
-  image.height = static_cast<int>(height);
+  Image8 image;
+  image.width = static_cast<int>(ihdr.width);
+  image.height = static_cast<int>(ihdr.height);
   image.pixels.resize(static_cast<size_t>(pixels) * 3);  // room for RGB; trimmed to the result's channels
-  std::vector<png_bytep> rows(height);
+  std::vector<png_bytep> rows(ihdr.height);
   PngSource source{data, size, 0, {0}};
   if (!DecodeWithLibpng(&source, options, &image, &rows)) {
     throw std::runtime_error(name + ": unreadable PNG: " + source.error);
@@ -224,6 +347,21 @@ Image8 DecodePng8(const uint8_t* data, size_t size, const PngReadOptions& option
 Image8 ReadPng8(const std::string& path, const PngReadOptions& options) {
   const std::vector<uint8_t> bytes = FileBytes(path);
   return DecodePng8(bytes.data(), bytes.size(), options, path);
+}
+
+Image8 ReadPngOrJpeg8(const std::string& path, const PngReadOptions& options) {
+  const std::vector<uint8_t> bytes = FileBytes(path);
+  if (bytes.size() < 3 || bytes[0] != 0xff || bytes[1] != 0xd8 || bytes[2] != 0xff) {
+    return DecodePng8(bytes.data(), bytes.size(), options, path);
+  }
+  // A JPEG's entropy-coded data expands at most some 1000-fold as well (all-zero blocks).
+  const uint64_t max_pixels = std::min<uint64_t>(kMaxPixels, kMaxExrSamplesPerByte * bytes.size());
+  JpegErrors errors{};
+  Image8 image;
+  if (!DecodeWithLibjpeg(bytes.data(), bytes.size(), max_pixels, &errors, &image)) {
+    throw std::runtime_error(path + ": unreadable JPEG: " + errors.message);
+  }
+  return image;
 }
 
 int FloatImage::Channel(const std::string& name) const {
@@ -274,26 +412,23 @@ void WriteExrFloat(const std::string& path, int width, int height, const std::ve
     throw std::invalid_argument(path + ": " + std::to_string(values.size()) + " values for a " + std::to_string(width) +
                                 "x" + std::to_string(height) + " image");
   }
-  const fs::path parent = fs::path(path).parent_path();
-  if (!parent.empty()) EnsureWritableDir(parent.string());
-  const std::string tmp = TempPathFor(path);
+  MemoryOStream stream;
   try {
     Imf::Header header(width, height);
     header.compression() = Imf::ZIP_COMPRESSION;
     header.channels().insert(channel, Imf::Channel(Imf::FLOAT));
     header.insert("software", Imf::StringAttribute(software));
-    Imf::OutputFile file(tmp.c_str(), header);
+    Imf::OutputFile file(stream, header);
     Imf::FrameBuffer frame;
     frame.insert(channel, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(values.data())),
                                      sizeof(float), sizeof(float) * static_cast<size_t>(width)));
     file.setFrameBuffer(frame);
     file.writePixels(height);
   } catch (const std::exception& e) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    throw std::runtime_error(path + ": cannot write image: " + e.what());
+    throw std::runtime_error(path + ": cannot encode OpenEXR: " + e.what());
   }
-  CommitTempFile(tmp, path);
+  // The file's destructor wrote the line offsets into memory; the disk write is checked as a whole.
+  WriteFileAtomic(path, stream.bytes);
 }
 
 void WritePng8(const std::string& path, int width, int height, int channels, const std::vector<uint8_t>& pixels,

@@ -1,6 +1,7 @@
 #pragma once
-// The image files rovo reads and writes: PNG (decoded by libpng, encoded by datasets/png_encode.h)
-// and OpenEXR (the OpenEXR library; the first part of a multi-part file). Readers throw
+// The image files rovo reads and writes: PNG (decoded by libpng, encoded by datasets/png_encode.h),
+// OpenEXR (the OpenEXR library; the first part of a multi-part file), and JPEG to read real cameras'
+// frames (libjpeg). Pixels are read as stored: an eXIf orientation is not applied. Readers throw
 // std::runtime_error "<file>: <what is wrong>"; writers write atomically (datasets/io.h).
 
 #include <cstddef>
@@ -30,7 +31,8 @@ struct Image8 {
 struct PngReadOptions {
   // 1: gray, colour turned to gray by libpng with weights 0.299 / 0.587 / 0.114 (9797, 19234, 3737
   // of 32768, as cv::imread(IMREAD_GRAYSCALE) reads it); 3: RGB, gray replicated; 0: as stored, 1
-  // channel for gray and 3 for every other colour type. Alpha is dropped, palettes expanded.
+  // channel for gray and 3 for every other colour type. Alpha is dropped, palettes expanded. (OpenCV
+  // would also turn the image by an eXIf orientation; rovo keeps the stored pixels.)
   int channels = 0;
   // 16-bit samples to 8 bits: rounded (v / 257), or their high byte (as OpenCV reads them).
   bool round_16_bit = true;
@@ -38,6 +40,11 @@ struct PngReadOptions {
 
 // A PNG file as 8-bit samples.
 Image8 ReadPng8(const std::string& path, const PngReadOptions& options = {});
+// A PNG or a JPEG file (baseline or progressive, gray or colour; libjpeg's decoding at its default
+// settings), told apart by their signatures, as 8-bit samples: PNGs as ReadPng8 reads them, JPEGs as
+// stored (1 channel for gray, 3 for colour, in RGB order). For images from outside rovo (real
+// cameras' frames); rovo's own images are PNG.
+Image8 ReadPngOrJpeg8(const std::string& path, const PngReadOptions& options = {});
 // The same from the file's bytes; `name` is the file named in errors.
 Image8 DecodePng8(const uint8_t* data, size_t size, const PngReadOptions& options, const std::string& name);
 

@@ -160,7 +160,7 @@ std::vector<ImageStatistics> ComputeImageFileStatistics(const std::vector<std::s
                                                         const ImageStatisticsOptions& options) {
   std::vector<ImageStatistics> out;
   for (const std::string& path : paths) {
-    Image8 file = ReadPng8(path);  // 16-bit samples rounded to 8 bits
+    Image8 file = ReadPngOrJpeg8(path);  // 16-bit samples rounded to 8 bits
     cv::Mat image(file.height, file.width, CV_8UC(file.channels), file.pixels.data());
     if (image.channels() == 3) cv::cvtColor(image, image, cv::COLOR_RGB2BGR);  // in place
     try {

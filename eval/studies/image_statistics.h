@@ -48,7 +48,7 @@ struct ImageStatistics {
 // std::invalid_argument when the image is smaller than the crop.
 ImageStatistics ComputeImageStatistics(const cv::Mat& image, const ImageStatisticsOptions& options);
 
-// The statistics of every image file (read with OpenCV; 16-bit images are scaled to 8 bits); throws
+// The statistics of every image file (PNG or JPEG, ReadPngOrJpeg8; 16-bit images are scaled to 8 bits); throws
 // std::runtime_error naming the file that cannot be read.
 std::vector<ImageStatistics> ComputeImageFileStatistics(const std::vector<std::string>& paths,
                                                         const ImageStatisticsOptions& options);

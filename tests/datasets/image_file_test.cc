@@ -1,6 +1,10 @@
 // datasets/image_file.h against OpenCV's codecs (libpng and OpenEXR set up by another project).
 #include "datasets/image_file.h"
 
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfOutputFile.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -13,6 +17,8 @@
 #include <random>
 #include <string>
 #include <vector>
+
+#include "datasets/io.h"
 
 namespace rovo {
 namespace {
@@ -48,6 +54,24 @@ bool Equal(const cv::Mat& a, const cv::Mat& b) {
   return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0;
 }
 
+// PNG's CRC-32 (for a test to restate a chunk it changed).
+uint32_t Crc32(const char* data, size_t size) {
+  uint32_t crc = 0xffffffffu;
+  for (size_t i = 0; i < size; ++i) {
+    crc ^= static_cast<uint8_t>(data[i]);
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+  }
+  return ~crc;
+}
+
+// What cv::imread gives with `flags` (without applying an eXIf orientation, which rovo ignores), in
+// rovo's channel order (RGB).
+cv::Mat OpenCvRgb(const std::string& path, int flags) {
+  cv::Mat image = cv::imread(path, flags | cv::IMREAD_IGNORE_ORIENTATION);
+  if (image.channels() == 3) cv::cvtColor(image, image, cv::COLOR_BGR2RGB);
+  return image;
+}
+
 TEST_F(ImageFileTest, GrayReadsAsOpenCvReadsItFromEveryKindOfPng) {
   for (const auto& [name, type] : std::vector<std::pair<std::string, int>>{{"gray.png", CV_8UC1},
                                                                            {"bgr.png", CV_8UC3},
@@ -60,6 +84,53 @@ TEST_F(ImageFileTest, GrayReadsAsOpenCvReadsItFromEveryKindOfPng) {
     cv::Mat colour = cv::imread(path, cv::IMREAD_ANYCOLOR);
     if (colour.channels() == 3) cv::cvtColor(colour, colour, cv::COLOR_BGR2RGB);
     EXPECT_TRUE(Equal(AsMat(ReadPng8(path, {0, false})), colour)) << name;
+  }
+}
+
+// The fuzz corpus holds the PNG kinds cv::imwrite does not write (palette with tRNS, gray + alpha,
+// 1-bit gray): both modes as OpenCV reads them.
+TEST_F(ImageFileTest, EveryCorpusPngReadsAsOpenCvReadsIt) {
+  int compared = 0;
+  for (const auto& entry : fs::directory_iterator(std::string(ROVO_TEST_DATA_DIR) + "/../fuzz/corpus/image_file")) {
+    const std::string path = entry.path().string();
+    // (Not the PNG whose chunk claims 1.7 GB, which OpenCV's libpng would allocate.)
+    if (entry.path().extension() != ".png" || !PngChunkProblem(path).empty()) continue;
+    if (cv::imread(path, cv::IMREAD_GRAYSCALE).empty()) continue;
+    EXPECT_TRUE(Equal(AsMat(ReadPng8(path, {1, false})), OpenCvRgb(path, cv::IMREAD_GRAYSCALE))) << path;
+    EXPECT_TRUE(Equal(AsMat(ReadPng8(path, {0, false})), OpenCvRgb(path, cv::IMREAD_ANYCOLOR))) << path;
+    ++compared;
+  }
+  EXPECT_GE(compared, 6);
+}
+
+// Flat images compress by hundreds: the size guard counts the stored rows, not the decoded pixels.
+TEST_F(ImageFileTest, FlatAndBilevelImagesDecode) {
+  WritePng8(Path("black.png"), 1920, 1080, 1, std::vector<uint8_t>(1920 * 1080, 0), "x", 12);
+  ASSERT_LT(fs::file_size(Path("black.png")), 1920u * 1080u * 3u / 1100u);
+  const Image8 black = ReadPng8(Path("black.png"), {3, true});
+  EXPECT_EQ(black.pixels, std::vector<uint8_t>(1920 * 1080 * 3, 0));
+  cv::Mat mask(1000, 1000, CV_8UC1, cv::Scalar(0));
+  cv::rectangle(mask, cv::Rect(100, 200, 300, 400), cv::Scalar(255), cv::FILLED);
+  ASSERT_TRUE(cv::imwrite(Path("mask.png"), mask, {cv::IMWRITE_PNG_BILEVEL, 1, cv::IMWRITE_PNG_COMPRESSION, 9}));
+  EXPECT_EQ(ReadImageHeader(Path("mask.png")).bit_depth, 1);
+  EXPECT_TRUE(Equal(AsMat(ReadPng8(Path("mask.png"), {1, false})), mask));
+}
+
+// Real cameras' JPEG frames (rovo study images): as OpenCV's libjpeg decodes them.
+TEST_F(ImageFileTest, JpegReadsAsOpenCvReadsIt) {
+  for (const auto& [name, type] :
+       std::vector<std::pair<std::string, int>>{{"gray.jpg", CV_8UC1}, {"bgr.jpg", CV_8UC3}}) {
+    const std::string path = WriteNoise(name, type, 9);
+    const Image8 image = ReadPngOrJpeg8(path);
+    EXPECT_TRUE(Equal(AsMat(image), OpenCvRgb(path, cv::IMREAD_UNCHANGED))) << name;
+  }
+  EXPECT_EQ(ReadPngOrJpeg8(WriteNoise("also.png", CV_8UC3, 1)).channels, 3);
+  std::ofstream(Path("cut.jpg"), std::ios::binary).write("\xff\xd8\xff\xe0\x00\x10JFIF", 10);
+  try {
+    ReadPngOrJpeg8(Path("cut.jpg"));
+    ADD_FAILURE() << "a cut JPEG was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(Path("cut.jpg") + ": unreadable JPEG: ", 0), 0u) << e.what();
   }
 }
 
@@ -93,6 +164,36 @@ TEST_F(ImageFileTest, HeadersOfPngAndExr) {
   EXPECT_EQ(h.height, 4);
   EXPECT_EQ(h.channels, 1);
   EXPECT_EQ(h.bit_depth, 32);
+}
+
+// A data window away from the origin and half samples, as other programs write them.
+TEST_F(ImageFileTest, ExrDataWindowAndHalfChannels) {
+  const Imath::Box2i display(Imath::V2i(0, 0), Imath::V2i(9, 9)), data(Imath::V2i(-3, 5), Imath::V2i(2, 8));
+  Imf::Header header(display, data);
+  header.channels().insert("Y", Imf::Channel(Imf::HALF));
+  std::vector<Imath::half> halves(6 * 4);
+  for (size_t i = 0; i < halves.size(); ++i) halves[i] = static_cast<float>(i) * 0.5f;
+  {
+    Imf::OutputFile file(Path("window.exr").c_str(), header);
+    Imf::FrameBuffer frame;
+    frame.insert("Y", Imf::Slice::Make(Imf::HALF, halves.data(), data));
+    file.setFrameBuffer(frame);
+    file.writePixels(4);
+  }
+  const FloatImage exr = ReadExr(Path("window.exr"));
+  ASSERT_EQ(exr.width, 6);
+  ASSERT_EQ(exr.height, 4);
+  for (size_t i = 0; i < halves.size(); ++i) ASSERT_EQ(exr.planes[0][i], static_cast<float>(i) * 0.5f) << i;
+  EXPECT_EQ(ReadImageHeader(Path("window.exr")).bit_depth, 16);
+}
+
+TEST_F(ImageFileTest, ExrWriteErrorsNameTheFileAndLeaveNothing) {
+  std::ofstream(Path("blocker")) << "a file where a folder should be";
+  EXPECT_THROW(WriteExrFloat(Path("blocker") + "/d.exr", 2, 2, std::vector<float>(4, 1.0f), "Z", "x"),
+               std::runtime_error);
+  EXPECT_FALSE(fs::exists(Path("blocker") + "/d.exr"));
+  EXPECT_THROW(WriteExrFloat(Path("d.exr"), 2, 2, std::vector<float>(3, 1.0f), "Z", "x"), std::invalid_argument);
+  EXPECT_FALSE(fs::exists(Path("d.exr")));
 }
 
 TEST_F(ImageFileTest, ExrRoundTripsExactly) {
@@ -140,13 +241,20 @@ TEST_F(ImageFileTest, BadFilesNameTheFileAndTheProblem) {
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   std::ofstream(Path("cut.png"), std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size() / 2));
   EXPECT_EQ(message([&] { ReadPng8(Path("cut.png")); }).rfind(Path("cut.png") + ": unreadable PNG: ", 0), 0u);
-  // A header that states far more pixels than the file can hold.
+  // A header that states far more pixels than the file can hold (its CRC restated), and one whose
+  // CRC no longer matches.
   std::string huge = bytes;
-  huge[16] = 0x7f;  // width 2^30 and more
-  EXPECT_NE(message([&] {
-              DecodePng8(reinterpret_cast<const uint8_t*>(huge.data()), huge.size(), {}, "huge");
-            }).find("more than"),
-            std::string::npos);
+  for (const int at : {16, 20}) {  // 900000 x 900000
+    huge[at] = 0, huge[at + 1] = 0x0d, huge[at + 2] = static_cast<char>(0xbb), huge[at + 3] = static_cast<char>(0xa0);
+  }
+  const uint32_t crc = Crc32(huge.data() + 12, 17);
+  for (int k = 0; k < 4; ++k) huge[29 + k] = static_cast<char>(crc >> (24 - 8 * k));
+  const auto decode = [&](const std::string& png) {
+    return message([&] { DecodePng8(reinterpret_cast<const uint8_t*>(png.data()), png.size(), {}, "mem.png"); });
+  };
+  EXPECT_NE(decode(huge).find("more than"), std::string::npos) << decode(huge);
+  huge[29] ^= 1;
+  EXPECT_NE(decode(huge).find("IHDR CRC error"), std::string::npos) << decode(huge);
   std::ofstream(Path("cut.exr"), std::ios::binary).write("\x76\x2f\x31\x01\x02\x00", 6);
   EXPECT_EQ(message([&] { ReadExr(Path("cut.exr")); }).rfind(Path("cut.exr") + ": unreadable OpenEXR file", 0), 0u);
 }

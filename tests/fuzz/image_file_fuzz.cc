@@ -1,8 +1,9 @@
 // Fuzz target: the image file readers (datasets/image_file.h): a PNG decoded from memory with every
-// set of PngReadOptions and from its file, the header, and the same bytes as an OpenEXR file. Besides
+// set of PngReadOptions and from its file, the header, the same bytes as a PNG or JPEG (by their
+// signature) and as an OpenEXR file. Besides
 // the error contract: a decoded PNG has the size of its header and the channels asked for, and
-// whenever OpenCV's decoder reads the bytes as gray, the gray decoding equals it (libpng set up as
-// OpenCV sets it up).
+// whenever OpenCV's decoder reads the bytes as gray, they are read, and the gray decoding equals
+// OpenCV's (libpng set up as OpenCV sets it up; no eXIf orientation applied).
 #include <opencv2/imgcodecs.hpp>
 
 #include "datasets/image_file.h"
@@ -14,9 +15,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string png = dir + "/image.png", exr = dir + "/image.exr";
   rovo::fuzz::WriteBytes(png, data, size);
   rovo::fuzz::WriteBytes(exr, data, size);
+  // OpenCV's gray decoding, without the eXIf orientation it would apply (rovo keeps pixels as stored).
+  const cv::Mat expected = cv::imdecode(cv::Mat(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(data)),
+                                        cv::IMREAD_GRAYSCALE | cv::IMREAD_IGNORE_ORIENTATION);
+  const bool is_png = size >= 4 && data[1] == 'P' && data[2] == 'N' && data[3] == 'G';
   for (const int channels : {0, 1, 3}) {
     for (const bool round : {true, false}) {
-      rovo::fuzz::ExpectClearError({"memory.png"}, [&] {
+      const bool read = rovo::fuzz::ExpectClearError({"memory.png"}, [&] {
         const rovo::Image8 image = rovo::DecodePng8(data, size, {channels, round}, "memory.png");
         const rovo::ImageHeader header = rovo::ReadImageHeader(png);
         if (image.width != header.width || image.height != header.height ||
@@ -25,17 +30,22 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
           rovo::fuzz::Finding("decoded PNG of the wrong size", png);
         }
         if (channels == 1 && !round) {
-          const cv::Mat expected = cv::imdecode(cv::Mat(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(data)),
-                                                cv::IMREAD_GRAYSCALE);
           const cv::Mat ours(image.height, image.width, CV_8UC1, const_cast<uint8_t*>(image.pixels.data()));
           if (!expected.empty() && (expected.size() != ours.size() || cv::countNonZero(expected != ours) != 0)) {
             rovo::fuzz::Finding("gray PNG differs from OpenCV's", png);
           }
         }
       });
+      if (!read && is_png && !expected.empty()) rovo::fuzz::Finding("a PNG OpenCV reads is refused", png);
     }
   }
   rovo::fuzz::ExpectClearError({png}, [&] { rovo::ReadPng8(png); });
+  rovo::fuzz::ExpectClearError({png}, [&] {
+    const rovo::Image8 image = rovo::ReadPngOrJpeg8(png);  // a JPEG when the bytes start as one
+    if (image.pixels.size() != static_cast<size_t>(image.width) * image.height * image.channels) {
+      rovo::fuzz::Finding("decoded image of the wrong size", png);
+    }
+  });
   rovo::fuzz::ExpectClearError({exr}, [&] {
     const rovo::FloatImage image = rovo::ReadExr(exr);
     for (const std::vector<float>& plane : image.planes) {
