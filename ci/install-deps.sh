@@ -16,7 +16,7 @@ what=${1:-all}
 BUILD=(
   build-essential cmake ninja-build git
   libembree-dev libtbb-dev
-  libpng-dev libopenexr-dev
+  libpng-dev libjpeg-dev libopenexr-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-features2d-dev libopencv-video-dev libopencv-calib3d-dev
   libopencv-imgcodecs-dev
   libeigen3-dev libceres-dev libopengv-dev
