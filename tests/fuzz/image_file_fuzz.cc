@@ -4,10 +4,9 @@
 // the error contract: a decoded PNG has the size of its header and the channels asked for, and
 // whenever OpenCV's decoder reads the bytes as gray, they are read, and the gray decoding equals
 // OpenCV's (libpng set up as OpenCV sets it up; no eXIf orientation applied).
-#include <opencv2/imgcodecs.hpp>
-
 #include "datasets/image_file.h"
 #include "tests/fuzz/fuzz_util.h"
+#include "tests/fuzz/opencv_gray.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const rovo::fuzz::ScratchDir scratch("image_file");
@@ -15,9 +14,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string png = dir + "/image.png", exr = dir + "/image.exr";
   rovo::fuzz::WriteBytes(png, data, size);
   rovo::fuzz::WriteBytes(exr, data, size);
-  // OpenCV's gray decoding, without the eXIf orientation it would apply (rovo keeps pixels as stored).
-  const cv::Mat expected = cv::imdecode(cv::Mat(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(data)),
-                                        cv::IMREAD_GRAYSCALE | cv::IMREAD_IGNORE_ORIENTATION);
+  const cv::Mat expected = rovo::fuzz::OpenCvGray(data, size);
   const bool is_png = size >= 4 && data[1] == 'P' && data[2] == 'N' && data[3] == 'G';
   for (const int channels : {0, 1, 3}) {
     for (const bool round : {true, false}) {

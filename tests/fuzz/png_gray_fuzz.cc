@@ -4,12 +4,11 @@
 // 32x31 rig. Besides the error contract: whenever the fast path decodes the bytes, OpenCV's decoder must give the same
 // image (the fast path must never accept what libpng would read otherwise or refuse), and whenever OpenCV decodes a
 // PNG, ReadGrayImage gives its image.
-#include <opencv2/imgcodecs.hpp>
-
 #include "datasets/dataset.h"
 #include "datasets/rig.h"
 #include "tests/fuzz/fuzz_rig.h"
 #include "tests/fuzz/fuzz_util.h"
+#include "tests/fuzz/opencv_gray.h"
 #include "vo/image_loader.h"
 #include "vo/png_gray.h"
 
@@ -29,9 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const rovo::Rig rig = OneCameraRig();
   const std::string path = rovo::ImagePath(dir, "cam0", 0);
   rovo::fuzz::WriteBytes(path, data, size);
-  const cv::Mat expected =  // without the eXIf orientation OpenCV would apply: rovo keeps the pixels as stored
-      cv::imdecode(cv::Mat(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(data)),
-                   cv::IMREAD_GRAYSCALE | cv::IMREAD_IGNORE_ORIENTATION);
+  const cv::Mat expected = rovo::fuzz::OpenCvGray(data, size);
   if (const auto fast = rovo::DecodePngGrayFast(data, size)) {
     if (expected.size() != fast->size() || cv::countNonZero(expected != *fast) != 0) {
       rovo::fuzz::Finding("fast PNG path differs from OpenCV", path);
