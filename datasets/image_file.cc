@@ -36,9 +36,9 @@ constexpr uint8_t kExrMagic[4] = {0x76, 0x2f, 0x31, 0x01};
 constexpr size_t kMaxExpansion = 1100;
 constexpr size_t kMaxPixels = size_t{1} << 28;
 constexpr uint32_t kMaxPngSide = 1000000;  // libpng's default limit of either side
-// OpenEXR's DWA compression keeps one DC value of an 8x8 block of a flat image and deflates them:
-// at most 64 x 1032 samples per byte.
-constexpr size_t kMaxExrSamplesPerByte = 64 * kMaxExpansion;
+// An OpenEXR file's samples per byte of file: its lossless codecs (zip, RLE, PIZ) stay below deflate's
+// bound; a flat image under the lossy DWA codec could exceed it and is refused.
+constexpr size_t kMaxExrSamplesPerByte = kMaxExpansion;
 
 std::vector<uint8_t> FileBytes(const std::string& path, size_t limit = SIZE_MAX) {
   std::ifstream in(path, std::ios::binary);
@@ -257,8 +257,18 @@ bool DecodeWithLibjpeg(const uint8_t* data, size_t size, uint64_t max_pixels, Jp
 
 // ---- OpenEXR ----
 
+// OpenEXR sizes its tables and line buffers by the header's data window before reading any pixel:
+// windows and tiles beyond these sides are refused while the header is read.
+constexpr int kMaxExrSide = 65536, kMaxExrTileSide = 4096;
+
 template <typename Fn>
 auto WithExrErrors(const std::string& path, Fn fn) -> decltype(fn()) {
+  static const bool limits_set = [] {
+    Imf::Header::setMaxImageSize(kMaxExrSide, kMaxExrSide);
+    Imf::Header::setMaxTileSize(kMaxExrTileSide, kMaxExrTileSide);
+    return true;
+  }();
+  (void)limits_set;
   try {
     return fn();
   } catch (const std::runtime_error&) {
@@ -282,7 +292,57 @@ ImageHeader HeaderOf(const Imf::Header& exr) {
   return header;
 }
 
+// Why the header part of an OpenEXR file cannot be handed to OpenEXR, or "": every attribute must fit
+// in the file (OpenEXR sizes its buffers by what the header states before it reads the data), and the
+// data window must lie within kMaxExrSide a side. Multi-part files: every part's header.
+std::string ExrHeaderProblem(const std::string& path) {
+  const std::vector<uint8_t> bytes = FileBytes(path, size_t{16} << 20);
+  if (bytes.size() < 8) return "the file ends in its version field";
+  const bool multi_part = (bytes[5] & 0x10) != 0;  // version flag bit 12
+  size_t at = 8;
+  std::string name, type;
+  const auto text = [&](std::string* out) {  // a NUL-terminated name of at most 255 characters
+    const auto first = bytes.begin() + static_cast<std::ptrdiff_t>(at);
+    const auto end = std::find(first, bytes.begin() + static_cast<std::ptrdiff_t>(std::min(bytes.size(), at + 256)), 0);
+    if (end == bytes.end() || *end != 0) return false;
+    out->assign(first, end);
+    at = static_cast<size_t>(end - bytes.begin()) + 1;
+    return true;
+  };
+  for (int part = 0; part < 1000; ++part) {
+    while (true) {  // the attributes of one header, up to an empty name
+      if (!text(&name)) return "header " + std::to_string(part) + ": a name beyond the file or 255 characters";
+      if (name.empty()) break;
+      if (!text(&type) || bytes.size() - at < 4) return "attribute " + name + " is cut short";
+      uint32_t size = 0;
+      std::memcpy(&size, bytes.data() + at, 4);  // little-endian, as the host
+      at += 4;
+      if (size > bytes.size() - at) return "attribute " + name + " claims " + std::to_string(size) + " bytes";
+      if (name == "dataWindow" && type == "box2i" && size == 16) {
+        int32_t box[4];
+        std::memcpy(box, bytes.data() + at, 16);
+        if (box[0] > box[2] || box[1] > box[3] || int64_t{box[2]} - box[0] >= kMaxExrSide ||
+            int64_t{box[3]} - box[1] >= kMaxExrSide) {
+          return "data window (" + std::to_string(box[0]) + ", " + std::to_string(box[1]) + ") - (" +
+                 std::to_string(box[2]) + ", " + std::to_string(box[3]) + ")";
+        }
+      }
+      at += size;
+    }
+    // One header, or a multi-part file's list of them ended by an empty one.
+    if (!multi_part || (at < bytes.size() && bytes[at] == 0)) return "";
+  }
+  return "more than 1000 parts";
+}
+
+// Throws naming the file when ExrHeaderProblem finds one.
+void CheckExrHeader(const std::string& path) {
+  const std::string problem = ExrHeaderProblem(path);
+  if (!problem.empty()) throw std::runtime_error(path + ": unreadable OpenEXR file: " + problem);
+}
+
 ImageHeader ExrHeader(const std::string& path) {
+  CheckExrHeader(path);
   return WithExrErrors(path, [&] { return HeaderOf(Imf::InputFile(path.c_str()).header()); });
 }
 
@@ -354,8 +414,8 @@ Image8 ReadPngOrJpeg8(const std::string& path, const PngReadOptions& options) {
   if (bytes.size() < 3 || bytes[0] != 0xff || bytes[1] != 0xd8 || bytes[2] != 0xff) {
     return DecodePng8(bytes.data(), bytes.size(), options, path);
   }
-  // A JPEG's entropy-coded data expands at most some 1000-fold as well (all-zero blocks).
-  const uint64_t max_pixels = std::min<uint64_t>(kMaxPixels, kMaxExrSamplesPerByte * bytes.size());
+  // An 8x8 block of a flat JPEG takes a few bits: at most some 250 pixels per byte.
+  const uint64_t max_pixels = std::min<uint64_t>(kMaxPixels, kMaxExpansion * bytes.size());
   JpegErrors errors{};
   Image8 image;
   if (!DecodeWithLibjpeg(bytes.data(), bytes.size(), max_pixels, &errors, &image)) {
@@ -373,6 +433,7 @@ FloatImage ReadExr(const std::string& path) {
   std::error_code ec;
   const uint64_t file_size = fs::file_size(path, ec);
   if (ec) throw std::runtime_error(path + ": cannot open the image: " + ec.message());
+  CheckExrHeader(path);
   return WithExrErrors(path, [&] {
     Imf::InputFile file(path.c_str());
     const Imath::Box2i& window = file.header().dataWindow();

@@ -1,8 +1,9 @@
 #pragma once
-// The fuzz targets' independent gray decoder: OpenCV's, without the eXIf orientation it would apply
-// (rovo keeps pixels as stored). Empty when OpenCV cannot read the bytes (it throws on no bytes), and
-// for a PNG whose chunk list rovo refuses (PngChunkProblem): OpenCV's libpng would allocate a chunk's
-// stated length first, up to 4 GB, and time out.
+// The fuzz targets' independent gray decoder of PNGs: OpenCV's, without the eXIf orientation it would
+// apply (rovo keeps pixels as stored). Empty when OpenCV cannot read the bytes, for other formats
+// (OpenCV's other decoders, GDCM's DICOM among them, allocate gigabytes on some inputs), and for a PNG
+// whose chunk list rovo refuses (PngChunkProblem): OpenCV's libpng would allocate a chunk's stated
+// length first, up to 4 GB, and time out.
 #include <cstddef>
 #include <cstdint>
 #include <opencv2/core.hpp>
@@ -13,7 +14,8 @@
 namespace rovo::fuzz {
 
 inline cv::Mat OpenCvGray(const uint8_t* data, size_t size) {
-  if (size == 0 || !PngChunkProblem(data, size).empty()) return cv::Mat();
+  const bool png = size >= 8 && data[0] == 0x89 && data[1] == 'P' && data[2] == 'N' && data[3] == 'G';
+  if (!png || !PngChunkProblem(data, size).empty()) return cv::Mat();
   try {
     return cv::imdecode(cv::Mat(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(data)),
                         cv::IMREAD_GRAYSCALE | cv::IMREAD_IGNORE_ORIENTATION);
