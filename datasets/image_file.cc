@@ -16,6 +16,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <stdexcept>
 
 // clang-format off
@@ -293,8 +294,9 @@ ImageHeader HeaderOf(const Imf::Header& exr) {
 }
 
 // Why the header part of an OpenEXR file cannot be handed to OpenEXR, or "": every attribute must fit
-// in the file (OpenEXR sizes its buffers by what the header states before it reads the data), and the
-// data window must lie within kMaxExrSide a side. Multi-part files: every part's header.
+// in the file (OpenEXR sizes its buffers by what the header states before it reads the data), the
+// required attributes must be there, and the data and display windows within kMaxExrSide a side.
+// Multi-part files: every part's header.
 std::string ExrHeaderProblem(const std::string& path) {
   const std::vector<uint8_t> bytes = FileBytes(path, size_t{16} << 20);
   if (bytes.size() < 8) return "the file ends in its version field";
@@ -309,7 +311,11 @@ std::string ExrHeaderProblem(const std::string& path) {
     at = static_cast<size_t>(end - bytes.begin()) + 1;
     return true;
   };
+  // The attributes every header must have (OpenEXR's own defaults for missing ones have sized tables
+  // by nonsense), with the windows' sides bounded.
+  static const char* const kRequired[] = {"channels", "compression", "dataWindow", "displayWindow", "lineOrder"};
   for (int part = 0; part < 1000; ++part) {
+    std::set<std::string> seen;
     while (true) {  // the attributes of one header, up to an empty name
       if (!text(&name)) return "header " + std::to_string(part) + ": a name beyond the file or 255 characters";
       if (name.empty()) break;
@@ -318,16 +324,23 @@ std::string ExrHeaderProblem(const std::string& path) {
       std::memcpy(&size, bytes.data() + at, 4);  // little-endian, as the host
       at += 4;
       if (size > bytes.size() - at) return "attribute " + name + " claims " + std::to_string(size) + " bytes";
-      if (name == "dataWindow" && type == "box2i" && size == 16) {
+      if ((name == "dataWindow" || name == "displayWindow") && (type != "box2i" || size != 16)) {
+        return "attribute " + name + " is not a box2i";
+      }
+      if (name == "dataWindow" || name == "displayWindow") {
         int32_t box[4];
         std::memcpy(box, bytes.data() + at, 16);
         if (box[0] > box[2] || box[1] > box[3] || int64_t{box[2]} - box[0] >= kMaxExrSide ||
             int64_t{box[3]} - box[1] >= kMaxExrSide) {
-          return "data window (" + std::to_string(box[0]) + ", " + std::to_string(box[1]) + ") - (" +
+          return name + " (" + std::to_string(box[0]) + ", " + std::to_string(box[1]) + ") - (" +
                  std::to_string(box[2]) + ", " + std::to_string(box[3]) + ")";
         }
       }
+      seen.insert(name);
       at += size;
+    }
+    for (const char* required : kRequired) {
+      if (!seen.count(required)) return "header " + std::to_string(part) + " has no " + required;
     }
     // One header, or a multi-part file's list of them ended by an empty one.
     if (!multi_part || (at < bytes.size() && bytes[at] == 0)) return "";
