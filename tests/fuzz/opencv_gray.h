@@ -6,6 +6,7 @@
 // length first, up to 4 GB, and time out.
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -14,7 +15,8 @@
 namespace rovo::fuzz {
 
 inline cv::Mat OpenCvGray(const uint8_t* data, size_t size) {
-  const bool png = size >= 8 && data[0] == 0x89 && data[1] == 'P' && data[2] == 'N' && data[3] == 'G';
+  static const uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  const bool png = size >= 8 && std::memcmp(data, kSignature, 8) == 0;  // else OpenCV tries GDCM, which asserts
   if (!png || !PngChunkProblem(data, size).empty()) return cv::Mat();
   try {
     return cv::imdecode(cv::Mat(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(data)),
