@@ -298,8 +298,12 @@ ImageHeader HeaderOf(const Imf::Header& exr) {
 // required attributes must be there, and the data and display windows within kMaxExrSide a side.
 // Multi-part files: every part's header.
 std::string ExrHeaderProblem(const std::string& path) {
-  const std::vector<uint8_t> bytes = FileBytes(path, size_t{16} << 20);
+  // The header only (a few kB; a preview image adds tens): not the pixels, which the validator
+  // would otherwise read for every depth file. A header beyond the first 1 MB is refused.
+  constexpr size_t kMaxHeaderBytes = size_t{1} << 20;
+  const std::vector<uint8_t> bytes = FileBytes(path, kMaxHeaderBytes);
   if (bytes.size() < 8) return "the file ends in its version field";
+  const std::string beyond = bytes.size() == kMaxHeaderBytes ? " (or a header longer than 1 MB)" : "";
   const bool multi_part = (bytes[5] & 0x10) != 0;  // version flag bit 12
   size_t at = 8;
   std::string name, type;
@@ -317,13 +321,13 @@ std::string ExrHeaderProblem(const std::string& path) {
   for (int part = 0; part < 1000; ++part) {
     std::set<std::string> seen;
     while (true) {  // the attributes of one header, up to an empty name
-      if (!text(&name)) return "header " + std::to_string(part) + ": a name beyond the file or 255 characters";
+      if (!text(&name)) return "header " + std::to_string(part) + ": a name beyond the file or 255 characters" + beyond;
       if (name.empty()) break;
-      if (!text(&type) || bytes.size() - at < 4) return "attribute " + name + " is cut short";
+      if (!text(&type) || bytes.size() - at < 4) return "attribute " + name + " is cut short" + beyond;
       uint32_t size = 0;
       std::memcpy(&size, bytes.data() + at, 4);  // little-endian, as the host
       at += 4;
-      if (size > bytes.size() - at) return "attribute " + name + " claims " + std::to_string(size) + " bytes";
+      if (size > bytes.size() - at) return "attribute " + name + " claims " + std::to_string(size) + " bytes" + beyond;
       if ((name == "dataWindow" || name == "displayWindow") && (type != "box2i" || size != 16)) {
         return "attribute " + name + " is not a box2i";
       }
