@@ -1,0 +1,149 @@
+#include "vo/pyr_lk.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+#include <vector>
+
+namespace rovo {
+namespace {
+
+// Smooth texture (blurred noise) with hard-edged blocks, so that gradients are both weak and at the
+// Scharr filter's extremes.
+cv::Mat Texture(int width, int height, uint64_t seed) {
+  cv::Mat noise(height, width, CV_8UC1);
+  cv::RNG rng(seed);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
+  cv::Mat image;
+  cv::GaussianBlur(noise, image, cv::Size(0, 0), 2.0);
+  cv::normalize(image, image, 0, 255, cv::NORM_MINMAX);
+  for (int k = 0; k < 30; ++k) {
+    const int x = rng.uniform(0, width - 12), y = rng.uniform(0, height - 12);
+    image(cv::Rect(x, y, 12, 12)).setTo(k % 2 == 0 ? 255 : 0);
+  }
+  return image;
+}
+
+// `image` moved by (dx, dy) with its brightness scaled and offset.
+cv::Mat Moved(const cv::Mat& image, double dx, double dy, double gain, double offset) {
+  const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, dx, 0, 1, dy);
+  cv::Mat moved;
+  cv::warpAffine(image, moved, shift, image.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT_101);
+  moved.convertTo(moved, CV_8U, gain, offset);
+  return moved;
+}
+
+struct Case {
+  cv::Size window;
+  int levels;
+  cv::TermCriteria criteria;
+  bool initial_flow;
+};
+
+// PyrLk against cv::calcOpticalFlowPyrLK on the same pyramids: every point's coordinates bit for bit and
+// every status. Returns the number of points tracked (status 1).
+int ExpectSameAsOpenCv(const cv::Mat& from, const cv::Mat& to, const std::vector<cv::Point2f>& points,
+                       const std::vector<cv::Point2f>& starts, const Case& c) {
+  std::vector<cv::Mat> from_pyramid, to_pyramid;
+  cv::buildOpticalFlowPyramid(from, from_pyramid, c.window, c.levels);
+  cv::buildOpticalFlowPyramid(to, to_pyramid, c.window, c.levels);
+  EXPECT_TRUE(PyrLkApplies(from_pyramid, to_pyramid, c.window));
+  const int flags = c.initial_flow ? cv::OPTFLOW_USE_INITIAL_FLOW : 0;
+  std::vector<cv::Point2f> expected = starts, actual = starts;
+  actual.resize(points.size());
+  std::vector<uint8_t> expected_status, actual_status(points.size(), 7);
+  cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, points, expected, expected_status, cv::noArray(), c.window,
+                           c.levels, c.criteria, flags);
+  PyrLk(from_pyramid, to_pyramid, points.data(), actual.data(), actual_status.data(), static_cast<int>(points.size()),
+        c.window, c.levels, c.criteria, flags);
+  int tracked = 0, differ = 0;
+  for (size_t k = 0; k < points.size(); ++k) {
+    tracked += expected_status[k];
+    if (expected_status[k] != actual_status[k] || std::memcmp(&expected[k], &actual[k], sizeof(cv::Point2f)) != 0) {
+      if (++differ <= 5) {
+        ADD_FAILURE() << "point " << k << " at " << points[k] << ": OpenCV " << expected[k] << " status "
+                      << int(expected_status[k]) << ", PyrLk " << actual[k] << " status " << int(actual_status[k]);
+      }
+    }
+  }
+  EXPECT_EQ(differ, 0) << "of " << points.size() << " points";
+  return tracked;
+}
+
+std::vector<cv::Point2f> RandomPoints(int n, cv::Size size, int margin, cv::RNG& rng) {
+  std::vector<cv::Point2f> points(n);
+  for (cv::Point2f& p : points) {
+    p = cv::Point2f(rng.uniform(static_cast<float>(-margin), static_cast<float>(size.width + margin)),
+                    rng.uniform(static_cast<float>(-margin), static_cast<float>(size.height + margin)));
+  }
+  return points;
+}
+
+const cv::TermCriteria kTrackerCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.03);
+
+TEST(PyrLk, SameAsOpenCvWithoutStarts) {
+  const cv::Mat from = Texture(320, 240, 1);
+  cv::RNG rng(11);
+  // Points across the image and beyond its borders (lost at some levels or all).
+  const std::vector<cv::Point2f> points = RandomPoints(3000, from.size(), 20, rng);
+  for (const double dx : {0.0, 3.3, -17.6}) {
+    const cv::Mat to = Moved(from, dx, 0.4 * dx + 1.7, 1.0, 0.0);
+    const int tracked = ExpectSameAsOpenCv(from, to, points, {}, {cv::Size(15, 15), 3, kTrackerCriteria, false});
+    EXPECT_GT(tracked, 1000) << "dx " << dx;
+  }
+}
+
+TEST(PyrLk, SameAsOpenCvFromStarts) {
+  const cv::Mat from = Texture(300, 260, 2);
+  const cv::Mat to = Moved(from, 6.25, -4.5, 1.0, 0.0);
+  cv::RNG rng(12);
+  const std::vector<cv::Point2f> points = RandomPoints(3000, from.size(), 5, rng);
+  std::vector<cv::Point2f> starts(points.size());
+  for (size_t k = 0; k < points.size(); ++k)
+    starts[k] = points[k] + cv::Point2f(6.25f + rng.uniform(-3.f, 3.f), -4.5f + rng.uniform(-3.f, 3.f));
+  for (const int levels : {0, 1, 3}) {
+    const int tracked = ExpectSameAsOpenCv(from, to, points, starts, {cv::Size(15, 15), levels, kTrackerCriteria, true});
+    EXPECT_GT(tracked, 1000) << "levels " << levels;
+  }
+}
+
+// Large mismatches (a brightness change) take the one-by-one float sums in OpenCV's order; small ones
+// (no change) the exact integer sums. Other criteria and window heights.
+TEST(PyrLk, SameAsOpenCvUnderBrightnessChangesAndOtherSettings) {
+  const cv::Mat from = Texture(256, 256, 3);
+  cv::RNG rng(13);
+  const std::vector<cv::Point2f> points = RandomPoints(2000, from.size(), 2, rng);
+  const cv::Mat brighter = Moved(from, 2.5, 1.25, 0.7, 70.0);
+  const cv::Mat same = Moved(from, 0.0, 0.0, 1.0, 0.0);
+  for (const cv::Mat* to : {&brighter, &same}) {
+    ExpectSameAsOpenCv(from, *to, points, {}, {cv::Size(15, 15), 2, kTrackerCriteria, false});
+    ExpectSameAsOpenCv(from, *to, points, {}, {cv::Size(15, 9), 2, kTrackerCriteria, false});
+    ExpectSameAsOpenCv(from, *to, points, {}, {cv::Size(15, 31), 1, cv::TermCriteria(cv::TermCriteria::COUNT, 5, 0),
+                                               false});
+    ExpectSameAsOpenCv(from, *to, points, {}, {cv::Size(15, 15), 3, cv::TermCriteria(cv::TermCriteria::EPS, 0, 1e-6),
+                                               false});
+  }
+}
+
+TEST(PyrLk, AppliesOnlyWhereItMatchesOpenCv) {
+  const cv::Mat image = Texture(128, 128, 4);
+  std::vector<cv::Mat> with, without;
+  cv::buildOpticalFlowPyramid(image, with, cv::Size(15, 15), 2);
+  cv::buildOpticalFlowPyramid(image, without, cv::Size(15, 15), 2, false);
+  const bool avx2 = __builtin_cpu_supports("avx2") != 0;
+  EXPECT_EQ(PyrLkApplies(with, with, cv::Size(15, 15)), avx2);
+  EXPECT_EQ(PyrLkApplies(with, without, cv::Size(15, 15)), avx2);
+  EXPECT_FALSE(PyrLkApplies(without, with, cv::Size(15, 15)));  // OpenCV computes the derivatives itself
+  EXPECT_FALSE(PyrLkApplies(with, with, cv::Size(21, 21)));
+  EXPECT_FALSE(PyrLkApplies(with, with, cv::Size(15, 33)));
+  std::vector<cv::Mat> colour;
+  cv::Mat bgr;
+  cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
+  cv::buildOpticalFlowPyramid(bgr, colour, cv::Size(15, 15), 2);
+  EXPECT_FALSE(PyrLkApplies(colour, colour, cv::Size(15, 15)));
+}
+
+}  // namespace
+}  // namespace rovo

@@ -1,0 +1,378 @@
+#include "vo/pyr_lk.h"
+
+#include <immintrin.h>
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdlib>
+#include <opencv2/video/tracking.hpp>
+
+// AVX2 only: without FMA the compiler cannot contract a product and a sum into one rounding.
+#define ROVO_TARGET_AVX2 __attribute__((target("avx2")))
+
+namespace rovo {
+namespace {
+
+constexpr int kWindowWidth = 15;
+constexpr int kMaxRows = 32;
+constexpr int kLanes = 16;     // one AVX2 register of int16: a window row and one spare column
+constexpr int kLaneBlock = 8;  // OpenCV's float lanes cover the first 8 columns of a row
+constexpr int kWBits = 14;     // bilinear weights: 1 << kWBits in all
+constexpr float kFltScale = 1.0f / (1 << 20);
+constexpr float kMinEigThreshold = 1e-4f;  // cv::calcOpticalFlowPyrLK's default, as float
+constexpr int64_t kExactFloatLimit = int64_t{1} << 24;
+
+bool HasAvx2() {
+  static const bool has = __builtin_cpu_supports("avx2") != 0;
+  return has;
+}
+
+// cvFloor and cvRound of OpenCV 4.6 on x86-64.
+inline int FloorInt(float v) {
+  const int i = static_cast<int>(v);
+  return i - (i > v);
+}
+inline int RoundInt(float v) { return _mm_cvtss_si32(_mm_set_ss(v)); }
+
+struct Weights {
+  int w00, w01, w10, w11;
+};
+
+// OpenCV's bilinear weights for the fractions (a, b) of a position.
+inline Weights BilinearWeights(float a, float b) {
+  Weights w;
+  w.w00 = RoundInt((1.f - a) * (1.f - b) * static_cast<float>(1 << kWBits));
+  w.w01 = RoundInt(a * (1.f - b) * static_cast<float>(1 << kWBits));
+  w.w10 = RoundInt((1.f - a) * b * static_cast<float>(1 << kWBits));
+  w.w11 = (1 << kWBits) - w.w00 - w.w01 - w.w10;
+  return w;
+}
+
+// The window of the previous image at a point: intensity (x 32) and Scharr derivatives, interpolated;
+// columns kWindowWidth.. are zero.
+struct Patch {
+  alignas(32) int16_t i[kMaxRows][kLanes];
+  alignas(32) int16_t ix[kMaxRows][kLanes];
+  alignas(32) int16_t iy[kMaxRows][kLanes];
+};
+
+// The gradient matrix in OpenCV's float order (lanes: columns k and k + 4 of the first 8, in turn;
+// the rest one by one; then the lanes' sum ((l0 + l2) + (l1 + l3)) added).
+struct Gradient {
+  float a11, a12, a22;
+};
+
+// Two rows' interpolation of 16 8-bit pixels (columns 0..15 of `row0` and `row1`, and 1..15 shifted
+// in): (p00 w00 + p01 w01 + p10 w10 + p11 w11 + 2^(shift - 1)) >> shift per column, as int16.
+ROVO_TARGET_AVX2 inline __m256i InterpolateBytes(__m128i row0, __m128i row1, __m256i w0, __m256i w1, int shift) {
+  const __m256i a0 = _mm256_cvtepu8_epi16(row0), a1 = _mm256_cvtepu8_epi16(_mm_srli_si128(row0, 1));
+  const __m256i c0 = _mm256_cvtepu8_epi16(row1), c1 = _mm256_cvtepu8_epi16(_mm_srli_si128(row1, 1));
+  const __m256i rounding = _mm256_set1_epi32(1 << (shift - 1));
+  const __m128i count = _mm_cvtsi32_si128(shift);
+  // unpacklo: columns 0-3 | 8-11, unpackhi: 4-7 | 12-15; packs puts them back in order.
+  const __m256i lo = _mm256_add_epi32(_mm256_madd_epi16(_mm256_unpacklo_epi16(a0, a1), w0),
+                                      _mm256_madd_epi16(_mm256_unpacklo_epi16(c0, c1), w1));
+  const __m256i hi = _mm256_add_epi32(_mm256_madd_epi16(_mm256_unpackhi_epi16(a0, a1), w0),
+                                      _mm256_madd_epi16(_mm256_unpackhi_epi16(c0, c1), w1));
+  return _mm256_packs_epi32(_mm256_sra_epi32(_mm256_add_epi32(lo, rounding), count),
+                            _mm256_sra_epi32(_mm256_add_epi32(hi, rounding), count));
+}
+
+// The interpolated derivatives of 8 pixels: d00/d01 the (Ix, Iy) pairs of pixels k and k + 1 of the
+// upper row, d10/d11 of the lower one. Returns Ix of the 8 pixels in the low half, Iy in the high one.
+ROVO_TARGET_AVX2 inline __m256i InterpolatePairs(__m256i d00, __m256i d01, __m256i d10, __m256i d11, __m256i w0,
+                                                 __m256i w1) {
+  const __m256i rounding = _mm256_set1_epi32(1 << (kWBits - 1));
+  // unpacklo: (Ix, Iy) of pixels 0-1 | 4-5, unpackhi: 2-3 | 6-7.
+  const __m256i lo = _mm256_add_epi32(_mm256_madd_epi16(_mm256_unpacklo_epi16(d00, d01), w0),
+                                      _mm256_madd_epi16(_mm256_unpacklo_epi16(d10, d11), w1));
+  const __m256i hi = _mm256_add_epi32(_mm256_madd_epi16(_mm256_unpackhi_epi16(d00, d01), w0),
+                                      _mm256_madd_epi16(_mm256_unpackhi_epi16(d10, d11), w1));
+  const __m256i pairs = _mm256_packs_epi32(_mm256_srai_epi32(_mm256_add_epi32(lo, rounding), kWBits),
+                                           _mm256_srai_epi32(_mm256_add_epi32(hi, rounding), kWBits));
+  // (Ix0 Iy0 .. Ix3 Iy3 | Ix4 Iy4 .. Ix7 Iy7) -> (Ix0..Ix3 Iy0..Iy3 | Ix4..Ix7 Iy4..Iy7) -> Ix0..7 | Iy0..7.
+  const __m256i split = _mm256_shuffle_epi8(
+      pairs, _mm256_setr_epi8(0, 1, 4, 5, 8, 9, 12, 13, 2, 3, 6, 7, 10, 11, 14, 15, 0, 1, 4, 5, 8, 9, 12, 13, 2, 3,
+                              6, 7, 10, 11, 14, 15));
+  return _mm256_permute4x64_epi64(split, _MM_SHUFFLE(3, 1, 2, 0));
+}
+
+ROVO_TARGET_AVX2 inline __m256i PairWeights(int a, int b) {
+  return _mm256_set1_epi32(static_cast<int>((static_cast<uint32_t>(a) & 0xffffu) | (static_cast<uint32_t>(b) << 16)));
+}
+
+// 8 (Ix, Iy) pairs; Load7 leaves the 8th unread (zero).
+ROVO_TARGET_AVX2 inline __m256i Load(const int16_t* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); }
+ROVO_TARGET_AVX2 inline __m256i Load7(const int16_t* p) {
+  return _mm256_maskload_epi32(reinterpret_cast<const int*>(p), _mm256_setr_epi32(-1, -1, -1, -1, -1, -1, -1, 0));
+}
+
+// Extracts the patch whose top-left pixel is `corner` and sums its gradient matrix. Reads what OpenCV
+// reads: columns 0..15 and rows 0..rows of the window (the last pixel pair through a masked load).
+ROVO_TARGET_AVX2 Gradient ExtractPatch(const cv::Mat& image, const cv::Mat& deriv, cv::Point corner, const Weights& w,
+                                       int rows, Patch* patch) {
+  const size_t step_i = image.step[0];
+  const size_t step_d = deriv.step[0] / sizeof(int16_t);
+  const __m256i w0 = PairWeights(w.w00, w.w01), w1 = PairWeights(w.w10, w.w11);
+  const __m256i window_columns = _mm256_setr_epi16(-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0);
+  __m128 lane11 = _mm_setzero_ps(), lane12 = _mm_setzero_ps(), lane22 = _mm_setzero_ps();
+  alignas(32) int32_t tail_xx[kMaxRows][kLaneBlock], tail_xy[kMaxRows][kLaneBlock], tail_yy[kMaxRows][kLaneBlock];
+  for (int y = 0; y < rows; ++y) {
+    const uint8_t* src = image.ptr<uint8_t>(corner.y + y) + corner.x;
+    const __m128i row0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(src));
+    const __m128i row1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(src + step_i));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(patch->i[y]), InterpolateBytes(row0, row1, w0, w1, kWBits - 5));
+
+    const int16_t* d = deriv.ptr<int16_t>(corner.y + y) + 2 * corner.x;
+    const int16_t* e = d + step_d;
+    const __m256i g0 = InterpolatePairs(Load(d), Load(d + 2), Load(e), Load(e + 2), w0, w1);
+    const __m256i g1 = InterpolatePairs(Load(d + 16), Load7(d + 18), Load(e + 16), Load7(e + 18), w0, w1);
+    const __m256i ix = _mm256_and_si256(_mm256_permute2x128_si256(g0, g1, 0x20), window_columns);
+    const __m256i iy = _mm256_and_si256(_mm256_permute2x128_si256(g0, g1, 0x31), window_columns);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(patch->ix[y]), ix);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(patch->iy[y]), iy);
+
+    // OpenCV's lanes: columns 0-3, then 4-7 (product, then sum: two roundings, no FMA).
+    const __m128i ix07 = _mm256_castsi256_si128(ix), iy07 = _mm256_castsi256_si128(iy);
+    for (const int half : {0, 1}) {
+      const __m128i sx = half == 0 ? ix07 : _mm_srli_si128(ix07, 8), sy = half == 0 ? iy07 : _mm_srli_si128(iy07, 8);
+      const __m128 fx = _mm_cvtepi32_ps(_mm_cvtepi16_epi32(sx)), fy = _mm_cvtepi32_ps(_mm_cvtepi16_epi32(sy));
+      lane22 = _mm_add_ps(_mm_mul_ps(fy, fy), lane22);
+      lane12 = _mm_add_ps(_mm_mul_ps(fx, fy), lane12);
+      lane11 = _mm_add_ps(_mm_mul_ps(fx, fx), lane11);
+    }
+    // Columns 8..15 (15 is zero) as exact int32 products, added one by one below.
+    const __m256i tx = _mm256_cvtepi16_epi32(_mm256_extracti128_si256(ix, 1));
+    const __m256i ty = _mm256_cvtepi16_epi32(_mm256_extracti128_si256(iy, 1));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(tail_xx[y]), _mm256_mullo_epi32(tx, tx));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(tail_xy[y]), _mm256_mullo_epi32(tx, ty));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(tail_yy[y]), _mm256_mullo_epi32(ty, ty));
+  }
+  float a11 = 0, a12 = 0, a22 = 0;
+  for (int y = 0; y < rows; ++y) {
+    for (int k = 0; k < kWindowWidth - kLaneBlock; ++k) {
+      a11 += static_cast<float>(tail_xx[y][k]);
+      a12 += static_cast<float>(tail_xy[y][k]);
+      a22 += static_cast<float>(tail_yy[y][k]);
+    }
+  }
+  alignas(16) float l11[4], l12[4], l22[4];
+  _mm_store_ps(l11, lane11);
+  _mm_store_ps(l12, lane12);
+  _mm_store_ps(l22, lane22);
+  a11 += (l11[0] + l11[2]) + (l11[1] + l11[3]);
+  a12 += (l12[0] + l12[2]) + (l12[1] + l12[3]);
+  a22 += (l22[0] + l22[2]) + (l22[1] + l22[3]);
+  return {a11 * kFltScale, a12 * kFltScale, a22 * kFltScale};
+}
+
+// The sum of the one-by-one columns (8..14) of `rows` rows, added in OpenCV's order (row by row, column
+// by column) from `terms`, or, where their magnitudes (per-lane int32 sums in abs_sum) sum below 2^24, as
+// the exact integer sum of the per-lane sums in `sum`: then every partial sum is exact in float.
+ROVO_TARGET_AVX2 float OneByOneSum(__m256i abs_sum, __m256i sum, const float (*terms)[kLaneBlock], int rows) {
+  alignas(32) int32_t a[8], s[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(a), abs_sum);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(s), sum);
+  int64_t total_abs = 0, total = 0;
+  for (int k = 0; k < 8; ++k) {
+    total_abs += a[k];
+    total += s[k];
+  }
+  if (total_abs < kExactFloatLimit) return static_cast<float>(total);
+  float acc = 0.0f;
+  for (int y = 0; y < rows; ++y)
+    for (int k = 0; k < kWindowWidth - kLaneBlock; ++k) acc += terms[y][k];
+  return acc;
+}
+
+// The mismatch vector (b1, b2) of the patch against the moving image whose window's top-left pixel is
+// `j` (interpolated with w), in OpenCV's float order (see Gradient; in the lanes the integer sum of
+// columns k and k + 4 is converted and added).
+ROVO_TARGET_AVX2 void Mismatch(const Patch& patch, const uint8_t* j, size_t step_j, const Weights& w, int rows,
+                               float* b1, float* b2) {
+  const __m256i w0 = PairWeights(w.w00, w.w01), w1 = PairWeights(w.w10, w.w11);
+  __m128 lanes_x = _mm_setzero_ps(), lanes_y = _mm_setzero_ps();
+  __m256i abs_x = _mm256_setzero_si256(), abs_y = _mm256_setzero_si256();
+  __m256i sum_x = _mm256_setzero_si256(), sum_y = _mm256_setzero_si256();
+  alignas(32) float tail_x[kMaxRows][kLaneBlock], tail_y[kMaxRows][kLaneBlock];
+  for (int y = 0; y < rows; ++y, j += step_j) {
+    const __m128i row0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(j));
+    const __m128i row1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(j + step_j));
+    const __m256i diff = _mm256_subs_epi16(InterpolateBytes(row0, row1, w0, w1, kWBits - 5),
+                                           _mm256_load_si256(reinterpret_cast<const __m256i*>(patch.i[y])));
+    // Products with the derivatives as int32: (a) columns 0-3 | 8-11, (b) 4-7 | 12-15.
+    const __m256i ix = _mm256_load_si256(reinterpret_cast<const __m256i*>(patch.ix[y]));
+    const __m256i iy = _mm256_load_si256(reinterpret_cast<const __m256i*>(patch.iy[y]));
+    const __m256i px_lo = _mm256_mullo_epi16(diff, ix), px_hi = _mm256_mulhi_epi16(diff, ix);
+    const __m256i py_lo = _mm256_mullo_epi16(diff, iy), py_hi = _mm256_mulhi_epi16(diff, iy);
+    const __m256i px_a = _mm256_unpacklo_epi16(px_lo, px_hi), px_b = _mm256_unpackhi_epi16(px_lo, px_hi);
+    const __m256i py_a = _mm256_unpacklo_epi16(py_lo, py_hi), py_b = _mm256_unpackhi_epi16(py_lo, py_hi);
+    lanes_x = _mm_add_ps(lanes_x, _mm_cvtepi32_ps(_mm_add_epi32(_mm256_castsi256_si128(px_a),
+                                                                 _mm256_castsi256_si128(px_b))));
+    lanes_y = _mm_add_ps(lanes_y, _mm_cvtepi32_ps(_mm_add_epi32(_mm256_castsi256_si128(py_a),
+                                                                 _mm256_castsi256_si128(py_b))));
+    // Columns 8..15 in order (15 is zero: the patch's derivatives are zero there).
+    const __m256i tx = _mm256_permute2x128_si256(px_a, px_b, 0x31);
+    const __m256i ty = _mm256_permute2x128_si256(py_a, py_b, 0x31);
+    _mm256_store_ps(tail_x[y], _mm256_cvtepi32_ps(tx));
+    _mm256_store_ps(tail_y[y], _mm256_cvtepi32_ps(ty));
+    abs_x = _mm256_add_epi32(abs_x, _mm256_abs_epi32(tx));
+    abs_y = _mm256_add_epi32(abs_y, _mm256_abs_epi32(ty));
+    sum_x = _mm256_add_epi32(sum_x, tx);
+    sum_y = _mm256_add_epi32(sum_y, ty);
+  }
+  alignas(16) float lx[4], ly[4];
+  _mm_store_ps(lx, lanes_x);
+  _mm_store_ps(ly, lanes_y);
+  // OpenCV pairs lanes 0 and 2, 1 and 3 of each of b1 and b2 before adding the pairs.
+  *b1 = OneByOneSum(abs_x, sum_x, tail_x, rows) + ((lx[0] + lx[2]) + (lx[1] + lx[3]));
+  *b2 = OneByOneSum(abs_y, sum_y, tail_y, rows) + ((ly[0] + ly[2]) + (ly[1] + ly[3]));
+}
+
+// Requests the cache lines of a window's rows: `bytes` bytes from column `corner.x` (of `bytes_per_pixel`)
+// in rows corner.y .. corner.y + rows, where the corner passes LK's bounds check.
+void PrefetchWindow(const cv::Mat& m, cv::Point corner, int rows, int bytes_per_pixel, int bytes) {
+  if (corner.x < -kWindowWidth || corner.x >= m.cols || corner.y < -rows || corner.y >= m.rows) return;
+  for (int y = 0; y <= rows; ++y) {
+    const char* p = m.ptr<char>(corner.y + y) + static_cast<ptrdiff_t>(corner.x) * bytes_per_pixel;
+    _mm_prefetch(p, _MM_HINT_T0);
+    _mm_prefetch(p + bytes - 1, _MM_HINT_T0);
+  }
+}
+
+struct Level {
+  const cv::Mat* image;  // previous image
+  const cv::Mat* deriv;  // its derivatives
+  const cv::Mat* next;   // moving image
+};
+
+struct Settings {
+  cv::Size window;
+  int max_count;
+  double epsilon2;  // squared
+  bool initial_flow;
+};
+
+// One point at one level (LKTrackerInvoker::operator() for one point); `next` is the point's state.
+void TrackAtLevel(const Level& lv, const Settings& s, int level, int max_level, cv::Point2f from, cv::Point2f* next,
+                  uint8_t* status, Patch* patch) {
+  const cv::Point2f half_win((s.window.width - 1) * 0.5f, (s.window.height - 1) * 0.5f);
+  cv::Point2f prev_pt = from * static_cast<float>(1. / (1 << level));
+  cv::Point2f next_pt;
+  if (level == max_level)
+    next_pt = s.initial_flow ? *next * static_cast<float>(1. / (1 << level)) : prev_pt;
+  else
+    next_pt = *next * 2.f;
+  *next = next_pt;
+
+  prev_pt -= half_win;
+  const cv::Point iprev(FloorInt(prev_pt.x), FloorInt(prev_pt.y));
+  if (iprev.x < -s.window.width || iprev.x >= lv.deriv->cols || iprev.y < -s.window.height ||
+      iprev.y >= lv.deriv->rows) {
+    if (level == 0) *status = 0;
+    return;
+  }
+  const cv::Point guess(FloorInt(next_pt.x - half_win.x), FloorInt(next_pt.y - half_win.y));
+  PrefetchWindow(*lv.next, guess, s.window.height, 1, kLanes);
+  const Gradient g = ExtractPatch(*lv.image, *lv.deriv, iprev,
+                                  BilinearWeights(prev_pt.x - iprev.x, prev_pt.y - iprev.y), s.window.height, patch);
+  float d = g.a11 * g.a22 - g.a12 * g.a12;
+  const float min_eig = (g.a22 + g.a11 - std::sqrt((g.a11 - g.a22) * (g.a11 - g.a22) + 4.f * g.a12 * g.a12)) /
+                        static_cast<float>(2 * s.window.width * s.window.height);
+  if (min_eig < kMinEigThreshold || d < FLT_EPSILON) {
+    if (level == 0) *status = 0;
+    return;
+  }
+  d = 1.f / d;
+
+  const cv::Mat& next_image = *lv.next;
+  next_pt -= half_win;
+  cv::Point2f prev_delta;
+  for (int it = 0; it < s.max_count; ++it) {
+    const cv::Point inext(FloorInt(next_pt.x), FloorInt(next_pt.y));
+    if (inext.x < -s.window.width || inext.x >= next_image.cols || inext.y < -s.window.height ||
+        inext.y >= next_image.rows) {
+      if (level == 0) *status = 0;
+      break;
+    }
+    float b1, b2;
+    Mismatch(*patch, next_image.ptr<uint8_t>(inext.y) + inext.x, next_image.step[0],
+             BilinearWeights(next_pt.x - inext.x, next_pt.y - inext.y), s.window.height, &b1, &b2);
+    b1 *= kFltScale;
+    b2 *= kFltScale;
+    const cv::Point2f delta((g.a12 * b2 - g.a22 * b1) * d, (g.a12 * b1 - g.a11 * b2) * d);
+    next_pt += delta;
+    *next = next_pt + half_win;
+    if (delta.ddot(delta) <= s.epsilon2) break;
+    if (it > 0 && std::abs(delta.x + prev_delta.x) < 0.01 && std::abs(delta.y + prev_delta.y) < 0.01) {
+      *next -= delta * 0.5f;
+      break;
+    }
+    prev_delta = delta;
+  }
+}
+
+// Levels of a pyramid as cv::calcOpticalFlowPyrLK reads it: the step between images (2 with
+// derivatives) and the number of levels above the base.
+struct PyramidShape {
+  int step = 1, levels = -1;
+};
+
+PyramidShape ShapeOf(const std::vector<cv::Mat>& pyramid) {
+  PyramidShape shape;
+  if (pyramid.empty()) return shape;
+  shape.levels = static_cast<int>(pyramid.size()) - 1;
+  if (shape.levels % 2 == 1 && pyramid[0].channels() * 2 == pyramid[1].channels() && pyramid[1].depth() == CV_16S) {
+    shape.step = 2;
+    shape.levels /= 2;
+  }
+  return shape;
+}
+
+}  // namespace
+
+bool PyrLkApplies(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
+                  cv::Size window) {
+  if (!HasAvx2() || window.width != kWindowWidth || window.height < 3 || window.height > kMaxRows) return false;
+  const PyramidShape from = ShapeOf(from_pyramid), to = ShapeOf(to_pyramid);
+  if (from.step != 2 || to.levels < 0) return false;
+  for (int l = 0; l <= std::min(from.levels, to.levels); ++l) {
+    const cv::Mat& i = from_pyramid[2 * l];
+    const cv::Mat& d = from_pyramid[2 * l + 1];
+    const cv::Mat& j = to_pyramid[to.step * l];
+    if (i.type() != CV_8UC1 || d.type() != CV_16SC2 || j.type() != CV_8UC1 || i.size() != j.size() ||
+        d.size() != i.size())
+      return false;
+  }
+  return true;
+}
+
+void PyrLk(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid, const cv::Point2f* from,
+           cv::Point2f* to, uint8_t* status, int n, cv::Size window, int max_level, const cv::TermCriteria& criteria,
+           int flags) {
+  const PyramidShape from_shape = ShapeOf(from_pyramid), to_shape = ShapeOf(to_pyramid);
+  max_level = std::min({max_level, from_shape.levels, to_shape.levels});
+  Settings s;
+  s.window = window;
+  s.initial_flow = (flags & cv::OPTFLOW_USE_INITIAL_FLOW) != 0;
+  s.max_count = (criteria.type & cv::TermCriteria::COUNT) == 0 ? 30 : std::min(std::max(criteria.maxCount, 0), 100);
+  const double eps = (criteria.type & cv::TermCriteria::EPS) == 0 ? 0.01 : std::min(std::max(criteria.epsilon, 0.), 10.);
+  s.epsilon2 = eps * eps;
+  std::vector<Level> levels(max_level + 1);
+  for (int l = 0; l <= max_level; ++l)
+    levels[l] = {&from_pyramid[2 * l], &from_pyramid[2 * l + 1], &to_pyramid[to_shape.step * l]};
+  Patch patch;
+  const cv::Point2f half_win((window.width - 1) * 0.5f, (window.height - 1) * 0.5f);
+  for (int k = 0; k < n; ++k) {
+    if (k + 1 < n) {  // the next point's base-level window, while this one is tracked
+      const cv::Point corner(FloorInt(from[k + 1].x - half_win.x), FloorInt(from[k + 1].y - half_win.y));
+      PrefetchWindow(*levels[0].image, corner, window.height, 1, kLanes);
+      PrefetchWindow(*levels[0].deriv, corner, window.height, 4, 4 * kLanes);
+    }
+    status[k] = 1;
+    for (int l = max_level; l >= 0; --l) TrackAtLevel(levels[l], s, l, max_level, from[k], &to[k], &status[k], &patch);
+  }
+}
+
+}  // namespace rovo

@@ -1,0 +1,33 @@
+#pragma once
+// Pyramidal Lucas-Kanade tracking with the results of cv::calcOpticalFlowPyrLK (OpenCV 4.6, x86-64)
+// bit for bit, its inner loop in AVX2.
+//
+// OpenCV's arithmetic (modules/video/src/lkpyramid.cpp, built for SSE2): bilinear weights rounded to
+// 14 bits; the patch, its Scharr derivatives and the moving image interpolated in integers; the
+// gradient matrix and the mismatch vector summed in float, the first 8 columns of each window row in
+// four float lanes and the other columns one by one. Integer sums do not depend on their order, float
+// sums do. Here the integers of a whole 15-pixel row are computed at once, and the floats are added in
+// OpenCV's order, except where the magnitudes of the one-by-one terms sum to less than 2^24: then every
+// partial sum is an exact integer and the order cannot change it. Points and statuses equal OpenCV's
+// for any input (unit tests PyrLk.*), so tracks do not change.
+
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <vector>
+
+namespace rovo {
+
+// Whether PyrLk serves these arguments: the CPU has AVX2, the window is 15 pixels wide and 3 to 32
+// high, and both pyramids come from cv::buildOpticalFlowPyramid of 8-bit gray images, `from_pyramid`
+// with its derivatives (withDerivatives = true).
+bool PyrLkApplies(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
+                  cv::Size window);
+
+// cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, from[0, n), to[0, n), status[0, n), cv::noArray(),
+// window, max_level, criteria, flags) with the default minimum eigenvalue (1e-4), where PyrLkApplies.
+// With cv::OPTFLOW_USE_INITIAL_FLOW in flags, `to` holds the starts.
+void PyrLk(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid, const cv::Point2f* from,
+           cv::Point2f* to, uint8_t* status, int n, cv::Size window, int max_level, const cv::TermCriteria& criteria,
+           int flags);
+
+}  // namespace rovo
