@@ -51,10 +51,14 @@ inline Weights BilinearWeights(float a, float b) {
 
 // The window of the previous image at a point: intensity (x 32) and Scharr derivatives, interpolated;
 // columns kWindowWidth.. are zero.
+// The derivatives are stored for Mismatch's pairwise products (_mm256_madd_epi16 against the
+// mismatch shuffled by kPairColumns): per row, x and y, (D0 D4 D1 D5 D2 D6 D3 D7 | D8 0 D9 0 D10 0 D11 0),
+// and (Dx12 0 Dx13 0 Dx14 0 0 0 | Dy12 0 Dy13 0 Dy14 0 0 0).
 struct Patch {
   alignas(32) int16_t i[kMaxRows][kLanes];
-  alignas(32) int16_t ix[kMaxRows][kLanes];
-  alignas(32) int16_t iy[kMaxRows][kLanes];
+  alignas(32) int16_t x_pairs[kMaxRows][kLanes];
+  alignas(32) int16_t y_pairs[kMaxRows][kLanes];
+  alignas(32) int16_t xy_last[kMaxRows][kLanes];
 };
 
 // The gradient matrix in OpenCV's float order (lanes: columns k and k + 4 of the first 8, in turn;
@@ -102,6 +106,17 @@ ROVO_TARGET_AVX2 inline __m256i PairWeights(int a, int b) {
   return _mm256_set1_epi32(static_cast<int>((static_cast<uint32_t>(a) & 0xffffu) | (static_cast<uint32_t>(b) << 16)));
 }
 
+// In-lane shuffles of 16 int16 columns: kPairColumns gives (c0 c4 c1 c5 c2 c6 c3 c7 | c8 0 c9 0 c10 0 c11 0),
+// kLastColumns (c12 0 c13 0 c14 0 c15 0) from the upper lane of each lane.
+ROVO_TARGET_AVX2 inline __m256i PairColumns(__m256i v) {
+  return _mm256_shuffle_epi8(v, _mm256_setr_epi8(0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15, 0, 1, -1, -1, 2,
+                                                 3, -1, -1, 4, 5, -1, -1, 6, 7, -1, -1));
+}
+ROVO_TARGET_AVX2 inline __m256i LastColumns(__m256i v) {
+  return _mm256_shuffle_epi8(v, _mm256_setr_epi8(8, 9, -1, -1, 10, 11, -1, -1, 12, 13, -1, -1, 14, 15, -1, -1, 8, 9,
+                                                 -1, -1, 10, 11, -1, -1, 12, 13, -1, -1, 14, 15, -1, -1));
+}
+
 // 8 (Ix, Iy) pairs; Load7 leaves the 8th unread (zero).
 ROVO_TARGET_AVX2 inline __m256i Load(const int16_t* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); }
 ROVO_TARGET_AVX2 inline __m256i Load7(const int16_t* p) {
@@ -130,8 +145,10 @@ ROVO_TARGET_AVX2 Gradient ExtractPatch(const cv::Mat& image, const cv::Mat& deri
     const __m256i g1 = InterpolatePairs(Load(d + 16), Load7(d + 18), Load(e + 16), Load7(e + 18), w0, w1);
     const __m256i ix = _mm256_and_si256(_mm256_permute2x128_si256(g0, g1, 0x20), window_columns);
     const __m256i iy = _mm256_and_si256(_mm256_permute2x128_si256(g0, g1, 0x31), window_columns);
-    _mm256_store_si256(reinterpret_cast<__m256i*>(patch->ix[y]), ix);
-    _mm256_store_si256(reinterpret_cast<__m256i*>(patch->iy[y]), iy);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(patch->x_pairs[y]), PairColumns(ix));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(patch->y_pairs[y]), PairColumns(iy));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(patch->xy_last[y]),
+                       LastColumns(_mm256_permute2x128_si256(ix, iy, 0x31)));
 
     // OpenCV's lanes: columns 0-3, then 4-7 (product, then sum: two roundings, no FMA).
     const __m128i ix07 = _mm256_castsi256_si128(ix), iy07 = _mm256_castsi256_si128(iy);
@@ -186,35 +203,52 @@ ROVO_TARGET_AVX2 float OneByOneSum(__m256i abs_sum, __m256i sum, const float (*t
   return acc;
 }
 
+// The (column k, column k + 1) pairs of 16 8-bit pixels of a row (the 16th pixel's partner is zero) as
+// int16: columns 0-3 | 8-11 in *lo, 4-7 | 12-15 in *hi (the order of _mm256_madd_epi16's sums).
+ROVO_TARGET_AVX2 inline void RowPairs(const uint8_t* row, __m256i* lo, __m256i* hi) {
+  const __m128i bytes = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row));
+  const __m256i a0 = _mm256_cvtepu8_epi16(bytes), a1 = _mm256_cvtepu8_epi16(_mm_srli_si128(bytes, 1));
+  *lo = _mm256_unpacklo_epi16(a0, a1);
+  *hi = _mm256_unpackhi_epi16(a0, a1);
+}
+
 // The mismatch vector (b1, b2) of the patch against the moving image whose window's top-left pixel is
 // `j` (interpolated with w), in OpenCV's float order (see Gradient; in the lanes the integer sum of
 // columns k and k + 4 is converted and added).
 ROVO_TARGET_AVX2 void Mismatch(const Patch& patch, const uint8_t* j, size_t step_j, const Weights& w, int rows,
                                float* b1, float* b2) {
   const __m256i w0 = PairWeights(w.w00, w.w01), w1 = PairWeights(w.w10, w.w11);
+  const __m256i rounding = _mm256_set1_epi32(1 << (kWBits - 5 - 1));
   __m128 lanes_x = _mm_setzero_ps(), lanes_y = _mm_setzero_ps();
   __m256i abs_x = _mm256_setzero_si256(), abs_y = _mm256_setzero_si256();
   __m256i sum_x = _mm256_setzero_si256(), sum_y = _mm256_setzero_si256();
   alignas(32) float tail_x[kMaxRows][kLaneBlock], tail_y[kMaxRows][kLaneBlock];
-  for (int y = 0; y < rows; ++y, j += step_j) {
-    const __m128i row0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(j));
-    const __m128i row1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(j + step_j));
-    const __m256i diff = _mm256_subs_epi16(InterpolateBytes(row0, row1, w0, w1, kWBits - 5),
-                                           _mm256_load_si256(reinterpret_cast<const __m256i*>(patch.i[y])));
-    // Products with the derivatives as int32: (a) columns 0-3 | 8-11, (b) 4-7 | 12-15.
-    const __m256i ix = _mm256_load_si256(reinterpret_cast<const __m256i*>(patch.ix[y]));
-    const __m256i iy = _mm256_load_si256(reinterpret_cast<const __m256i*>(patch.iy[y]));
-    const __m256i px_lo = _mm256_mullo_epi16(diff, ix), px_hi = _mm256_mulhi_epi16(diff, ix);
-    const __m256i py_lo = _mm256_mullo_epi16(diff, iy), py_hi = _mm256_mulhi_epi16(diff, iy);
-    const __m256i px_a = _mm256_unpacklo_epi16(px_lo, px_hi), px_b = _mm256_unpackhi_epi16(px_lo, px_hi);
-    const __m256i py_a = _mm256_unpacklo_epi16(py_lo, py_hi), py_b = _mm256_unpackhi_epi16(py_lo, py_hi);
-    lanes_x = _mm_add_ps(lanes_x, _mm_cvtepi32_ps(_mm_add_epi32(_mm256_castsi256_si128(px_a),
-                                                                 _mm256_castsi256_si128(px_b))));
-    lanes_y = _mm_add_ps(lanes_y, _mm_cvtepi32_ps(_mm_add_epi32(_mm256_castsi256_si128(py_a),
-                                                                 _mm256_castsi256_si128(py_b))));
+  // Each image row's (column k, k + 1) pairs serve as the lower row of one window row and the upper of the next.
+  __m256i upper_lo, upper_hi;
+  RowPairs(j, &upper_lo, &upper_hi);
+  for (int y = 0; y < rows; ++y) {
+    j += step_j;
+    __m256i lower_lo, lower_hi;
+    RowPairs(j, &lower_lo, &lower_hi);
+    const __m256i lo = _mm256_add_epi32(_mm256_add_epi32(_mm256_madd_epi16(upper_lo, w0), _mm256_madd_epi16(lower_lo, w1)),
+                                        rounding);
+    const __m256i hi = _mm256_add_epi32(_mm256_add_epi32(_mm256_madd_epi16(upper_hi, w0), _mm256_madd_epi16(lower_hi, w1)),
+                                        rounding);
+    upper_lo = lower_lo;
+    upper_hi = lower_hi;
+    const __m256i diff = _mm256_subs_epi16(
+        _mm256_packs_epi32(_mm256_srai_epi32(lo, kWBits - 5), _mm256_srai_epi32(hi, kWBits - 5)),
+        _mm256_load_si256(reinterpret_cast<const __m256i*>(patch.i[y])));
+    // Products with the derivatives: (k, k + 4) pairs of columns 0-7 | single columns 8-11, and 12-14 | 12-14.
+    const __m256i pairs = PairColumns(diff), last = LastColumns(_mm256_permute2x128_si256(diff, diff, 0x11));
+    const __m256i px = _mm256_madd_epi16(pairs, _mm256_load_si256(reinterpret_cast<const __m256i*>(patch.x_pairs[y])));
+    const __m256i py = _mm256_madd_epi16(pairs, _mm256_load_si256(reinterpret_cast<const __m256i*>(patch.y_pairs[y])));
+    const __m256i pl = _mm256_madd_epi16(last, _mm256_load_si256(reinterpret_cast<const __m256i*>(patch.xy_last[y])));
+    lanes_x = _mm_add_ps(lanes_x, _mm_cvtepi32_ps(_mm256_castsi256_si128(px)));
+    lanes_y = _mm_add_ps(lanes_y, _mm_cvtepi32_ps(_mm256_castsi256_si128(py)));
     // Columns 8..15 in order (15 is zero: the patch's derivatives are zero there).
-    const __m256i tx = _mm256_permute2x128_si256(px_a, px_b, 0x31);
-    const __m256i ty = _mm256_permute2x128_si256(py_a, py_b, 0x31);
+    const __m256i tx = _mm256_permute2x128_si256(px, pl, 0x21);
+    const __m256i ty = _mm256_permute2x128_si256(py, pl, 0x31);
     _mm256_store_ps(tail_x[y], _mm256_cvtepi32_ps(tx));
     _mm256_store_ps(tail_y[y], _mm256_cvtepi32_ps(ty));
     abs_x = _mm256_add_epi32(abs_x, _mm256_abs_epi32(tx));
