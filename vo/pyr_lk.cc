@@ -264,17 +264,6 @@ ROVO_TARGET_AVX2 void Mismatch(const Patch& patch, const uint8_t* j, size_t step
   *b2 = OneByOneSum(abs_y, sum_y, tail_y, rows) + ((ly[0] + ly[2]) + (ly[1] + ly[3]));
 }
 
-// Requests the cache lines of a window's rows: `bytes` bytes from column `corner.x` (of `bytes_per_pixel`)
-// in rows corner.y .. corner.y + rows, where the corner passes LK's bounds check.
-void PrefetchWindow(const cv::Mat& m, cv::Point corner, int rows, int bytes_per_pixel, int bytes) {
-  if (corner.x < -kWindowWidth || corner.x >= m.cols || corner.y < -rows || corner.y >= m.rows) return;
-  for (int y = 0; y <= rows; ++y) {
-    const char* p = m.ptr<char>(corner.y + y) + static_cast<ptrdiff_t>(corner.x) * bytes_per_pixel;
-    _mm_prefetch(p, _MM_HINT_T0);
-    _mm_prefetch(p + bytes - 1, _MM_HINT_T0);
-  }
-}
-
 struct Level {
   const cv::Mat* image;  // previous image
   const cv::Mat* deriv;  // its derivatives
@@ -307,8 +296,6 @@ void TrackAtLevel(const Level& lv, const Settings& s, int level, int max_level, 
     if (level == 0) *status = 0;
     return;
   }
-  const cv::Point guess(FloorInt(next_pt.x - half_win.x), FloorInt(next_pt.y - half_win.y));
-  PrefetchWindow(*lv.next, guess, s.window.height, 1, kLanes);
   const Gradient g = ExtractPatch(*lv.image, *lv.deriv, iprev,
                                   BilinearWeights(prev_pt.x - iprev.x, prev_pt.y - iprev.y), s.window.height, patch);
   float d = g.a11 * g.a22 - g.a12 * g.a12;
@@ -397,13 +384,7 @@ void PyrLk(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>&
   for (int l = 0; l <= max_level; ++l)
     levels[l] = {&from_pyramid[2 * l], &from_pyramid[2 * l + 1], &to_pyramid[to_shape.step * l]};
   Patch patch;
-  const cv::Point2f half_win((window.width - 1) * 0.5f, (window.height - 1) * 0.5f);
   for (int k = 0; k < n; ++k) {
-    if (k + 1 < n) {  // the next point's base-level window, while this one is tracked
-      const cv::Point corner(FloorInt(from[k + 1].x - half_win.x), FloorInt(from[k + 1].y - half_win.y));
-      PrefetchWindow(*levels[0].image, corner, window.height, 1, kLanes);
-      PrefetchWindow(*levels[0].deriv, corner, window.height, 4, 4 * kLanes);
-    }
     status[k] = 1;
     for (int l = max_level; l >= 0; --l) TrackAtLevel(levels[l], s, l, max_level, from[k], &to[k], &status[k], &patch);
   }
