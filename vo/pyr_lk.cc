@@ -96,9 +96,9 @@ ROVO_TARGET_AVX2 inline __m256i InterpolatePairs(__m256i d00, __m256i d01, __m25
   const __m256i pairs = _mm256_packs_epi32(_mm256_srai_epi32(_mm256_add_epi32(lo, rounding), kWBits),
                                            _mm256_srai_epi32(_mm256_add_epi32(hi, rounding), kWBits));
   // (Ix0 Iy0 .. Ix3 Iy3 | Ix4 Iy4 .. Ix7 Iy7) -> (Ix0..Ix3 Iy0..Iy3 | Ix4..Ix7 Iy4..Iy7) -> Ix0..7 | Iy0..7.
-  const __m256i split = _mm256_shuffle_epi8(
-      pairs, _mm256_setr_epi8(0, 1, 4, 5, 8, 9, 12, 13, 2, 3, 6, 7, 10, 11, 14, 15, 0, 1, 4, 5, 8, 9, 12, 13, 2, 3,
-                              6, 7, 10, 11, 14, 15));
+  const __m256i split =
+      _mm256_shuffle_epi8(pairs, _mm256_setr_epi8(0, 1, 4, 5, 8, 9, 12, 13, 2, 3, 6, 7, 10, 11, 14, 15, 0, 1, 4, 5, 8,
+                                                  9, 12, 13, 2, 3, 6, 7, 10, 11, 14, 15));
   return _mm256_permute4x64_epi64(split, _MM_SHUFFLE(3, 1, 2, 0));
 }
 
@@ -113,12 +113,14 @@ ROVO_TARGET_AVX2 inline __m256i PairColumns(__m256i v) {
                                                  3, -1, -1, 4, 5, -1, -1, 6, 7, -1, -1));
 }
 ROVO_TARGET_AVX2 inline __m256i LastColumns(__m256i v) {
-  return _mm256_shuffle_epi8(v, _mm256_setr_epi8(8, 9, -1, -1, 10, 11, -1, -1, 12, 13, -1, -1, 14, 15, -1, -1, 8, 9,
-                                                 -1, -1, 10, 11, -1, -1, 12, 13, -1, -1, 14, 15, -1, -1));
+  return _mm256_shuffle_epi8(v, _mm256_setr_epi8(8, 9, -1, -1, 10, 11, -1, -1, 12, 13, -1, -1, 14, 15, -1, -1, 8, 9, -1,
+                                                 -1, 10, 11, -1, -1, 12, 13, -1, -1, 14, 15, -1, -1));
 }
 
 // 8 (Ix, Iy) pairs; Load7 leaves the 8th unread (zero).
-ROVO_TARGET_AVX2 inline __m256i Load(const int16_t* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); }
+ROVO_TARGET_AVX2 inline __m256i Load(const int16_t* p) {
+  return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p));
+}
 ROVO_TARGET_AVX2 inline __m256i Load7(const int16_t* p) {
   return _mm256_maskload_epi32(reinterpret_cast<const int*>(p), _mm256_setr_epi32(-1, -1, -1, -1, -1, -1, -1, 0));
 }
@@ -230,15 +232,15 @@ ROVO_TARGET_AVX2 void Mismatch(const Patch& patch, const uint8_t* j, size_t step
     j += step_j;
     __m256i lower_lo, lower_hi;
     RowPairs(j, &lower_lo, &lower_hi);
-    const __m256i lo = _mm256_add_epi32(_mm256_add_epi32(_mm256_madd_epi16(upper_lo, w0), _mm256_madd_epi16(lower_lo, w1)),
-                                        rounding);
-    const __m256i hi = _mm256_add_epi32(_mm256_add_epi32(_mm256_madd_epi16(upper_hi, w0), _mm256_madd_epi16(lower_hi, w1)),
-                                        rounding);
+    const __m256i lo =
+        _mm256_add_epi32(_mm256_add_epi32(_mm256_madd_epi16(upper_lo, w0), _mm256_madd_epi16(lower_lo, w1)), rounding);
+    const __m256i hi =
+        _mm256_add_epi32(_mm256_add_epi32(_mm256_madd_epi16(upper_hi, w0), _mm256_madd_epi16(lower_hi, w1)), rounding);
     upper_lo = lower_lo;
     upper_hi = lower_hi;
-    const __m256i diff = _mm256_subs_epi16(
-        _mm256_packs_epi32(_mm256_srai_epi32(lo, kWBits - 5), _mm256_srai_epi32(hi, kWBits - 5)),
-        _mm256_load_si256(reinterpret_cast<const __m256i*>(patch.i[y])));
+    const __m256i diff =
+        _mm256_subs_epi16(_mm256_packs_epi32(_mm256_srai_epi32(lo, kWBits - 5), _mm256_srai_epi32(hi, kWBits - 5)),
+                          _mm256_load_si256(reinterpret_cast<const __m256i*>(patch.i[y])));
     // Products with the derivatives: (k, k + 4) pairs of columns 0-7 | single columns 8-11, and 12-14 | 12-14.
     const __m256i pairs = PairColumns(diff), last = LastColumns(_mm256_permute2x128_si256(diff, diff, 0x11));
     const __m256i px = _mm256_madd_epi16(pairs, _mm256_load_si256(reinterpret_cast<const __m256i*>(patch.x_pairs[y])));
@@ -353,8 +355,7 @@ PyramidShape ShapeOf(const std::vector<cv::Mat>& pyramid) {
 
 }  // namespace
 
-bool PyrLkApplies(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
-                  cv::Size window) {
+bool PyrLkApplies(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid, cv::Size window) {
   if (!HasAvx2() || window.width != kWindowWidth || window.height < 3 || window.height > kMaxRows) return false;
   const PyramidShape from = ShapeOf(from_pyramid), to = ShapeOf(to_pyramid);
   if (from.step != 2 || to.levels < 0) return false;
@@ -378,7 +379,8 @@ void PyrLk(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>&
   s.window = window;
   s.initial_flow = (flags & cv::OPTFLOW_USE_INITIAL_FLOW) != 0;
   s.max_count = (criteria.type & cv::TermCriteria::COUNT) == 0 ? 30 : std::min(std::max(criteria.maxCount, 0), 100);
-  const double eps = (criteria.type & cv::TermCriteria::EPS) == 0 ? 0.01 : std::min(std::max(criteria.epsilon, 0.), 10.);
+  const double eps =
+      (criteria.type & cv::TermCriteria::EPS) == 0 ? 0.01 : std::min(std::max(criteria.epsilon, 0.), 10.);
   s.epsilon2 = eps * eps;
   std::vector<Level> levels(max_level + 1);
   for (int l = 0; l <= max_level; ++l)

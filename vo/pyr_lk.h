@@ -20,8 +20,7 @@ namespace rovo {
 // Whether PyrLk serves these arguments: the CPU has AVX2, the window is 15 pixels wide and 3 to 32
 // high, and both pyramids come from cv::buildOpticalFlowPyramid of 8-bit gray images, `from_pyramid`
 // with its derivatives (withDerivatives = true).
-bool PyrLkApplies(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
-                  cv::Size window);
+bool PyrLkApplies(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid, cv::Size window);
 
 // cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, from[0, n), to[0, n), status[0, n), cv::noArray(),
 // window, max_level, criteria, flags) with the default minimum eigenvalue (1e-4), where PyrLkApplies.

@@ -104,7 +104,8 @@ TEST(PyrLk, SameAsOpenCvFromStarts) {
   for (size_t k = 0; k < points.size(); ++k)
     starts[k] = points[k] + cv::Point2f(6.25f + rng.uniform(-3.f, 3.f), -4.5f + rng.uniform(-3.f, 3.f));
   for (const int levels : {0, 1, 3}) {
-    const int tracked = ExpectSameAsOpenCv(from, to, points, starts, {cv::Size(15, 15), levels, kTrackerCriteria, true});
+    const int tracked =
+        ExpectSameAsOpenCv(from, to, points, starts, {cv::Size(15, 15), levels, kTrackerCriteria, true});
     EXPECT_GT(tracked, 1000) << "levels " << levels;
   }
 }
@@ -120,10 +121,10 @@ TEST(PyrLk, SameAsOpenCvUnderBrightnessChangesAndOtherSettings) {
   for (const cv::Mat* to : {&brighter, &same}) {
     ExpectSameAsOpenCv(from, *to, points, {}, {cv::Size(15, 15), 2, kTrackerCriteria, false});
     ExpectSameAsOpenCv(from, *to, points, {}, {cv::Size(15, 9), 2, kTrackerCriteria, false});
-    ExpectSameAsOpenCv(from, *to, points, {}, {cv::Size(15, 31), 1, cv::TermCriteria(cv::TermCriteria::COUNT, 5, 0),
-                                               false});
-    ExpectSameAsOpenCv(from, *to, points, {}, {cv::Size(15, 15), 3, cv::TermCriteria(cv::TermCriteria::EPS, 0, 1e-6),
-                                               false});
+    ExpectSameAsOpenCv(from, *to, points, {},
+                       {cv::Size(15, 31), 1, cv::TermCriteria(cv::TermCriteria::COUNT, 5, 0), false});
+    ExpectSameAsOpenCv(from, *to, points, {},
+                       {cv::Size(15, 15), 3, cv::TermCriteria(cv::TermCriteria::EPS, 0, 1e-6), false});
   }
 }
 
