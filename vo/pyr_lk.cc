@@ -6,9 +6,11 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdlib>
+#include <stdexcept>
 #include <opencv2/video/tracking.hpp>
 
-// AVX2 only: without FMA the compiler cannot contract a product and a sum into one rounding.
+// AVX2 only, and vo/CMakeLists.txt compiles this file with -ffp-contract=off: a product and a sum must
+// round twice, as in OpenCV's SSE2 build, on any target.
 #define ROVO_TARGET_AVX2 __attribute__((target("avx2")))
 
 namespace rovo {
@@ -23,7 +25,7 @@ constexpr float kFltScale = 1.0f / (1 << 20);
 constexpr float kMinEigThreshold = 1e-4f;  // cv::calcOpticalFlowPyrLK's default, as float
 constexpr int64_t kExactFloatLimit = int64_t{1} << 24;
 
-bool HasAvx2() {
+bool CpuHasAvx2() {
   static const bool has = __builtin_cpu_supports("avx2") != 0;
   return has;
 }
@@ -353,10 +355,20 @@ PyramidShape ShapeOf(const std::vector<cv::Mat>& pyramid) {
   return shape;
 }
 
+// Whether `m` is an ROI with at least `window` pixels of its allocation on every side (the border
+// cv::buildOpticalFlowPyramid leaves, which LK's reads near the image's edges rely on).
+bool Padded(const cv::Mat& m, cv::Size window) {
+  cv::Size whole;
+  cv::Point offset;
+  m.locateROI(whole, offset);
+  return offset.x >= window.width && offset.y >= window.height && offset.x + m.cols + window.width <= whole.width &&
+         offset.y + m.rows + window.height <= whole.height;
+}
+
 }  // namespace
 
 bool PyrLkApplies(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid, cv::Size window) {
-  if (!HasAvx2() || window.width != kWindowWidth || window.height < 3 || window.height > kMaxRows) return false;
+  if (!CpuHasAvx2() || window.width != kWindowWidth || window.height < 3 || window.height > kMaxRows) return false;
   const PyramidShape from = ShapeOf(from_pyramid), to = ShapeOf(to_pyramid);
   if (from.step != 2 || to.levels < 0) return false;
   for (int l = 0; l <= std::min(from.levels, to.levels); ++l) {
@@ -364,7 +376,7 @@ bool PyrLkApplies(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv
     const cv::Mat& d = from_pyramid[2 * l + 1];
     const cv::Mat& j = to_pyramid[to.step * l];
     if (i.type() != CV_8UC1 || d.type() != CV_16SC2 || j.type() != CV_8UC1 || i.size() != j.size() ||
-        d.size() != i.size())
+        d.size() != i.size() || !Padded(i, window) || !Padded(d, window) || !Padded(j, window))
       return false;
   }
   return true;
@@ -373,6 +385,7 @@ bool PyrLkApplies(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv
 void PyrLk(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid, const cv::Point2f* from,
            cv::Point2f* to, uint8_t* status, int n, cv::Size window, int max_level, const cv::TermCriteria& criteria,
            int flags) {
+  if (max_level < 0) throw std::invalid_argument("PyrLk: max_level must be >= 0");
   const PyramidShape from_shape = ShapeOf(from_pyramid), to_shape = ShapeOf(to_pyramid);
   max_level = std::min({max_level, from_shape.levels, to_shape.levels});
   Settings s;

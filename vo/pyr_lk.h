@@ -18,12 +18,15 @@
 namespace rovo {
 
 // Whether PyrLk serves these arguments: the CPU has AVX2, the window is 15 pixels wide and 3 to 32
-// high, and both pyramids come from cv::buildOpticalFlowPyramid of 8-bit gray images, `from_pyramid`
-// with its derivatives (withDerivatives = true).
+// high, and both pyramids are 8-bit gray with a border of at least the window on every level,
+// `from_pyramid` with its derivatives. They must come from cv::buildOpticalFlowPyramid (withDerivatives =
+// true for `from_pyramid`) with this window or a larger one: the exact-sum shortcut relies on Scharr
+// derivatives (|value| <= 16 * 255).
 bool PyrLkApplies(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid, cv::Size window);
 
 // cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, from[0, n), to[0, n), status[0, n), cv::noArray(),
 // window, max_level, criteria, flags) with the default minimum eigenvalue (1e-4), where PyrLkApplies.
+// Throws std::invalid_argument for max_level < 0 (OpenCV asserts).
 // With cv::OPTFLOW_USE_INITIAL_FLOW in flags, `to` holds the starts.
 void PyrLk(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid, const cv::Point2f* from,
            cv::Point2f* to, uint8_t* status, int n, cv::Size window, int max_level, const cv::TermCriteria& criteria,

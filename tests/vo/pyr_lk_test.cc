@@ -139,6 +139,10 @@ TEST(PyrLk, AppliesOnlyWhereItMatchesOpenCv) {
   EXPECT_FALSE(PyrLkApplies(without, with, cv::Size(15, 15)));  // OpenCV computes the derivatives itself
   EXPECT_FALSE(PyrLkApplies(with, with, cv::Size(21, 21)));
   EXPECT_FALSE(PyrLkApplies(with, with, cv::Size(15, 33)));
+  std::vector<cv::Mat> flat;  // a border of 3 rows: too little for a window 31 high
+  cv::buildOpticalFlowPyramid(image, flat, cv::Size(15, 3), 2);
+  EXPECT_EQ(PyrLkApplies(flat, flat, cv::Size(15, 3)), avx2);
+  EXPECT_FALSE(PyrLkApplies(flat, flat, cv::Size(15, 31)));
   std::vector<cv::Mat> colour;
   cv::Mat bgr;
   cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
