@@ -6,8 +6,8 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdlib>
-#include <stdexcept>
 #include <opencv2/video/tracking.hpp>
+#include <stdexcept>
 
 // AVX2 only, and vo/CMakeLists.txt compiles this file with -ffp-contract=off: a product and a sum must
 // round twice, as in OpenCV's SSE2 build, on any target.
