@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "datasets/rig.h"
+#include "tests/vo/blurred_noise.h"
 #include "vo/frontend.h"
 #include "vo/interview_matching.h"
 #include "vo/opencv_threads.h"
@@ -18,11 +19,8 @@ namespace rovo {
 namespace {
 
 cv::Mat Texture(int width, int height, uint64_t seed) {
-  cv::Mat image(height, width, CV_8UC1);
   cv::RNG rng(seed);
-  rng.fill(image, cv::RNG::UNIFORM, 0, 255);
-  cv::GaussianBlur(image, image, cv::Size(0, 0), 2.0);
-  cv::normalize(image, image, 0, 255, cv::NORM_MINMAX);
+  cv::Mat image = BlurredNoise(width, height, rng);
   for (int k = 0; k < 3000; ++k) {
     cv::rectangle(image,
                   cv::Rect(rng.uniform(0, width), rng.uniform(0, height), rng.uniform(8, 50), rng.uniform(8, 50)),

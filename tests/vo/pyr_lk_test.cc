@@ -7,18 +7,16 @@
 #include <opencv2/video/tracking.hpp>
 #include <vector>
 
+#include "blurred_noise.h"
+
 namespace rovo {
 namespace {
 
 // Smooth texture (blurred noise) with hard-edged blocks, so that gradients are both weak and at the
 // Scharr filter's extremes.
 cv::Mat Texture(int width, int height, uint64_t seed) {
-  cv::Mat noise(height, width, CV_8UC1);
   cv::RNG rng(seed);
-  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
-  cv::Mat image;
-  cv::GaussianBlur(noise, image, cv::Size(0, 0), 2.0);
-  cv::normalize(image, image, 0, 255, cv::NORM_MINMAX);
+  cv::Mat image = BlurredNoise(width, height, rng);
   for (int k = 0; k < 30; ++k) {
     const int x = rng.uniform(0, width - 12), y = rng.uniform(0, height - 12);
     image(cv::Rect(x, y, 12, 12)).setTo(k % 2 == 0 ? 255 : 0);

@@ -11,16 +11,15 @@
 #include <random>
 #include <set>
 
+#include "blurred_noise.h"
+
 namespace rovo {
 namespace {
 
 // Smooth random texture (blurred noise plus random rectangles) with strong corners.
 cv::Mat TexturedImage(int width, int height, uint64_t seed) {
-  cv::Mat image(height, width, CV_8UC1);
   cv::RNG rng(seed);
-  rng.fill(image, cv::RNG::UNIFORM, 0, 255);
-  cv::GaussianBlur(image, image, cv::Size(0, 0), 2.0);
-  cv::normalize(image, image, 0, 255, cv::NORM_MINMAX);
+  cv::Mat image = BlurredNoise(width, height, rng);
   for (int k = 0; k < 400; ++k) {
     const int x = rng.uniform(0, width), y = rng.uniform(0, height);
     cv::rectangle(image, cv::Rect(x, y, rng.uniform(8, 40), rng.uniform(8, 40)), cv::Scalar(rng.uniform(0, 255)),
