@@ -386,6 +386,14 @@ void PyrLk(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>&
            cv::Point2f* to, uint8_t* status, int n, cv::Size window, int max_level, const cv::TermCriteria& criteria,
            int flags) {
   if (max_level < 0) throw std::invalid_argument("PyrLk: max_level must be >= 0");
+  if (n <= 0) return;
+  if (!PyrLkApplies(from_pyramid, to_pyramid, window)) {  // OpenCV itself, on the caller's arrays
+    const cv::Mat from_mat(n, 1, CV_32FC2, const_cast<cv::Point2f*>(from));
+    cv::Mat to_mat(n, 1, CV_32FC2, to), status_mat(n, 1, CV_8U, status);
+    cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, from_mat, to_mat, status_mat, cv::noArray(), window, max_level,
+                             criteria, flags);
+    return;
+  }
   const PyramidShape from_shape = ShapeOf(from_pyramid), to_shape = ShapeOf(to_pyramid);
   max_level = std::min({max_level, from_shape.levels, to_shape.levels});
   Settings s;

@@ -25,7 +25,8 @@ namespace rovo {
 bool PyrLkApplies(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid, cv::Size window);
 
 // cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, from[0, n), to[0, n), status[0, n), cv::noArray(),
-// window, max_level, criteria, flags) with the default minimum eigenvalue (1e-4), where PyrLkApplies.
+// window, max_level, criteria, flags) with the default minimum eigenvalue (1e-4): computed here where
+// PyrLkApplies, by OpenCV elsewhere.
 // Throws std::invalid_argument for max_level < 0 (OpenCV asserts).
 // With cv::OPTFLOW_USE_INITIAL_FLOW in flags, `to` holds the starts.
 void PyrLk(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid, const cv::Point2f* from,

@@ -110,23 +110,12 @@ void PyrLkInChunks(const std::vector<cv::Mat>& from_pyramid, const std::vector<c
   to->resize(n);
   status->assign(n, 0);
   const int chunks = (n + kLkChunkPoints - 1) / kLkChunkPoints;
-  const bool fast = PyrLkApplies(from_pyramid, to_pyramid, window);
   tbb::this_task_arena::isolate([&] {
     tbb::parallel_for(0, chunks, [&](int c) {
       const auto first = static_cast<std::ptrdiff_t>(c) * kLkChunkPoints;
       const auto last = std::min<std::ptrdiff_t>(first + kLkChunkPoints, n);
-      if (fast) {
-        PyrLk(from_pyramid, to_pyramid, from.data() + first, to->data() + first, status->data() + first,
-              static_cast<int>(last - first), window, levels, criteria, flags);
-        return;
-      }
-      const std::vector<cv::Point2f> chunk_from(from.begin() + first, from.begin() + last);
-      std::vector<cv::Point2f> chunk_to(to->begin() + first, to->begin() + last);
-      std::vector<uint8_t> chunk_status;
-      cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, chunk_from, chunk_to, chunk_status, cv::noArray(), window,
-                               levels, criteria, flags);
-      std::copy(chunk_to.begin(), chunk_to.end(), to->begin() + first);
-      std::copy(chunk_status.begin(), chunk_status.end(), status->begin() + first);
+      PyrLk(from_pyramid, to_pyramid, from.data() + first, to->data() + first, status->data() + first,
+            static_cast<int>(last - first), window, levels, criteria, flags);
     });
   });
 }

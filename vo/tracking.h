@@ -99,8 +99,8 @@ constexpr int kLkChunkPoints = 64;
 // cv::calcOpticalFlowPyrLK of `from` into `to` (which holds the starts when flags has
 // cv::OPTFLOW_USE_INITIAL_FLOW, and must then be as long as `from`), in chunks of kLkChunkPoints points
 // under TBB, isolated (a thread waiting for its chunks takes no other work). LK tracks every point on its
-// own, so positions and status are those of one call; the chunks let an idle worker take part. Where
-// PyrLkApplies (vo/pyr_lk.h), PyrLk computes the same results.
+// own, so positions and status are those of one call; the chunks let an idle worker take part. Each chunk
+// goes to PyrLk (vo/pyr_lk.h): the same results, computed in AVX2 where it applies.
 void PyrLkInChunks(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
                    const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to, std::vector<uint8_t>* status,
                    cv::Size window, int levels, const cv::TermCriteria& criteria, int flags);

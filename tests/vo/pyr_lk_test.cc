@@ -47,7 +47,7 @@ int ExpectSameAsOpenCv(const cv::Mat& from, const cv::Mat& to, const std::vector
   std::vector<cv::Mat> from_pyramid, to_pyramid;
   cv::buildOpticalFlowPyramid(from, from_pyramid, c.window, c.levels);
   cv::buildOpticalFlowPyramid(to, to_pyramid, c.window, c.levels);
-  EXPECT_TRUE(PyrLkApplies(from_pyramid, to_pyramid, c.window));
+  EXPECT_EQ(PyrLkApplies(from_pyramid, to_pyramid, c.window), __builtin_cpu_supports("avx2") != 0);
   const int flags = c.initial_flow ? cv::OPTFLOW_USE_INITIAL_FLOW : 0;
   std::vector<cv::Point2f> expected = starts, actual = starts;
   actual.resize(points.size());
@@ -124,6 +124,32 @@ TEST(PyrLk, SameAsOpenCvUnderBrightnessChangesAndOtherSettings) {
     ExpectSameAsOpenCv(from, *to, points, {},
                        {cv::Size(15, 15), 3, cv::TermCriteria(cv::TermCriteria::EPS, 0, 1e-6), false});
   }
+}
+
+// Where it does not apply (a 21-pixel window), PyrLk hands the points to OpenCV and writes its results
+// into the caller's arrays.
+TEST(PyrLk, FallsBackToOpenCvWhereItDoesNotApply) {
+  const cv::Mat from = Texture(200, 160, 5);
+  const cv::Mat to = Moved(from, 2.0, -1.5, 1.0, 0.0);
+  const cv::Size window(21, 21);
+  std::vector<cv::Mat> from_pyramid, to_pyramid;
+  cv::buildOpticalFlowPyramid(from, from_pyramid, window, 2);
+  cv::buildOpticalFlowPyramid(to, to_pyramid, window, 2);
+  ASSERT_FALSE(PyrLkApplies(from_pyramid, to_pyramid, window));
+  cv::RNG rng(15);
+  const std::vector<cv::Point2f> points = RandomPoints(500, from.size(), 10, rng);
+  std::vector<cv::Point2f> expected, actual(points.size());
+  std::vector<uint8_t> expected_status, actual_status(points.size(), 7);
+  cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, points, expected, expected_status, cv::noArray(), window, 2,
+                           kTrackerCriteria, 0);
+  PyrLk(from_pyramid, to_pyramid, points.data(), actual.data(), actual_status.data(), static_cast<int>(points.size()),
+        window, 2, kTrackerCriteria, 0);
+  EXPECT_EQ(actual_status, expected_status);
+  ASSERT_EQ(actual.size(), expected.size());
+  EXPECT_EQ(std::memcmp(actual.data(), expected.data(), actual.size() * sizeof(cv::Point2f)), 0);
+  EXPECT_THROW(PyrLk(from_pyramid, to_pyramid, points.data(), actual.data(), actual_status.data(), 1, window, -1,
+                     kTrackerCriteria, 0),
+               std::invalid_argument);
 }
 
 TEST(PyrLk, AppliesOnlyWhereItMatchesOpenCv) {
