@@ -77,7 +77,8 @@ void BM_FrontendFullSize(benchmark::State& state) {
   state.counters["warped_width"] = frontend.projection(0).width();
 }
 // Args: features per view, KLT window, KLT levels, focal scale in percent. The first row is the
-// default configuration (FrontendOptions), the second the KLT window used before (21 px).
+// default configuration (FrontendOptions), the second the KLT window used before (21 px; vo/pyr_lk.h serves
+// 15-px windows only, so this row runs OpenCV's LK).
 BENCHMARK(BM_FrontendFullSize)
     ->ArgNames({"features", "window", "levels", "focal_pct"})
     ->Args({600, FrontendOptions{}.klt_window_px, FrontendOptions{}.klt_levels, 100})

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
-#include <cstdlib>
 #include <opencv2/video/tracking.hpp>
 #include <stdexcept>
 
@@ -54,7 +53,7 @@ inline Weights BilinearWeights(float a, float b) {
 // The window of the previous image at a point: intensity (x 32) and Scharr derivatives, interpolated;
 // columns kWindowWidth.. are zero.
 // The derivatives are stored for Mismatch's pairwise products (_mm256_madd_epi16 against the
-// mismatch shuffled by kPairColumns): per row, x and y, (D0 D4 D1 D5 D2 D6 D3 D7 | D8 0 D9 0 D10 0 D11 0),
+// mismatch shuffled by PairColumns): per row, x and y, (D0 D4 D1 D5 D2 D6 D3 D7 | D8 0 D9 0 D10 0 D11 0),
 // and (Dx12 0 Dx13 0 Dx14 0 0 0 | Dy12 0 Dy13 0 Dy14 0 0 0).
 struct Patch {
   alignas(32) int16_t i[kMaxRows][kLanes];
@@ -108,8 +107,8 @@ ROVO_TARGET_AVX2 inline __m256i PairWeights(int a, int b) {
   return _mm256_set1_epi32(static_cast<int>((static_cast<uint32_t>(a) & 0xffffu) | (static_cast<uint32_t>(b) << 16)));
 }
 
-// In-lane shuffles of 16 int16 columns: kPairColumns gives (c0 c4 c1 c5 c2 c6 c3 c7 | c8 0 c9 0 c10 0 c11 0),
-// kLastColumns (c12 0 c13 0 c14 0 c15 0) from the upper lane of each lane.
+// In-lane shuffles of 16 int16 columns: PairColumns gives (c0 c4 c1 c5 c2 c6 c3 c7 | c8 0 c9 0 c10 0 c11 0),
+// LastColumns (c12 0 c13 0 c14 0 c15 0) from the upper half of each 128-bit lane.
 ROVO_TARGET_AVX2 inline __m256i PairColumns(__m256i v) {
   return _mm256_shuffle_epi8(v, _mm256_setr_epi8(0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15, 0, 1, -1, -1, 2,
                                                  3, -1, -1, 4, 5, -1, -1, 6, 7, -1, -1));

@@ -9,7 +9,7 @@
 // sums do. Here the integers of a whole 15-pixel row are computed at once, and the floats are added in
 // OpenCV's order, except where the magnitudes of the one-by-one terms sum to less than 2^24: then every
 // partial sum is an exact integer and the order cannot change it. Points and statuses equal OpenCV's
-// for any input (unit tests PyrLk.*), so tracks do not change.
+// for pyramids from cv::buildOpticalFlowPyramid (unit tests PyrLk.*), so tracks do not change.
 
 #include <cstdint>
 #include <opencv2/core.hpp>

@@ -94,7 +94,7 @@ float IntensityCentroidAngleDeg(const cv::Mat& image, cv::Point2f px);
 // Hamming distance of two 1x32 CV_8U ORB descriptors.
 int HammingDistance(const cv::Mat& a, const cv::Mat& b);
 
-// Points per cv::calcOpticalFlowPyrLK call in PyrLkInChunks.
+// Points per PyrLk call in PyrLkInChunks.
 constexpr int kLkChunkPoints = 64;
 // cv::calcOpticalFlowPyrLK of `from` into `to` (which holds the starts when flags has
 // cv::OPTFLOW_USE_INITIAL_FLOW, and must then be as long as `from`), in chunks of kLkChunkPoints points
