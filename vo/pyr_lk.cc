@@ -68,20 +68,26 @@ struct Gradient {
   float a11, a12, a22;
 };
 
-// Two rows' interpolation of 16 8-bit pixels (columns 0..15 of `row0` and `row1`, and 1..15 shifted
-// in): (p00 w00 + p01 w01 + p10 w10 + p11 w11 + 2^(shift - 1)) >> shift per column, as int16.
-ROVO_TARGET_AVX2 inline __m256i InterpolateBytes(__m128i row0, __m128i row1, __m256i w0, __m256i w1, int shift) {
-  const __m256i a0 = _mm256_cvtepu8_epi16(row0), a1 = _mm256_cvtepu8_epi16(_mm_srli_si128(row0, 1));
-  const __m256i c0 = _mm256_cvtepu8_epi16(row1), c1 = _mm256_cvtepu8_epi16(_mm_srli_si128(row1, 1));
+// The (column k, column k + 1) pairs of 16 8-bit pixels of a row (the 16th pixel's partner is zero) as
+// int16: columns 0-3 | 8-11 in *lo, 4-7 | 12-15 in *hi (the order of _mm256_madd_epi16's sums).
+ROVO_TARGET_AVX2 inline void RowPairs(const uint8_t* row, __m256i* lo, __m256i* hi) {
+  const __m128i bytes = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row));
+  const __m256i a0 = _mm256_cvtepu8_epi16(bytes), a1 = _mm256_cvtepu8_epi16(_mm_srli_si128(bytes, 1));
+  *lo = _mm256_unpacklo_epi16(a0, a1);
+  *hi = _mm256_unpackhi_epi16(a0, a1);
+}
+
+// Bilinear interpolation of a window row from the column pairs (RowPairs) of its upper and lower image
+// rows: (p00 w00 + p01 w01 + p10 w10 + p11 w11 + 2^(shift - 1)) >> shift per column, as int16 in column order.
+ROVO_TARGET_AVX2 inline __m256i InterpolateRow(__m256i upper_lo, __m256i upper_hi, __m256i lower_lo, __m256i lower_hi,
+                                               __m256i w0, __m256i w1, int shift) {
   const __m256i rounding = _mm256_set1_epi32(1 << (shift - 1));
   const __m128i count = _mm_cvtsi32_si128(shift);
-  // unpacklo: columns 0-3 | 8-11, unpackhi: 4-7 | 12-15; packs puts them back in order.
-  const __m256i lo = _mm256_add_epi32(_mm256_madd_epi16(_mm256_unpacklo_epi16(a0, a1), w0),
-                                      _mm256_madd_epi16(_mm256_unpacklo_epi16(c0, c1), w1));
-  const __m256i hi = _mm256_add_epi32(_mm256_madd_epi16(_mm256_unpackhi_epi16(a0, a1), w0),
-                                      _mm256_madd_epi16(_mm256_unpackhi_epi16(c0, c1), w1));
-  return _mm256_packs_epi32(_mm256_sra_epi32(_mm256_add_epi32(lo, rounding), count),
-                            _mm256_sra_epi32(_mm256_add_epi32(hi, rounding), count));
+  const __m256i lo =
+      _mm256_add_epi32(_mm256_add_epi32(_mm256_madd_epi16(upper_lo, w0), _mm256_madd_epi16(lower_lo, w1)), rounding);
+  const __m256i hi =
+      _mm256_add_epi32(_mm256_add_epi32(_mm256_madd_epi16(upper_hi, w0), _mm256_madd_epi16(lower_hi, w1)), rounding);
+  return _mm256_packs_epi32(_mm256_sra_epi32(lo, count), _mm256_sra_epi32(hi, count));  // back in column order
 }
 
 // The interpolated derivatives of 8 pixels: d00/d01 the (Ix, Iy) pairs of pixels k and k + 1 of the
@@ -138,9 +144,11 @@ ROVO_TARGET_AVX2 Gradient ExtractPatch(const cv::Mat& image, const cv::Mat& deri
   alignas(32) int32_t tail_xx[kMaxRows][kLaneBlock], tail_xy[kMaxRows][kLaneBlock], tail_yy[kMaxRows][kLaneBlock];
   for (int y = 0; y < rows; ++y) {
     const uint8_t* src = image.ptr<uint8_t>(corner.y + y) + corner.x;
-    const __m128i row0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(src));
-    const __m128i row1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(src + step_i));
-    _mm256_store_si256(reinterpret_cast<__m256i*>(patch->i[y]), InterpolateBytes(row0, row1, w0, w1, kWBits - 5));
+    __m256i upper_lo, upper_hi, lower_lo, lower_hi;
+    RowPairs(src, &upper_lo, &upper_hi);
+    RowPairs(src + step_i, &lower_lo, &lower_hi);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(patch->i[y]),
+                       InterpolateRow(upper_lo, upper_hi, lower_lo, lower_hi, w0, w1, kWBits - 5));
 
     const int16_t* d = deriv.ptr<int16_t>(corner.y + y) + 2 * corner.x;
     const int16_t* e = d + step_d;
@@ -206,22 +214,12 @@ ROVO_TARGET_AVX2 float OneByOneSum(__m256i abs_sum, __m256i sum, const float (*t
   return acc;
 }
 
-// The (column k, column k + 1) pairs of 16 8-bit pixels of a row (the 16th pixel's partner is zero) as
-// int16: columns 0-3 | 8-11 in *lo, 4-7 | 12-15 in *hi (the order of _mm256_madd_epi16's sums).
-ROVO_TARGET_AVX2 inline void RowPairs(const uint8_t* row, __m256i* lo, __m256i* hi) {
-  const __m128i bytes = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row));
-  const __m256i a0 = _mm256_cvtepu8_epi16(bytes), a1 = _mm256_cvtepu8_epi16(_mm_srli_si128(bytes, 1));
-  *lo = _mm256_unpacklo_epi16(a0, a1);
-  *hi = _mm256_unpackhi_epi16(a0, a1);
-}
-
 // The mismatch vector (b1, b2) of the patch against the moving image whose window's top-left pixel is
 // `j` (interpolated with w), in OpenCV's float order (see Gradient; in the lanes the integer sum of
 // columns k and k + 4 is converted and added).
 ROVO_TARGET_AVX2 void Mismatch(const Patch& patch, const uint8_t* j, size_t step_j, const Weights& w, int rows,
                                float* b1, float* b2) {
   const __m256i w0 = PairWeights(w.w00, w.w01), w1 = PairWeights(w.w10, w.w11);
-  const __m256i rounding = _mm256_set1_epi32(1 << (kWBits - 5 - 1));
   __m128 lanes_x = _mm_setzero_ps(), lanes_y = _mm_setzero_ps();
   __m256i abs_x = _mm256_setzero_si256(), abs_y = _mm256_setzero_si256();
   __m256i sum_x = _mm256_setzero_si256(), sum_y = _mm256_setzero_si256();
@@ -233,15 +231,10 @@ ROVO_TARGET_AVX2 void Mismatch(const Patch& patch, const uint8_t* j, size_t step
     j += step_j;
     __m256i lower_lo, lower_hi;
     RowPairs(j, &lower_lo, &lower_hi);
-    const __m256i lo =
-        _mm256_add_epi32(_mm256_add_epi32(_mm256_madd_epi16(upper_lo, w0), _mm256_madd_epi16(lower_lo, w1)), rounding);
-    const __m256i hi =
-        _mm256_add_epi32(_mm256_add_epi32(_mm256_madd_epi16(upper_hi, w0), _mm256_madd_epi16(lower_hi, w1)), rounding);
+    const __m256i diff = _mm256_subs_epi16(InterpolateRow(upper_lo, upper_hi, lower_lo, lower_hi, w0, w1, kWBits - 5),
+                                           _mm256_load_si256(reinterpret_cast<const __m256i*>(patch.i[y])));
     upper_lo = lower_lo;
     upper_hi = lower_hi;
-    const __m256i diff =
-        _mm256_subs_epi16(_mm256_packs_epi32(_mm256_srai_epi32(lo, kWBits - 5), _mm256_srai_epi32(hi, kWBits - 5)),
-                          _mm256_load_si256(reinterpret_cast<const __m256i*>(patch.i[y])));
     // Products with the derivatives: (k, k + 4) pairs of columns 0-7 | single columns 8-11, and 12-14 | 12-14.
     const __m256i pairs = PairColumns(diff), last = LastColumns(_mm256_permute2x128_si256(diff, diff, 0x11));
     const __m256i px = _mm256_madd_epi16(pairs, _mm256_load_si256(reinterpret_cast<const __m256i*>(patch.x_pairs[y])));
