@@ -104,6 +104,21 @@ void BM_HybridWarpOneView(benchmark::State& state) {
 }
 BENCHMARK(BM_HybridWarpOneView)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// The same warp by cv::remap itself (the pixels Warp returns; vo/bilinear_remap.h).
+void BM_HybridWarpOneViewOpenCv(benchmark::State& state) {
+  const Rig rig = MakeRigPreset("rovo4");
+  const auto projections = HybridProjection::ForRig(rig);
+  const cv::Mat image = Texture(rig.cameras[0].camera.width, rig.cameras[0].camera.height, 7);
+  const ScopedOpenCvThreads serial_opencv;
+  cv::Mat warped;
+  for (auto _ : state) {
+    cv::remap(image, warped, projections[0].map_fixed(), projections[0].map_frac(), cv::INTER_LINEAR,
+              cv::BORDER_CONSTANT, cv::Scalar::all(0));
+    benchmark::DoNotOptimize(warped.data);
+  }
+}
+BENCHMARK(BM_HybridWarpOneViewOpenCv)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 // The same warp in bands of state.range(0) rows, one after the other on one thread (the front-end
 // warps bands in parallel): cv::remap's blocks follow the band's shape (HybridProjection::kWarpBandRows).
 void BM_HybridWarpOneViewInBands(benchmark::State& state) {

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "datasets/camera_models.h"
+#include "vo/bilinear_remap.h"
 
 namespace rovo {
 
@@ -355,7 +356,7 @@ void CheckFisheyeSize(const cv::Mat& fisheye, const Camera& camera) {
 
 void HybridProjection::Warp(const cv::Mat& fisheye, cv::Mat* warped) const {
   CheckFisheyeSize(fisheye, camera_);
-  cv::remap(fisheye, *warped, map_fixed_, map_frac_, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+  RemapBilinearGray(fisheye, map_fixed_, map_frac_, warped);
 }
 
 void HybridProjection::WarpRows(const cv::Mat& fisheye, int first_row, int last_row, cv::Mat* warped) const {
@@ -369,8 +370,7 @@ void HybridProjection::WarpRows(const cv::Mat& fisheye, int first_row, int last_
   last_row = std::min(last_row, height_);
   if (first_row >= last_row) return;
   cv::Mat band = warped->rowRange(first_row, last_row);
-  cv::remap(fisheye, band, map_fixed_.rowRange(first_row, last_row), map_frac_.rowRange(first_row, last_row),
-            cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+  RemapBilinearGray(fisheye, map_fixed_.rowRange(first_row, last_row), map_frac_.rowRange(first_row, last_row), &band);
 }
 
 }  // namespace rovo

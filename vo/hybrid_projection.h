@@ -127,15 +127,15 @@ class HybridProjection {
   Eigen::Vector3d RigFromCamRotate(const Eigen::Vector3d& v) const { return rig_from_cam_rotation_ * v; }
 
   // Warps a fisheye image (8-bit, 1 or 3 channels) into `warped` (same type) with the fixed-point
-  // maps (cv::remap, bilinear, 0 outside the valid area).
+  // maps: cv::remap's pixels (bilinear, 0 outside the valid area), gray ones by RemapBilinearGray.
   void Warp(const cv::Mat& fisheye, cv::Mat* warped) const;
   // Warp of the rows [first_row, last_row) (clipped to the image) only, into `warped` (allocated:
   // height() x width(), the fisheye's type): the same pixels as Warp there, so bands can be warped in
   // parallel.
   void WarpRows(const cv::Mat& fisheye, int first_row, int last_row, cv::Mat* warped) const;
-  // Rows per band for WarpRows. cv::remap works in blocks of up to 128 rows and 2^14 pixels: 128 x 128
-  // on the whole warped image, 8 x 2048 on 8-row bands, which cost about 0.6x the whole warp (bands of
-  // 128 rows cost what the whole does; BM_HybridWarpOneViewInBands).
+  // Rows per band for WarpRows: tasks an idle thread can take from another view. RemapBilinearGray
+  // costs the same in bands of any height; cv::remap (the floor's warp) is cheapest in 8-row bands, where
+  // its blocks are 8 x 2048 (BM_HybridWarpOneViewInBands, docs/design-notes.md).
   static constexpr int kWarpBandRows = 8;
   // CV_8U, 255 where the warped pixel maps into the fisheye's valid area.
   const cv::Mat& valid_mask() const { return valid_mask_; }

@@ -7,8 +7,7 @@
 #include <cstdlib>
 #include <opencv2/core/hal/intrin.hpp>
 
-// Compiles a function for AVX2 (called only after HasAvx2()).
-#define ROVO_TARGET_AVX2 __attribute__((target("avx2")))
+#include "vo/cpu_dispatch.h"
 
 namespace rovo {
 namespace {
@@ -62,11 +61,6 @@ const DiscRowWeights& RowWeights() {
 }  // namespace
 
 namespace patch_kernels_internal {
-
-bool HasAvx2() {
-  static const bool has = __builtin_cpu_supports("avx2") != 0;
-  return has;
-}
 
 PatchSums PatchSumsPortable(const int16_t* a, const cv::Mat& image, int x0, int y0, int side) {
   PatchSums sums;
@@ -180,7 +174,7 @@ bool DiscMomentsAvx2Fits(const cv::Mat& image, int cx, int cy) {
 using namespace patch_kernels_internal;  // NOLINT(google-build-using-namespace): this file's own forms
 
 PatchSums PatchSumsAgainst(const int16_t* reference_rows, const cv::Mat& image, int x0, int y0, int side) {
-  if (HasAvx2()) return PatchSumsAvx2(reference_rows, image, x0, y0, side);
+  if (CpuHasAvx2()) return PatchSumsAvx2(reference_rows, image, x0, y0, side);
   return PatchSumsPortable(reference_rows, image, x0, y0, side);
 }
 
@@ -190,7 +184,7 @@ DiscMoments DiscMomentsAt(const cv::Mat& image, int cx, int cy) {
   // The AVX2 rows read 32 bytes from cx - 15: inside the image when cx + 16 < cols.
   const bool avx2_inside =
       cx >= kDiscRadius && cy >= kDiscRadius && cx + kDiscRadius + 1 < image.cols && cy + kDiscRadius < image.rows;
-  if (avx2_inside && HasAvx2()) return DiscMomentsAvx2(image, cx, cy);
+  if (avx2_inside && CpuHasAvx2()) return DiscMomentsAvx2(image, cx, cy);
   return DiscMomentsPortable(image, cx, cy);
 }
 

@@ -31,10 +31,9 @@ struct DiscMoments {
 };
 DiscMoments DiscMomentsAt(const cv::Mat& image, int cx, int cy);
 
-// The two forms behind the functions above, for tests (the AVX2 ones only where the CPU has AVX2;
+// The two forms behind the functions above, for tests (the AVX2 ones only where CpuHasAvx2(), vo/cpu_dispatch.h;
 // DiscMomentsAvx2 only where its 32-byte rows lie inside the image: DiscMomentsAvx2Fits).
 namespace patch_kernels_internal {
-bool HasAvx2();
 PatchSums PatchSumsPortable(const int16_t* reference_rows, const cv::Mat& image, int x0, int y0, int side);
 PatchSums PatchSumsAvx2(const int16_t* reference_rows, const cv::Mat& image, int x0, int y0, int side);
 DiscMoments DiscMomentsPortable(const cv::Mat& image, int cx, int cy);

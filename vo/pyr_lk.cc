@@ -8,9 +8,10 @@
 #include <opencv2/video/tracking.hpp>
 #include <stdexcept>
 
-// AVX2 only, and vo/CMakeLists.txt compiles this file with -ffp-contract=off: a product and a sum must
-// round twice, as in OpenCV's SSE2 build, on any target.
-#define ROVO_TARGET_AVX2 __attribute__((target("avx2")))
+#include "vo/cpu_dispatch.h"
+
+// vo/CMakeLists.txt compiles this file with -ffp-contract=off: a product and a sum must round twice, as
+// in OpenCV's SSE2 build, on any target.
 
 namespace rovo {
 namespace {
@@ -23,11 +24,6 @@ constexpr int kWBits = 14;     // bilinear weights: 1 << kWBits in all
 constexpr float kFltScale = 1.0f / (1 << 20);
 constexpr float kMinEigThreshold = 1e-4f;  // cv::calcOpticalFlowPyrLK's default, as float
 constexpr int64_t kExactFloatLimit = int64_t{1} << 24;
-
-bool CpuHasAvx2() {
-  static const bool has = __builtin_cpu_supports("avx2") != 0;
-  return has;
-}
 
 // cvFloor and cvRound of OpenCV 4.6 on x86-64.
 inline int FloorInt(float v) {

@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <vector>
 
+#include "vo/cpu_dispatch.h"
+
 namespace rovo {
 namespace {
 
@@ -80,7 +82,7 @@ TEST(PatchKernels, PatchSumsAreTheDirectSumsForEverySide) {
       const PatchSums expected = DirectSums(a, image, x0, y0, side);
       ExpectEqual(expected, PatchSumsAgainst(a.data(), image, x0, y0, side), "dispatched");
       ExpectEqual(expected, internal::PatchSumsPortable(a.data(), image, x0, y0, side), "portable");
-      if (internal::HasAvx2()) {
+      if (CpuHasAvx2()) {
         ExpectEqual(expected, internal::PatchSumsAvx2(a.data(), image, x0, y0, side), "avx2");
       }
     }
@@ -119,7 +121,7 @@ TEST(PatchKernels, DiscMomentsAreTheDirectSumsEverywhere) {
       ASSERT_EQ(expected.m01, at.m01) << cx << "," << cy;
       ASSERT_EQ(expected.m10, portable.m10) << cx << "," << cy;
       ASSERT_EQ(expected.m01, portable.m01) << cx << "," << cy;
-      if (internal::HasAvx2() && internal::DiscMomentsAvx2Fits(image, cx, cy)) {
+      if (CpuHasAvx2() && internal::DiscMomentsAvx2Fits(image, cx, cy)) {
         const DiscMoments avx2 = internal::DiscMomentsAvx2(image, cx, cy);
         ASSERT_EQ(expected.m10, avx2.m10) << cx << "," << cy;
         ASSERT_EQ(expected.m01, avx2.m01) << cx << "," << cy;
@@ -127,7 +129,7 @@ TEST(PatchKernels, DiscMomentsAreTheDirectSumsEverywhere) {
       }
     }
   }
-  if (internal::HasAvx2()) {
+  if (CpuHasAvx2()) {
     EXPECT_GT(avx2_checked, 500);
   }
 }

@@ -1,0 +1,205 @@
+#include "vo/bilinear_remap.h"
+
+#include <immintrin.h>
+
+#include <array>
+#include <cstdint>
+#include <opencv2/imgproc.hpp>
+
+#include "vo/cpu_dispatch.h"
+
+namespace rovo {
+namespace {
+
+constexpr int kTabSize = 32;  // fractions of a pixel per axis (INTER_TAB_SIZE)
+constexpr int kTabEntries = kTabSize * kTabSize;
+constexpr int kCoefBits = 15;  // INTER_REMAP_COEF_BITS
+constexpr int kCoefScale = 1 << kCoefBits;
+constexpr int kBlock = 16;  // pixels per AVX2 step: two gathers of eight
+
+// OpenCV's BilinearTab_i: entry fy * 32 + fx holds the weights of the taps (sx, sy), (sx + 1, sy),
+// (sx, sy + 1), (sx + 1, sy + 1), each rounded to 15 bits, then their sum corrected to 2^15 as
+// initInterTab2D does (only entry 0 needs it: its 2^15 saturates to 32767). That correction compares
+// four weights from the entry's last one on, three of them in the next entry (zero then, as the table
+// fills in order, and overwritten after), hence the spare zeros past the last entry.
+struct WeightTable {
+  std::array<int16_t, kTabEntries * 4 + 4> weights{};
+  // The same weights as int16 pairs for the gathers: (w0, w1) of the top row, (w2, w3) of the bottom.
+  std::array<int32_t, kTabEntries> top{}, bottom{};
+};
+
+void CorrectSum(int16_t* w, int sum) {
+  if (sum == kCoefScale) return;
+  const int diff = sum - kCoefScale;
+  int max_k = 3, min_k = 3;
+  for (int k1 = 1; k1 < 3; ++k1) {
+    for (int k2 = 1; k2 < 3; ++k2) {
+      const int k = k1 * 2 + k2;
+      if (w[k] < w[min_k]) {
+        min_k = k;
+      } else if (w[k] > w[max_k]) {
+        max_k = k;
+      }
+    }
+  }
+  const int k = diff < 0 ? max_k : min_k;
+  w[k] = static_cast<int16_t>(w[k] - diff);
+}
+
+WeightTable BuildWeightTable() {
+  WeightTable table;
+  std::array<float, 2 * kTabSize> linear{};  // (1 - f, f) per fraction f = i / 32
+  const float scale = 1.f / kTabSize;
+  for (int i = 0; i < kTabSize; ++i) {
+    linear[2 * i] = 1.f - static_cast<float>(i) * scale;
+    linear[2 * i + 1] = static_cast<float>(i) * scale;
+  }
+  for (int entry = 0; entry < kTabEntries; ++entry) {
+    int16_t* w = table.weights.data() + 4 * entry;
+    const int fy = entry / kTabSize, fx = entry % kTabSize;
+    int sum = 0;
+    for (int k1 = 0; k1 < 2; ++k1) {
+      for (int k2 = 0; k2 < 2; ++k2) {
+        const float v = linear[2 * fy + k1] * linear[2 * fx + k2];
+        w[k1 * 2 + k2] = cv::saturate_cast<int16_t>(v * static_cast<float>(kCoefScale));
+        sum += w[k1 * 2 + k2];
+      }
+    }
+    CorrectSum(w, sum);
+  }
+  for (int entry = 0; entry < kTabEntries; ++entry) {
+    const int16_t* w = table.weights.data() + 4 * entry;
+    const auto pair = [](int16_t low, int16_t high) {
+      return static_cast<int32_t>(static_cast<uint32_t>(static_cast<uint16_t>(low)) |
+                                  (static_cast<uint32_t>(static_cast<uint16_t>(high)) << 16));
+    };
+    table.top[entry] = pair(w[0], w[1]);
+    table.bottom[entry] = pair(w[2], w[3]);
+  }
+  return table;
+}
+
+const WeightTable& Weights() {
+  static const WeightTable table = BuildWeightTable();
+  return table;
+}
+
+// One pixel as cv::remap's border loop computes it with BORDER_CONSTANT and the value 0: taps outside
+// the image count as 0.
+uint8_t PixelAt(const cv::Mat& src, int sx, int sy, const int16_t* w) {
+  int sum = 0;
+  const auto tap = [&](int x, int y, int weight) {
+    if (static_cast<unsigned>(x) < static_cast<unsigned>(src.cols) &&
+        static_cast<unsigned>(y) < static_cast<unsigned>(src.rows)) {
+      sum += src.ptr<uint8_t>(y)[x] * weight;
+    }
+  };
+  tap(sx, sy, w[0]);
+  tap(sx + 1, sy, w[1]);
+  tap(sx, sy + 1, w[2]);
+  tap(sx + 1, sy + 1, w[3]);
+  return cv::saturate_cast<uint8_t>((sum + (1 << (kCoefBits - 1))) >> kCoefBits);
+}
+
+void RemapPixels(const cv::Mat& src, const int16_t* xy, const uint16_t* frac, int count, uint8_t* out) {
+  const WeightTable& table = Weights();
+  for (int x = 0; x < count; ++x) {
+    const int16_t* w = table.weights.data() + 4 * (frac[x] & (kTabEntries - 1));
+    out[x] = PixelAt(src, xy[2 * x], xy[2 * x + 1], w);
+  }
+}
+
+// Constants of a row's AVX2 steps.
+struct Avx2Row {
+  const uint8_t* top_row;     // the image's first row
+  const uint8_t* bottom_row;  // its second row
+  __m256i offset_of_pair;     // (1, step) as int16 pairs: madd of (sx, sy) gives sy * step + sx
+  __m256i x_limit, y_limit;   // sx <= cols - 2, sy <= rows - 3: all four taps and the gathers' bytes inside
+  __m256i spread;             // bytes 0 and 1 of each int32 lane to int16 lanes 0 and 1
+};
+
+ROVO_TARGET_AVX2 inline Avx2Row MakeAvx2Row(const cv::Mat& src) {
+  const int step = static_cast<int>(src.step);
+  const __m256i spread = _mm256_setr_epi8(0, -1, 1, -1, 4, -1, 5, -1, 8, -1, 9, -1, 12, -1, 13, -1,  //
+                                          0, -1, 1, -1, 4, -1, 5, -1, 8, -1, 9, -1, 12, -1, 13, -1);
+  return {src.data, src.data + step, _mm256_set1_epi32((step << 16) | 1), _mm256_set1_epi32(src.cols - 1),
+          _mm256_set1_epi32(src.rows - 2), spread};
+}
+
+// Whether the eight (sx, sy) pairs of `xy` lie where the gathers may read: sx in [0, cols - 2], sy in
+// [0, rows - 3] (each gather reads four bytes from sx of rows sy and sy + 1).
+ROVO_TARGET_AVX2 inline bool EightInside(const Avx2Row& row, __m256i xy) {
+  const __m256i sx = _mm256_srai_epi32(_mm256_slli_epi32(xy, 16), 16);
+  const __m256i sy = _mm256_srai_epi32(xy, 16);
+  const __m256i minus_one = _mm256_set1_epi32(-1);
+  const __m256i inside = _mm256_and_si256(
+      _mm256_and_si256(_mm256_cmpgt_epi32(sx, minus_one), _mm256_cmpgt_epi32(row.x_limit, sx)),
+      _mm256_and_si256(_mm256_cmpgt_epi32(sy, minus_one), _mm256_cmpgt_epi32(row.y_limit, sy)));
+  return _mm256_movemask_epi8(inside) == -1;
+}
+
+// Eight pixels, as int32: (sum of tap * weight + 2^14) >> 15.
+ROVO_TARGET_AVX2 inline __m256i EightPixels(const Avx2Row& row, const WeightTable& table, __m256i xy,
+                                            const uint16_t* frac) {
+  const __m256i offset = _mm256_madd_epi16(xy, row.offset_of_pair);
+  const __m256i top = _mm256_i32gather_epi32(reinterpret_cast<const int*>(row.top_row), offset, 1);
+  const __m256i bottom = _mm256_i32gather_epi32(reinterpret_cast<const int*>(row.bottom_row), offset, 1);
+  const __m256i entry = _mm256_and_si256(
+      _mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(frac))),
+      _mm256_set1_epi32(kTabEntries - 1));
+  const __m256i top_weights = _mm256_i32gather_epi32(table.top.data(), entry, 4);
+  const __m256i bottom_weights = _mm256_i32gather_epi32(table.bottom.data(), entry, 4);
+  const __m256i sum = _mm256_add_epi32(_mm256_madd_epi16(_mm256_shuffle_epi8(top, row.spread), top_weights),
+                                       _mm256_madd_epi16(_mm256_shuffle_epi8(bottom, row.spread), bottom_weights));
+  return _mm256_srai_epi32(_mm256_add_epi32(sum, _mm256_set1_epi32(1 << (kCoefBits - 1))), kCoefBits);
+}
+
+// Sixteen int32 pixels in [0, 255] stored as bytes, in order.
+ROVO_TARGET_AVX2 inline void StoreSixteen(__m256i first, __m256i second, uint8_t* out) {
+  const __m256i words = _mm256_permute4x64_epi64(_mm256_packs_epi32(first, second), 0xD8);
+  const __m256i bytes = _mm256_permute4x64_epi64(_mm256_packus_epi16(words, words), 0x08);
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm256_castsi256_si128(bytes));
+}
+
+ROVO_TARGET_AVX2 void RemapRowAvx2(const cv::Mat& src, const Avx2Row& row, const int16_t* xy, const uint16_t* frac,
+                                   int width, uint8_t* out) {
+  const WeightTable& table = Weights();
+  int x = 0;
+  for (; x + kBlock <= width; x += kBlock) {
+    const __m256i xy_first = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(xy + 2 * x));
+    const __m256i xy_second = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(xy + 2 * x + 16));
+    if (EightInside(row, xy_first) && EightInside(row, xy_second)) {
+      StoreSixteen(EightPixels(row, table, xy_first, frac + x), EightPixels(row, table, xy_second, frac + x + 8),
+                   out + x);
+    } else {
+      RemapPixels(src, xy + 2 * x, frac + x, kBlock, out + x);
+    }
+  }
+  RemapPixels(src, xy + 2 * x, frac + x, width - x, out + x);
+}
+
+ROVO_TARGET_AVX2 void RemapAvx2(const cv::Mat& src, const cv::Mat& map_fixed, const cv::Mat& map_frac, cv::Mat* dst) {
+  const Avx2Row row = MakeAvx2Row(src);
+  for (int y = 0; y < map_fixed.rows; ++y) {
+    RemapRowAvx2(src, row, map_fixed.ptr<int16_t>(y), map_frac.ptr<uint16_t>(y), map_fixed.cols, dst->ptr<uint8_t>(y));
+  }
+}
+
+bool Applies(const cv::Mat& src, const cv::Mat& map_fixed, const cv::Mat& map_frac, const cv::Mat& dst) {
+  return CpuHasAvx2() && src.type() == CV_8UC1 && !src.empty() && src.step < 0x8000 &&
+         map_fixed.type() == CV_16SC2 && map_frac.type() == CV_16UC1 && map_fixed.size() == map_frac.size() &&
+         dst.data != src.data;
+}
+
+}  // namespace
+
+void RemapBilinearGray(const cv::Mat& src, const cv::Mat& map_fixed, const cv::Mat& map_frac, cv::Mat* dst) {
+  if (!Applies(src, map_fixed, map_frac, *dst)) {
+    cv::remap(src, *dst, map_fixed, map_frac, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+    return;
+  }
+  dst->create(map_fixed.size(), CV_8UC1);
+  RemapAvx2(src, map_fixed, map_frac, dst);
+}
+
+}  // namespace rovo
