@@ -15,7 +15,7 @@ constexpr int kTabSize = 32;  // fractions of a pixel per axis (INTER_TAB_SIZE)
 constexpr int kTabEntries = kTabSize * kTabSize;
 constexpr int kCoefBits = 15;  // INTER_REMAP_COEF_BITS
 constexpr int kCoefScale = 1 << kCoefBits;
-constexpr int kBlock = 16;  // pixels per AVX2 step: two gathers of eight
+constexpr int kBlock = 16;  // pixels per AVX2 step: two steps of eight
 
 // OpenCV's BilinearTab_i: entry fy * 32 + fx holds the weights of the taps (sx, sy), (sx + 1, sy),
 // (sx, sy + 1), (sx + 1, sy + 1), each rounded to 15 bits, then their sum corrected to 2^15 as
@@ -24,8 +24,6 @@ constexpr int kBlock = 16;  // pixels per AVX2 step: two gathers of eight
 // fills in order, and overwritten after), hence the spare zeros past the last entry.
 struct WeightTable {
   std::array<int16_t, kTabEntries * 4 + 4> weights{};
-  // The same weights as int16 pairs for the gathers: (w0, w1) of the top row, (w2, w3) of the bottom.
-  std::array<int32_t, kTabEntries> top{}, bottom{};
 };
 
 void CorrectSum(int16_t* w, int sum) {
@@ -66,15 +64,6 @@ WeightTable BuildWeightTable() {
       }
     }
     CorrectSum(w, sum);
-  }
-  for (int entry = 0; entry < kTabEntries; ++entry) {
-    const int16_t* w = table.weights.data() + 4 * entry;
-    const auto pair = [](int16_t low, int16_t high) {
-      return static_cast<int32_t>(static_cast<uint32_t>(static_cast<uint16_t>(low)) |
-                                  (static_cast<uint32_t>(static_cast<uint16_t>(high)) << 16));
-    };
-    table.top[entry] = pair(w[0], w[1]);
-    table.bottom[entry] = pair(w[2], w[3]);
   }
   return table;
 }
@@ -122,8 +111,12 @@ ROVO_TARGET_AVX2 inline Avx2Row MakeAvx2Row(const cv::Mat& src) {
   const int step = static_cast<int>(src.step);
   const __m256i spread = _mm256_setr_epi8(0, -1, 1, -1, 4, -1, 5, -1, 8, -1, 9, -1, 12, -1, 13, -1,  //
                                           0, -1, 1, -1, 4, -1, 5, -1, 8, -1, 9, -1, 12, -1, 13, -1);
-  return {src.data, src.data + step, _mm256_set1_epi32((step << 16) | 1), _mm256_set1_epi32(src.cols - 1),
-          _mm256_set1_epi32(src.rows - 2), spread};
+  return {src.data,
+          src.data + step,
+          _mm256_set1_epi32((step << 16) | 1),
+          _mm256_set1_epi32(src.cols - 1),
+          _mm256_set1_epi32(src.rows - 2),
+          spread};
 }
 
 // Whether the eight (sx, sy) pairs of `xy` lie where the gathers may read: sx in [0, cols - 2], sy in
@@ -132,23 +125,41 @@ ROVO_TARGET_AVX2 inline bool EightInside(const Avx2Row& row, __m256i xy) {
   const __m256i sx = _mm256_srai_epi32(_mm256_slli_epi32(xy, 16), 16);
   const __m256i sy = _mm256_srai_epi32(xy, 16);
   const __m256i minus_one = _mm256_set1_epi32(-1);
-  const __m256i inside = _mm256_and_si256(
-      _mm256_and_si256(_mm256_cmpgt_epi32(sx, minus_one), _mm256_cmpgt_epi32(row.x_limit, sx)),
-      _mm256_and_si256(_mm256_cmpgt_epi32(sy, minus_one), _mm256_cmpgt_epi32(row.y_limit, sy)));
+  const __m256i inside =
+      _mm256_and_si256(_mm256_and_si256(_mm256_cmpgt_epi32(sx, minus_one), _mm256_cmpgt_epi32(row.x_limit, sx)),
+                       _mm256_and_si256(_mm256_cmpgt_epi32(sy, minus_one), _mm256_cmpgt_epi32(row.y_limit, sy)));
   return _mm256_movemask_epi8(inside) == -1;
 }
 
+// 32 v in both int16 halves of each int32 lane (v <= 32).
+ROVO_TARGET_AVX2 inline __m256i BothHalvesTimes32(__m256i v) {
+  return _mm256_or_si256(_mm256_slli_epi32(v, 5), _mm256_slli_epi32(v, 21));
+}
+
+// The table's weights of eight fraction indices as int16 pairs, (w0, w1) and (w2, w3), computed rather
+// than loaded (loads compete with the pixels' gathers): every product (1 - fy)(1 - fx) ... of multiples
+// of 1/32 is exact in float, so w0 = 32 (32 - fx)(32 - fy), w1 = 32 fx (32 - fy), w2 = 32 (32 - fx) fy,
+// w3 = 32 fx fy, except entry 0, whose 2^15 became 32767 and 1 (unit test EveryWeightEntry...).
+ROVO_TARGET_AVX2 inline void EightWeights(__m128i frac, __m256i* top, __m256i* bottom) {
+  const __m256i entry = _mm256_and_si256(_mm256_cvtepu16_epi32(frac), _mm256_set1_epi32(kTabEntries - 1));
+  const __m256i fx = _mm256_and_si256(entry, _mm256_set1_epi32(kTabSize - 1));
+  const __m256i fy = _mm256_srli_epi32(entry, 5);
+  const __m256i gx = _mm256_sub_epi32(_mm256_set1_epi32(kTabSize), fx);
+  const __m256i gy = _mm256_sub_epi32(_mm256_set1_epi32(kTabSize), fy);
+  const __m256i x_pair = _mm256_or_si256(gx, _mm256_slli_epi32(fx, 16));  // (32 - fx, fx)
+  const __m256i is_zero = _mm256_cmpeq_epi32(entry, _mm256_setzero_si256());
+  *top =
+      _mm256_blendv_epi8(_mm256_mullo_epi16(x_pair, BothHalvesTimes32(gy)), _mm256_set1_epi32(kCoefScale - 1), is_zero);
+  *bottom = _mm256_blendv_epi8(_mm256_mullo_epi16(x_pair, BothHalvesTimes32(fy)), _mm256_set1_epi32(1 << 16), is_zero);
+}
+
 // Eight pixels, as int32: (sum of tap * weight + 2^14) >> 15.
-ROVO_TARGET_AVX2 inline __m256i EightPixels(const Avx2Row& row, const WeightTable& table, __m256i xy,
-                                            const uint16_t* frac) {
+ROVO_TARGET_AVX2 inline __m256i EightPixels(const Avx2Row& row, __m256i xy, const uint16_t* frac) {
   const __m256i offset = _mm256_madd_epi16(xy, row.offset_of_pair);
   const __m256i top = _mm256_i32gather_epi32(reinterpret_cast<const int*>(row.top_row), offset, 1);
   const __m256i bottom = _mm256_i32gather_epi32(reinterpret_cast<const int*>(row.bottom_row), offset, 1);
-  const __m256i entry = _mm256_and_si256(
-      _mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(frac))),
-      _mm256_set1_epi32(kTabEntries - 1));
-  const __m256i top_weights = _mm256_i32gather_epi32(table.top.data(), entry, 4);
-  const __m256i bottom_weights = _mm256_i32gather_epi32(table.bottom.data(), entry, 4);
+  __m256i top_weights, bottom_weights;
+  EightWeights(_mm_loadu_si128(reinterpret_cast<const __m128i*>(frac)), &top_weights, &bottom_weights);
   const __m256i sum = _mm256_add_epi32(_mm256_madd_epi16(_mm256_shuffle_epi8(top, row.spread), top_weights),
                                        _mm256_madd_epi16(_mm256_shuffle_epi8(bottom, row.spread), bottom_weights));
   return _mm256_srai_epi32(_mm256_add_epi32(sum, _mm256_set1_epi32(1 << (kCoefBits - 1))), kCoefBits);
@@ -163,14 +174,12 @@ ROVO_TARGET_AVX2 inline void StoreSixteen(__m256i first, __m256i second, uint8_t
 
 ROVO_TARGET_AVX2 void RemapRowAvx2(const cv::Mat& src, const Avx2Row& row, const int16_t* xy, const uint16_t* frac,
                                    int width, uint8_t* out) {
-  const WeightTable& table = Weights();
   int x = 0;
   for (; x + kBlock <= width; x += kBlock) {
     const __m256i xy_first = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(xy + 2 * x));
     const __m256i xy_second = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(xy + 2 * x + 16));
     if (EightInside(row, xy_first) && EightInside(row, xy_second)) {
-      StoreSixteen(EightPixels(row, table, xy_first, frac + x), EightPixels(row, table, xy_second, frac + x + 8),
-                   out + x);
+      StoreSixteen(EightPixels(row, xy_first, frac + x), EightPixels(row, xy_second, frac + x + 8), out + x);
     } else {
       RemapPixels(src, xy + 2 * x, frac + x, kBlock, out + x);
     }
@@ -186,9 +195,8 @@ ROVO_TARGET_AVX2 void RemapAvx2(const cv::Mat& src, const cv::Mat& map_fixed, co
 }
 
 bool Applies(const cv::Mat& src, const cv::Mat& map_fixed, const cv::Mat& map_frac, const cv::Mat& dst) {
-  return CpuHasAvx2() && src.type() == CV_8UC1 && !src.empty() && src.step < 0x8000 &&
-         map_fixed.type() == CV_16SC2 && map_frac.type() == CV_16UC1 && map_fixed.size() == map_frac.size() &&
-         dst.data != src.data;
+  return CpuHasAvx2() && src.type() == CV_8UC1 && !src.empty() && src.step < 0x8000 && map_fixed.type() == CV_16SC2 &&
+         map_frac.type() == CV_16UC1 && map_fixed.size() == map_frac.size() && dst.data != src.data;
 }
 
 }  // namespace

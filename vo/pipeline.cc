@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <future>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -171,6 +172,52 @@ void ApplyBaUpdate(const VoBackend::BaUpdate& update, const std::vector<Rigid3>&
   }
 }
 
+// The front-end's side of a frame: its images (the wait for them) and their features.
+struct FrontendStep {
+  LoadedFrame loaded;
+  FrontendFrame features;
+  double ms_load = 0.0;
+};
+
+// The front-end's steps, frame by frame in order. With async BA, frame k + 1's step runs on its own
+// thread beside frame k's back-end (Start, then Take): it sees the extrinsics it would see in turn, as the
+// back-end changes them only when it joins a BA (VoBackend::FinishPendingBa, before Start). With
+// synchronous BA, the back-end changes them in ProcessFrame, so the steps run in turn (Take computes).
+class FrontendFeed {
+ public:
+  FrontendFeed(const VoOptions& options, const FrameReader& reader, Frontend* frontend, int begin, int end)
+      : options_(options),
+        frontend_(frontend),
+        begin_(begin),
+        preloaded_(options.io.preload ? PreloadImages(options, reader, begin, end) : std::vector<LoadedFrame>{}),
+        prefetcher_(reader, begin, options.io.preload ? begin : end) {}
+  FrontendFeed(const FrontendFeed&) = delete;
+  FrontendFeed& operator=(const FrontendFeed&) = delete;
+
+  bool overlaps() const { return options_.backend.async_ba; }
+  void Start(int frame) {
+    if (overlaps()) next_ = std::async(std::launch::async, [this, frame] { return Run(frame); });
+  }
+  FrontendStep Take(int frame) { return next_.valid() ? next_.get() : Run(frame); }
+
+ private:
+  FrontendStep Run(int frame) {
+    FrontendStep step;
+    const auto start = Clock::now();
+    step.loaded = options_.io.preload ? std::move(preloaded_[frame - begin_]) : prefetcher_.Get(frame);
+    step.ms_load = MsSince(start);
+    step.features = frontend_->Process(step.loaded.images);
+    return step;
+  }
+
+  const VoOptions& options_;
+  Frontend* frontend_;
+  int begin_;
+  std::vector<LoadedFrame> preloaded_;
+  ImagePrefetcher prefetcher_;
+  std::future<FrontendStep> next_;  // joined by its destructor if a back-end step throws
+};
+
 // The cameras whose image was missing or unreadable, in the record and the summary.
 void NoteMissingImages(const LoadedFrame& loaded, FrameRecord* rec, VoSummary* summary) {
   for (int cam : loaded.missing_cameras) {
@@ -331,30 +378,32 @@ VoSummary RunVo(const VoOptions& options) {
   int total_hypotheses = 0;
   double ok_ratio_sum = 0.0, ok_error_sum = 0.0;
   Progress progress("vo " + ExtrinsicsModeName(options.start.mode), end - begin, "frames", options.io.quiet);
-  std::vector<LoadedFrame> preloaded;
-  if (options.io.preload) preloaded = PreloadImages(options, reader, begin, end);
-  ImagePrefetcher prefetcher(reader, begin, options.io.preload ? begin : end);
+  FrontendFeed feed(options, reader, &frontend, begin, end);
+  const bool online = options.start.mode == ExtrinsicsMode::kOnline;
+  auto frame_start = Clock::now();
+  FrontendStep step = feed.Take(begin);
   for (int frame = begin; frame < end; ++frame) {
-    const auto frame_start = Clock::now();
-    const LoadedFrame loaded = options.io.preload ? std::move(preloaded[frame - begin]) : prefetcher.Get(frame);
-    ms.load += MsSince(frame_start);
-    if (!loaded.problems.empty() && !options.io.quiet) {
-      std::fprintf(stderr, "vo: frame %d: %s\n", frame, loaded.problems.c_str());
+    ms.load += step.ms_load;
+    if (!step.loaded.problems.empty() && !options.io.quiet) {
+      std::fprintf(stderr, "vo: frame %d: %s\n", frame, step.loaded.problems.c_str());
     }
-    const FrontendFrame features = frontend.Process(loaded.images);  // beside the previous keyframe's BA
     const auto backend_start = Clock::now();
     if (auto update = backend.FinishPendingBa()) ApplyBaUpdate(*update, backend.cam_from_rig(), &run, &ms);
-    BackendFrameResult result = backend.ProcessFrame(frame, features);
+    if (online && feed.overlaps()) frontend.SetExtrinsics(backend.cam_from_rig());
+    if (frame + 1 < end) feed.Start(frame + 1);  // beside this frame's back-end (with async BA)
+    BackendFrameResult result = backend.ProcessFrame(frame, step.features);
     ms.backend_total += MsSince(backend_start);
-    if (options.start.mode == ExtrinsicsMode::kOnline) frontend.SetExtrinsics(backend.cam_from_rig());
-    AddStageTimes(features, result, &ms);
+    if (online && !feed.overlaps()) frontend.SetExtrinsics(backend.cam_from_rig());
+    AddStageTimes(step.features, result, &ms);
     total_hypotheses += result.ransac_hypotheses;
+    FrontendStep next = frame + 1 < end ? feed.Take(frame + 1) : FrontendStep{};
 
     FrameRecord rec = result.record;
-    NoteMissingImages(loaded, &rec, &summary);
+    NoteMissingImages(step.loaded, &rec, &summary);
     rec.frame = frame;
     rec.timestamp = timestamp_of(frame);
-    rec.time_ms = MsSince(frame_start);
+    rec.time_ms = MsSince(frame_start);  // from the previous frame's end: the sum is the loop's time
+    frame_start = Clock::now();
     ms.total += rec.time_ms;
     CountFrame(rec, &summary, &ok_ratio_sum, &ok_error_sum);
     run.frames.push_back(rec);
@@ -363,6 +412,7 @@ VoSummary RunVo(const VoOptions& options) {
       run.extrinsics.push_back({frame, rec.timestamp, vo_cameras[static_cast<size_t>(j)], backend.cam_from_rig()[j]});
     }
     progress.Add();
+    step = std::move(next);
   }
   if (auto update = backend.FinishPendingBa()) ApplyBaUpdate(*update, backend.cam_from_rig(), &run, &ms);
   progress.Finish();
