@@ -227,6 +227,16 @@ void NoteMissingImages(const LoadedFrame& loaded, FrameRecord* rec, VoSummary* s
   summary->frames_with_missing_images += loaded.missing_cameras.empty() ? 0 : 1;
 }
 
+// A frame's record, pose and extrinsics (camera j is dataset camera vo_cameras[j]) into the run's files.
+void AddToRun(const FrameRecord& rec, const Rigid3& world_from_rig, const std::vector<int>& vo_cameras,
+              const std::vector<Rigid3>& cam_from_rig, RunData* run) {
+  run->frames.push_back(rec);
+  run->trajectory.push_back({rec.timestamp, world_from_rig});
+  for (size_t j = 0; j < cam_from_rig.size(); ++j) {
+    run->extrinsics.push_back({rec.frame, rec.timestamp, vo_cameras[j], cam_from_rig[j]});
+  }
+}
+
 // Counts a frame by status; "ok" frames add to the sums of inlier ratio and error.
 void CountFrame(const FrameRecord& rec, VoSummary* summary, double* ok_ratio_sum, double* ok_error_sum) {
   ++summary->frames;
@@ -347,7 +357,6 @@ VoSummary RunVo(const VoOptions& options) {
   options.Check();
   std::vector<int> vo_cameras;
   const DatasetInfo info = DatasetForVo(options, &vo_cameras);
-  const int num_cams = info.rig.NumCameras();
   const int begin = options.io.frames.begin;
   const int end = options.io.frames.end < 0 ? info.frame_count : options.io.frames.end;
   CheckRangeAndFolders(options, info, begin, end);
@@ -406,11 +415,7 @@ VoSummary RunVo(const VoOptions& options) {
     frame_start = Clock::now();
     ms.total += rec.time_ms;
     CountFrame(rec, &summary, &ok_ratio_sum, &ok_error_sum);
-    run.frames.push_back(rec);
-    run.trajectory.push_back({rec.timestamp, result.world_from_rig});
-    for (int j = 0; j < num_cams; ++j) {
-      run.extrinsics.push_back({frame, rec.timestamp, vo_cameras[static_cast<size_t>(j)], backend.cam_from_rig()[j]});
-    }
+    AddToRun(rec, result.world_from_rig, vo_cameras, backend.cam_from_rig(), &run);
     progress.Add();
     step = std::move(next);
   }

@@ -20,7 +20,7 @@ struct VoStageTimes {
   double ba = 0;       // keyframe BA solve (on its own thread with async BA)
   double ba_wait = 0;  // time the pipeline waited for an async BA to finish
   double ransac_us_per_hypothesis = 0;
-  double total = 0;  // whole frame incl. loading
+  double total = 0;  // whole frame: the loop's time per frame (a front-end runs beside the previous back-end)
 };
 
 struct VoSummary {

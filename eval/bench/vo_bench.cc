@@ -17,11 +17,11 @@ namespace rovo {
 
 // Machine reference printed with the bench table: full-size hybrid warps by cv::remap itself (rovo4,
 // camera 0, its fixed-point maps, a fixed random image; the front-end's own warp is faster,
-// vo/bilinear_remap.h, and would move the unit), one per core on `cores` cores at once (shared caches and memory bandwidth included),
-// median wall time of 31 rounds after 9 warm-up rounds (single rounds vary by 2x on this machine, the
-// median by about 10 % between seconds). Measured before and after the run: the machine's speed
-// drifts by a third or more between hours (the one-core warp took 6.8 ms one evening, 10.5 ms
-// another), so runs are comparable only when their references agree.
+// vo/bilinear_remap.h, and would move the unit), one per core on `cores` cores at once (shared caches and memory
+// bandwidth included), median wall time of 31 rounds after 9 warm-up rounds (single rounds vary by 2x on this machine,
+// the median by about 10 % between seconds). Measured before and after the run: the machine's speed drifts by a third
+// or more between hours (the one-core warp took 6.8 ms one evening, 10.5 ms another), so runs are comparable only when
+// their references agree.
 double MachineReferenceWarpMs(int cores) {
   const Rig rig = MakeRigPreset("rovo4");
   const std::vector<HybridLayout> layouts = ComputeHybridLayouts(rig);
@@ -36,7 +36,8 @@ double MachineReferenceWarpMs(int cores) {
     const auto start = std::chrono::steady_clock::now();
     std::vector<std::thread> workers;
     workers.reserve(static_cast<size_t>(cores));
-    for (int c = 0; c < cores; ++c) workers.emplace_back([&, c] {
+    for (int c = 0; c < cores; ++c)
+      workers.emplace_back([&, c] {
         cv::remap(image, warped[c], projection.map_fixed(), projection.map_frac(), cv::INTER_LINEAR,
                   cv::BORDER_CONSTANT, cv::Scalar::all(0));
       });
@@ -97,14 +98,18 @@ void RunVoBenchmark(VoOptions options) {
                 s.startup_ms, s.startup_ms / reference_ms, s.startup_cpu_ms);
   }
   std::printf("RANSAC: %.2f us per hypothesis\n", t.ransac_us_per_hypothesis);
-  std::printf("local BA: %s\n", options.backend.async_ba ? "solved on its own thread beside the next frame's front-end "
-                                                           "(in-line total = wait for it + the rest)"
-                                                         : "solved in line (--sync-ba)");
+  std::printf("local BA: %s\n",
+              options.backend.async_ba
+                  ? "solved on its own thread beside the next frame's front-end (in-line total = wait "
+                    "for it + the rest); the next frame's front-end runs beside the back-end, so the "
+                    "whole frame is less than the two totals"
+                  : "solved in line (--sync-ba), front-end and back-end in turn");
   std::printf("whole pipeline: %.2f frames/s (target 10 Hz), %.2f machine refs per frame%s\n",
               t.total > 0 ? 1000.0 / t.total : 0.0, t.total / reference_ms,
               options.io.preload ? ", images decoded beforehand" : ", images decoded on a second thread");
   std::printf(
-      "machine reference: one full-size hybrid warp by cv::remap per core on %d core%s at once: %.2f ms before the run, "
+      "machine reference: one full-size hybrid warp by cv::remap per core on %d core%s at once: %.2f ms before the "
+      "run, "
       "%.2f ms after\n",
       cores, cores == 1 ? "" : "s", reference_before_ms, reference_after_ms);
   const double reference_low_ms = std::min(reference_before_ms, reference_after_ms);

@@ -221,7 +221,8 @@ void RunVoFloorBenchmark(VoOptions options) {
   const double reference_after_ms = MachineReferenceWarpMs(threads);
   PrintFloorTable(frontend_ms, floor_ms, end - begin, threads);
   std::printf(
-      "machine reference: one full-size hybrid warp by cv::remap per core on %d core%s at once: %.2f ms before, %.2f ms after\n",
+      "machine reference: one full-size hybrid warp by cv::remap per core on %d core%s at once: %.2f ms before, %.2f "
+      "ms after\n",
       threads, threads == 1 ? "" : "s", reference_before_ms, reference_after_ms);
 }
 
