@@ -33,7 +33,7 @@ struct FrameRecord {
   double mean_reproj_error_deg = 0.0;  // mean angular error of inliers after refinement
   bool keyframe = false;
   FrameStatus status = FrameStatus::kOk;
-  double time_ms = 0.0;         // wall time of the frame in the run (from the previous frame's end)
+  double time_ms = 0.0;         // wall time from the previous frame's end to this frame's (its back-end done)
   std::string missing_cameras;  // cameras whose image was missing or unreadable, "1;3"; "" when none
 };
 

@@ -194,15 +194,17 @@ ROVO_TARGET_AVX2 void RemapAvx2(const cv::Mat& src, const cv::Mat& map_fixed, co
   }
 }
 
-bool Applies(const cv::Mat& src, const cv::Mat& map_fixed, const cv::Mat& map_frac, const cv::Mat& dst) {
-  return CpuHasAvx2() && src.type() == CV_8UC1 && !src.empty() && src.step < 0x8000 && map_fixed.type() == CV_16SC2 &&
-         map_frac.type() == CV_16UC1 && map_fixed.size() == map_frac.size() && dst.data != src.data;
-}
-
 }  // namespace
 
+bool RemapBilinearGrayApplies(const cv::Mat& src, const cv::Mat& map_fixed, const cv::Mat& map_frac,
+                              const cv::Mat& dst) {
+  return CpuHasAvx2() && src.type() == CV_8UC1 && !src.empty() && src.step < 0x8000 && !map_fixed.empty() &&
+         map_fixed.type() == CV_16SC2 && map_frac.type() == CV_16UC1 && map_fixed.size() == map_frac.size() &&
+         dst.data != src.data;
+}
+
 void RemapBilinearGray(const cv::Mat& src, const cv::Mat& map_fixed, const cv::Mat& map_frac, cv::Mat* dst) {
-  if (!Applies(src, map_fixed, map_frac, *dst)) {
+  if (!RemapBilinearGrayApplies(src, map_fixed, map_frac, *dst)) {
     cv::remap(src, *dst, map_fixed, map_frac, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
     return;
   }

@@ -6,7 +6,7 @@
 // position (sx, sy), map_frac the index fy * 32 + fx of its fraction in 1/32 px; the four taps' weights
 // are a 1024-entry table of 15-bit integers, and the pixel is (sum of tap * weight + 2^14) >> 15, with
 // taps outside the image taken as the border value 0. Integer sums do not depend on their order, so
-// eight pixels at a time give the same bytes as OpenCV's four and its one-by-one border loop.
+// sixteen pixels at a time give the same bytes as OpenCV's eight and its one-by-one border loop.
 
 #include <opencv2/core.hpp>
 
@@ -17,5 +17,9 @@ namespace rovo {
 // on a CPU with AVX2 (a row step below 32768 bytes, as OpenCV's SIMD path needs); by OpenCV otherwise.
 // `dst` gets the maps' size (a region of that size is written in place).
 void RemapBilinearGray(const cv::Mat& src, const cv::Mat& map_fixed, const cv::Mat& map_frac, cv::Mat* dst);
+
+// Whether RemapBilinearGray computes these arguments itself (else it calls cv::remap).
+bool RemapBilinearGrayApplies(const cv::Mat& src, const cv::Mat& map_fixed, const cv::Mat& map_frac,
+                              const cv::Mat& dst);
 
 }  // namespace rovo

@@ -119,8 +119,8 @@ void BM_HybridWarpOneViewOpenCv(benchmark::State& state) {
 }
 BENCHMARK(BM_HybridWarpOneViewOpenCv)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// The same warp in bands of state.range(0) rows, one after the other on one thread (the front-end
-// warps bands in parallel): cv::remap's blocks follow the band's shape (HybridProjection::kWarpBandRows).
+// The same warp in bands of state.range(0) rows through WarpRows (RemapBilinearGray where the CPU has
+// AVX2), one after the other on one thread (the front-end warps bands in parallel).
 void BM_HybridWarpOneViewInBands(benchmark::State& state) {
   const Rig rig = MakeRigPreset("rovo4");
   const auto projections = HybridProjection::ForRig(rig);

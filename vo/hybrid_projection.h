@@ -134,8 +134,8 @@ class HybridProjection {
   // parallel.
   void WarpRows(const cv::Mat& fisheye, int first_row, int last_row, cv::Mat* warped) const;
   // Rows per band for WarpRows: tasks an idle thread can take from another view. RemapBilinearGray
-  // costs the same in bands of any height; cv::remap (the floor's warp) is cheapest in 8-row bands, where
-  // its blocks are 8 x 2048 (BM_HybridWarpOneViewInBands, docs/design-notes.md).
+  // costs about the same in bands of any height (BM_HybridWarpOneViewInBands); cv::remap (the floor's
+  // warp) is cheapest in 8-row bands, where its blocks are 8 x 2048 (docs/design-notes.md).
   static constexpr int kWarpBandRows = 8;
   // CV_8U, 255 where the warped pixel maps into the fisheye's valid area.
   const cv::Mat& valid_mask() const { return valid_mask_; }

@@ -390,22 +390,23 @@ VoSummary RunVo(const VoOptions& options) {
   FrontendFeed feed(options, reader, &frontend, begin, end);
   const bool online = options.start.mode == ExtrinsicsMode::kOnline;
   auto frame_start = Clock::now();
-  FrontendStep step = feed.Take(begin);
   for (int frame = begin; frame < end; ++frame) {
+    const FrontendStep step = feed.Take(frame);  // started beside the previous frame's back-end, or computed now
     ms.load += step.ms_load;
     if (!step.loaded.problems.empty() && !options.io.quiet) {
       std::fprintf(stderr, "vo: frame %d: %s\n", frame, step.loaded.problems.c_str());
     }
-    const auto backend_start = Clock::now();
+    auto backend_start = Clock::now();
     if (auto update = backend.FinishPendingBa()) ApplyBaUpdate(*update, backend.cam_from_rig(), &run, &ms);
+    ms.backend_total += MsSince(backend_start);
     if (online && feed.overlaps()) frontend.SetExtrinsics(backend.cam_from_rig());
     if (frame + 1 < end) feed.Start(frame + 1);  // beside this frame's back-end (with async BA)
+    backend_start = Clock::now();
     BackendFrameResult result = backend.ProcessFrame(frame, step.features);
     ms.backend_total += MsSince(backend_start);
     if (online && !feed.overlaps()) frontend.SetExtrinsics(backend.cam_from_rig());
     AddStageTimes(step.features, result, &ms);
     total_hypotheses += result.ransac_hypotheses;
-    FrontendStep next = frame + 1 < end ? feed.Take(frame + 1) : FrontendStep{};
 
     FrameRecord rec = result.record;
     NoteMissingImages(step.loaded, &rec, &summary);
@@ -417,7 +418,6 @@ VoSummary RunVo(const VoOptions& options) {
     CountFrame(rec, &summary, &ok_ratio_sum, &ok_error_sum);
     AddToRun(rec, result.world_from_rig, vo_cameras, backend.cam_from_rig(), &run);
     progress.Add();
-    step = std::move(next);
   }
   if (auto update = backend.FinishPendingBa()) ApplyBaUpdate(*update, backend.cam_from_rig(), &run, &ms);
   progress.Finish();

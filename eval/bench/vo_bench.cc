@@ -61,8 +61,9 @@ void RunVoBenchmark(VoOptions options) {
   std::printf("rovo bench vo: %s, mode %s, %d frames, threads %d\n", options.io.dataset_dir.c_str(),
               ExtrinsicsModeName(options.start.mode).c_str(), s.frames, options.io.threads);
   // CPU = process CPU time of all threads (FrontendFrame::cpu_ms_*); measured for the front-end only. It
-  // includes the image decoder and an async BA running meanwhile: use --preload --sync-ba for the
-  // front-end's own CPU time.
+  // includes the image decoder and, with async BA, the BA and the previous frame's back-end running
+  // meanwhile: use --preload --sync-ba for the front-end's own CPU time. "load images (wait)" is the
+  // front-end's wait for its frame's images.
   // Ratios against the mean of the two references: what stays comparable between machines and hours.
   const double reference_ms = 0.5 * (reference_before_ms + reference_after_ms);
   std::printf(

@@ -72,7 +72,7 @@ class Floor {
       (*ms)[stage] += now - start;
       start = now;
     };
-    // cv::remap in bands of rows, as the front-end calls it (HybridProjection::kWarpBandRows).
+    // cv::remap in the front-end's bands of rows (HybridProjection::kWarpBandRows).
     cv::Mat warped(projection.height(), projection.width(), fisheye.type());
     for (int first = 0; first < warped.rows; first += HybridProjection::kWarpBandRows) {
       const int last = std::min(first + HybridProjection::kWarpBandRows, warped.rows);

@@ -1,11 +1,15 @@
 #include "vo/bilinear_remap.h"
 
 #include <gtest/gtest.h>
+#include <sys/mman.h>
+#include <unistd.h>
 
 #include <cstdint>
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "datasets/rig.h"
+#include "vo/cpu_dispatch.h"
 #include "vo/hybrid_projection.h"
 
 namespace rovo {
@@ -82,6 +86,74 @@ TEST(BilinearRemap, LastRowsAndColumnsOfARegionAtTheBuffersEnd) {
     RandomMaps(16, 1024, cv::Rect2i(src->cols - 4, src->rows - 4, 4, 4), 7, &map_fixed, &map_frac);
     ExpectSameAsOpenCv(*src, map_fixed, map_frac);
   }
+}
+
+// One row per position: 16-pixel blocks (the AVX2 step) all at `positions[r]`, fractions 0, 67, 134, ...
+void BlockMaps(const std::vector<cv::Vec2s>& positions, cv::Mat* map_fixed, cv::Mat* map_frac) {
+  const int cols = 64;  // four blocks
+  map_fixed->create(static_cast<int>(positions.size()), cols, CV_16SC2);
+  map_frac->create(static_cast<int>(positions.size()), cols, CV_16UC1);
+  for (int y = 0; y < map_fixed->rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      map_fixed->at<cv::Vec2s>(y, x) = positions[static_cast<size_t>(y)];
+      map_frac->at<uint16_t>(y, x) = static_cast<uint16_t>((67 * (x + cols * y)) % 1024);
+    }
+  }
+}
+
+TEST(BilinearRemap, BlocksAtTheLimitsOfTheGathers) {
+  // Whole blocks at the last position the gathers serve (cols - 2, rows - 3) and just beyond it, where
+  // the pixels take OpenCV's border rule.
+  const cv::Mat src = Noise(45, 33, 16);
+  const int c = src.cols, r = src.rows;
+  cv::Mat map_fixed, map_frac;
+  BlockMaps({{0, 0},
+             {static_cast<int16_t>(c - 2), static_cast<int16_t>(r - 3)},
+             {static_cast<int16_t>(c - 1), static_cast<int16_t>(r - 3)},
+             {static_cast<int16_t>(c - 2), static_cast<int16_t>(r - 2)},
+             {static_cast<int16_t>(c - 1), static_cast<int16_t>(r - 1)},
+             {-1, 0},
+             {0, -1},
+             {static_cast<int16_t>(c), 0}},
+            &map_fixed, &map_frac);
+  if (CpuHasAvx2()) {
+    EXPECT_TRUE(RemapBilinearGrayApplies(src, map_fixed, map_frac, cv::Mat()));
+  }
+  ExpectSameAsOpenCv(src, map_fixed, map_frac);
+}
+
+TEST(BilinearRemap, GathersStayInsideAnImageThatEndsAtAnUnreadablePage) {
+  // A 64 x 64 continuous image filling one page, followed by a page that may not be read: every block
+  // at the gathers' last position (and beyond it, where the pixels go one by one) reads inside.
+  const long page = sysconf(_SC_PAGESIZE);
+  ASSERT_EQ(page % 64, 0);
+  const int side = 64;
+  const size_t bytes = static_cast<size_t>(side) * side;
+  const size_t span = (bytes + static_cast<size_t>(page) - 1) / static_cast<size_t>(page) * static_cast<size_t>(page);
+  void* base =
+      mmap(nullptr, span + static_cast<size_t>(page), PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  ASSERT_NE(base, MAP_FAILED);
+  uint8_t* guard = static_cast<uint8_t*>(base) + span;
+  ASSERT_EQ(mprotect(guard, static_cast<size_t>(page), PROT_NONE), 0);
+  cv::Mat src(side, side, CV_8UC1, guard - bytes);  // its last byte just before the guard
+  Noise(side, side, 17).copyTo(src);
+  cv::Mat map_fixed, map_frac;
+  BlockMaps({{side - 2, side - 3}, {side - 2, side - 2}, {side - 1, side - 1}}, &map_fixed, &map_frac);
+  ExpectSameAsOpenCv(src, map_fixed, map_frac);
+  munmap(base, span + static_cast<size_t>(page));
+}
+
+TEST(BilinearRemap, AppliesOnlyWhereItComputes) {
+  const cv::Mat gray = Noise(40, 30, 18);
+  cv::Mat map_fixed, map_frac;
+  RandomMaps(4, 20, cv::Rect2i(0, 0, 39, 29), 19, &map_fixed, &map_frac);
+  EXPECT_EQ(RemapBilinearGrayApplies(gray, map_fixed, map_frac, cv::Mat()), CpuHasAvx2());
+  EXPECT_FALSE(RemapBilinearGrayApplies(cv::Mat(30, 40, CV_8UC3), map_fixed, map_frac, cv::Mat()));
+  EXPECT_FALSE(RemapBilinearGrayApplies(gray, cv::Mat(4, 20, CV_32FC2), map_frac, cv::Mat()));
+  EXPECT_FALSE(RemapBilinearGrayApplies(gray, map_fixed, map_frac.colRange(0, 10), cv::Mat()));
+  EXPECT_FALSE(RemapBilinearGrayApplies(gray, cv::Mat(), cv::Mat(), cv::Mat()));
+  EXPECT_FALSE(RemapBilinearGrayApplies(gray, map_fixed, map_frac, gray));
+  EXPECT_FALSE(RemapBilinearGrayApplies(cv::Mat(2, 40000, CV_8UC1), map_fixed, map_frac, cv::Mat()));
 }
 
 TEST(BilinearRemap, WidthsOffTheStepAndFractionIndicesAbove1023) {
