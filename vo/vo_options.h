@@ -283,11 +283,11 @@ void VisitBackend(BackendOptions& backend, Visitor& visitor, int part) {
                        "Rig travel in metres that makes a keyframe (and a local BA; default 1, recorded in run.json)",
                        0.0, 100.0, false},
             backend.keyframes.min_translation_m);
-    visitor(
-        OptionSpec{"--sync-ba", "backend.async_ba",
-                   "Run each keyframe BA before the next frame's front-end instead of beside it (same GTExt/NoisyExt "
-                   "result, slower; OnlineExt's front-end then sees the calibration one frame earlier)"},
-        InvertedFlag{&backend.async_ba});
+    visitor(OptionSpec{"--sync-ba", "backend.async_ba",
+                       "Run each keyframe BA before the next frame's front-end instead of beside it, and each frame's "
+                       "front-end after the previous frame's back-end (same GTExt/NoisyExt result, slower; OnlineExt's "
+                       "front-end then sees the calibration one frame earlier)"},
+            InvertedFlag{&backend.async_ba});
   }
 }
 
