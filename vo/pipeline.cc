@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <future>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -195,13 +196,18 @@ class FrontendFeed {
   FrontendFeed& operator=(const FrontendFeed&) = delete;
 
   bool overlaps() const { return options_.backend.async_ba; }
-  void Start(int frame) {
-    if (overlaps()) next_ = std::async(std::launch::async, [this, frame] { return Run(frame); });
+  // With `cam_from_rig`, the step first hands the front-end these extrinsics (OnlineExt).
+  void Start(int frame, std::optional<std::vector<Rigid3>> cam_from_rig) {
+    if (overlaps()) {
+      next_ = std::async(std::launch::async,
+                         [this, frame, extrinsics = std::move(cam_from_rig)] { return Run(frame, extrinsics); });
+    }
   }
-  FrontendStep Take(int frame) { return next_.valid() ? next_.get() : Run(frame); }
+  FrontendStep Take(int frame) { return next_.valid() ? next_.get() : Run(frame, std::nullopt); }
 
  private:
-  FrontendStep Run(int frame) {
+  FrontendStep Run(int frame, const std::optional<std::vector<Rigid3>>& cam_from_rig) {
+    if (cam_from_rig) frontend_->SetExtrinsics(*cam_from_rig);
     FrontendStep step;
     const auto start = Clock::now();
     step.loaded = options_.io.preload ? std::move(preloaded_[frame - begin_]) : prefetcher_.Get(frame);
@@ -399,8 +405,8 @@ VoSummary RunVo(const VoOptions& options) {
     auto backend_start = Clock::now();
     if (auto update = backend.FinishPendingBa()) ApplyBaUpdate(*update, backend.cam_from_rig(), &run, &ms);
     ms.backend_total += MsSince(backend_start);
-    if (online && feed.overlaps()) frontend.SetExtrinsics(backend.cam_from_rig());
-    if (frame + 1 < end) feed.Start(frame + 1);  // beside this frame's back-end (with async BA)
+    // Beside this frame's back-end (with async BA), the next front-end with the extrinsics it would see in turn.
+    if (frame + 1 < end) feed.Start(frame + 1, online ? std::optional(backend.cam_from_rig()) : std::nullopt);
     backend_start = Clock::now();
     BackendFrameResult result = backend.ProcessFrame(frame, step.features);
     ms.backend_total += MsSince(backend_start);
