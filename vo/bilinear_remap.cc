@@ -2,7 +2,6 @@
 
 #include <immintrin.h>
 
-#include <array>
 #include <cstdint>
 #include <opencv2/imgproc.hpp>
 
@@ -17,65 +16,24 @@ constexpr int kCoefBits = 15;  // INTER_REMAP_COEF_BITS
 constexpr int kCoefScale = 1 << kCoefBits;
 constexpr int kBlock = 16;  // pixels per AVX2 step: two steps of eight
 
-// OpenCV's BilinearTab_i: entry fy * 32 + fx holds the weights of the taps (sx, sy), (sx + 1, sy),
-// (sx, sy + 1), (sx + 1, sy + 1), each rounded to 15 bits, then their sum corrected to 2^15 as
-// initInterTab2D does (only entry 0 needs it: its 2^15 saturates to 32767). That correction compares
-// four weights from the entry's last one on, three of them in the next entry (zero then, as the table
-// fills in order, and overwritten after), hence the spare zeros past the last entry.
-struct WeightTable {
-  std::array<int16_t, kTabEntries * 4 + 4> weights{};
+// OpenCV's weights (BilinearTab_i of initInterTab2D) of fraction entry fy * 32 + fx for the taps (sx, sy),
+// (sx + 1, sy), (sx, sy + 1), (sx + 1, sy + 1): each product of multiples of 1/32 is exact in float, so
+// its 15-bit rounding is 32 (32 - fx)(32 - fy), 32 fx (32 - fy), 32 (32 - fx) fy, 32 fx fy; only entry
+// 0's 2^15 saturates to 32767, and the table's sum correction makes its last weight 1.
+struct TapWeights {
+  int w[4];
 };
 
-void CorrectSum(int16_t* w, int sum) {
-  if (sum == kCoefScale) return;
-  const int diff = sum - kCoefScale;
-  int max_k = 3, min_k = 3;
-  for (int k1 = 1; k1 < 3; ++k1) {
-    for (int k2 = 1; k2 < 3; ++k2) {
-      const int k = k1 * 2 + k2;
-      if (w[k] < w[min_k]) {
-        min_k = k;
-      } else if (w[k] > w[max_k]) {
-        max_k = k;
-      }
-    }
-  }
-  const int k = diff < 0 ? max_k : min_k;
-  w[k] = static_cast<int16_t>(w[k] - diff);
-}
-
-WeightTable BuildWeightTable() {
-  WeightTable table;
-  std::array<float, 2 * kTabSize> linear{};  // (1 - f, f) per fraction f = i / 32
-  const float scale = 1.f / kTabSize;
-  for (int i = 0; i < kTabSize; ++i) {
-    linear[2 * i] = 1.f - static_cast<float>(i) * scale;
-    linear[2 * i + 1] = static_cast<float>(i) * scale;
-  }
-  for (int entry = 0; entry < kTabEntries; ++entry) {
-    int16_t* w = table.weights.data() + 4 * entry;
-    const int fy = entry / kTabSize, fx = entry % kTabSize;
-    int sum = 0;
-    for (int k1 = 0; k1 < 2; ++k1) {
-      for (int k2 = 0; k2 < 2; ++k2) {
-        const float v = linear[2 * fy + k1] * linear[2 * fx + k2];
-        w[k1 * 2 + k2] = cv::saturate_cast<int16_t>(v * static_cast<float>(kCoefScale));
-        sum += w[k1 * 2 + k2];
-      }
-    }
-    CorrectSum(w, sum);
-  }
-  return table;
-}
-
-const WeightTable& Weights() {
-  static const WeightTable table = BuildWeightTable();
-  return table;
+TapWeights WeightsOf(int entry) {
+  if (entry == 0) return {{kCoefScale - 1, 0, 0, 1}};
+  const int fx = entry % kTabSize, fy = entry / kTabSize, gx = kTabSize - fx, gy = kTabSize - fy;
+  return {{kTabSize * gx * gy, kTabSize * fx * gy, kTabSize * gx * fy, kTabSize * fx * fy}};
 }
 
 // One pixel as cv::remap's border loop computes it with BORDER_CONSTANT and the value 0: taps outside
 // the image count as 0.
-uint8_t PixelAt(const cv::Mat& src, int sx, int sy, const int16_t* w) {
+uint8_t PixelAt(const cv::Mat& src, int sx, int sy, const TapWeights& weights) {
+  const int* w = weights.w;
   int sum = 0;
   const auto tap = [&](int x, int y, int weight) {
     if (static_cast<unsigned>(x) < static_cast<unsigned>(src.cols) &&
@@ -91,10 +49,8 @@ uint8_t PixelAt(const cv::Mat& src, int sx, int sy, const int16_t* w) {
 }
 
 void RemapPixels(const cv::Mat& src, const int16_t* xy, const uint16_t* frac, int count, uint8_t* out) {
-  const WeightTable& table = Weights();
   for (int x = 0; x < count; ++x) {
-    const int16_t* w = table.weights.data() + 4 * (frac[x] & (kTabEntries - 1));
-    out[x] = PixelAt(src, xy[2 * x], xy[2 * x + 1], w);
+    out[x] = PixelAt(src, xy[2 * x], xy[2 * x + 1], WeightsOf(frac[x] & (kTabEntries - 1)));
   }
 }
 
@@ -136,10 +92,8 @@ ROVO_TARGET_AVX2 inline __m256i BothHalvesTimes32(__m256i v) {
   return _mm256_or_si256(_mm256_slli_epi32(v, 5), _mm256_slli_epi32(v, 21));
 }
 
-// The table's weights of eight fraction indices as int16 pairs, (w0, w1) and (w2, w3), computed rather
-// than loaded (loads compete with the pixels' gathers): every product (1 - fy)(1 - fx) ... of multiples
-// of 1/32 is exact in float, so w0 = 32 (32 - fx)(32 - fy), w1 = 32 fx (32 - fy), w2 = 32 (32 - fx) fy,
-// w3 = 32 fx fy, except entry 0, whose 2^15 became 32767 and 1 (unit test EveryWeightEntry...).
+// WeightsOf for eight fraction indices, as int16 pairs (w0, w1) and (w2, w3): computed, as a table's
+// loads would compete with the pixels' gathers.
 ROVO_TARGET_AVX2 inline void EightWeights(__m128i frac, __m256i* top, __m256i* bottom) {
   const __m256i entry = _mm256_and_si256(_mm256_cvtepu16_epi32(frac), _mm256_set1_epi32(kTabEntries - 1));
   const __m256i fx = _mm256_and_si256(entry, _mm256_set1_epi32(kTabSize - 1));
