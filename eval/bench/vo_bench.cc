@@ -103,15 +103,14 @@ void RunVoBenchmark(VoOptions options) {
               options.backend.async_ba
                   ? "solved on its own thread beside the next frame's front-end (in-line total = wait "
                     "for it + the rest); the next frame's front-end runs beside the back-end, so the "
-                    "whole frame is less than the two totals"
+                    "whole frame is less than the two totals' sum"
                   : "solved in line (--sync-ba), front-end and back-end in turn");
   std::printf("whole pipeline: %.2f frames/s (target 10 Hz), %.2f machine refs per frame%s\n",
               t.total > 0 ? 1000.0 / t.total : 0.0, t.total / reference_ms,
               options.io.preload ? ", images decoded beforehand" : ", images decoded on a second thread");
   std::printf(
-      "machine reference: one full-size hybrid warp by cv::remap per core on %d core%s at once: %.2f ms before the "
-      "run, "
-      "%.2f ms after\n",
+      "machine reference: one full-size hybrid warp by cv::remap per core on %d core%s at once: %.2f ms before "
+      "the run, %.2f ms after\n",
       cores, cores == 1 ? "" : "s", reference_before_ms, reference_after_ms);
   const double reference_low_ms = std::min(reference_before_ms, reference_after_ms);
   if (std::abs(reference_after_ms - reference_before_ms) > 0.2 * reference_low_ms) {
