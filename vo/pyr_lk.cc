@@ -128,30 +128,18 @@ ROVO_TARGET_AVX2 inline __m256i Load7(const int16_t* p) {
   return _mm256_maskload_epi32(reinterpret_cast<const int*>(p), _mm256_setr_epi32(-1, -1, -1, -1, -1, -1, -1, 0));
 }
 
-// Extracts the patch whose top-left pixel is `corner` and sums its gradient matrix. Reads what OpenCV
-// reads: columns 0..15 and rows 0..rows of the window (the last pixel pair through a masked load).
-ROVO_TARGET_AVX2 Gradient ExtractPatch(const cv::Mat& image, const cv::Mat& deriv, cv::Point corner, const Weights& w,
-                                       int rows, Patch* patch) {
-  const size_t step_i = image.step[0];
-  const size_t step_d = deriv.step[0] / sizeof(int16_t);
-  const __m256i w0 = PairWeights(w.w00, w.w01), w1 = PairWeights(w.w10, w.w11);
-  const __m256i window_columns = _mm256_setr_epi16(-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0);
+// The gradient matrix's sums over a patch's rows, in OpenCV's order (Gradient), and the patch's rows.
+struct GradientSums {
   __m128 lane11 = _mm_setzero_ps(), lane12 = _mm_setzero_ps(), lane22 = _mm_setzero_ps();
   alignas(32) int32_t tail_xx[kMaxRows][kLaneBlock], tail_xy[kMaxRows][kLaneBlock], tail_yy[kMaxRows][kLaneBlock];
-  for (int y = 0; y < rows; ++y) {
-    const uint8_t* src = image.ptr<uint8_t>(corner.y + y) + corner.x;
-    __m256i upper_lo, upper_hi, lower_lo, lower_hi;
-    RowPairs(src, &upper_lo, &upper_hi);
-    RowPairs(src + step_i, &lower_lo, &lower_hi);
-    _mm256_store_si256(reinterpret_cast<__m256i*>(patch->i[y]),
-                       InterpolateRow(upper_lo, upper_hi, lower_lo, lower_hi, w0, w1, kWBits - 5));
 
-    const int16_t* d = deriv.ptr<int16_t>(corner.y + y) + 2 * corner.x;
-    const int16_t* e = d + step_d;
-    const __m256i g0 = InterpolatePairs(Load(d), Load(d + 2), Load(e), Load(e + 2), w0, w1);
-    const __m256i g1 = InterpolatePairs(Load(d + 16), Load7(d + 18), Load(e + 16), Load7(e + 18), w0, w1);
-    const __m256i ix = _mm256_and_si256(_mm256_permute2x128_si256(g0, g1, 0x20), window_columns);
-    const __m256i iy = _mm256_and_si256(_mm256_permute2x128_si256(g0, g1, 0x31), window_columns);
+  // Window row y: its interpolated intensity and derivatives (Ix, Iy of columns 0..15; column 15 is
+  // outside the window and cleared here).
+  ROVO_TARGET_AVX2 void AddRow(int y, __m256i intensity, __m256i ix, __m256i iy, Patch* patch) {
+    const __m256i window_columns = _mm256_setr_epi16(-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0);
+    ix = _mm256_and_si256(ix, window_columns);
+    iy = _mm256_and_si256(iy, window_columns);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(patch->i[y]), intensity);
     _mm256_store_si256(reinterpret_cast<__m256i*>(patch->x_pairs[y]), PairColumns(ix));
     _mm256_store_si256(reinterpret_cast<__m256i*>(patch->y_pairs[y]), PairColumns(iy));
     _mm256_store_si256(reinterpret_cast<__m256i*>(patch->xy_last[y]),
@@ -166,29 +154,168 @@ ROVO_TARGET_AVX2 Gradient ExtractPatch(const cv::Mat& image, const cv::Mat& deri
       lane12 = _mm_add_ps(_mm_mul_ps(fx, fy), lane12);
       lane11 = _mm_add_ps(_mm_mul_ps(fx, fx), lane11);
     }
-    // Columns 8..15 (15 is zero) as exact int32 products, added one by one below.
+    // Columns 8..15 (15 is zero) as exact int32 products, added one by one in Total.
     const __m256i tx = _mm256_cvtepi16_epi32(_mm256_extracti128_si256(ix, 1));
     const __m256i ty = _mm256_cvtepi16_epi32(_mm256_extracti128_si256(iy, 1));
     _mm256_store_si256(reinterpret_cast<__m256i*>(tail_xx[y]), _mm256_mullo_epi32(tx, tx));
     _mm256_store_si256(reinterpret_cast<__m256i*>(tail_xy[y]), _mm256_mullo_epi32(tx, ty));
     _mm256_store_si256(reinterpret_cast<__m256i*>(tail_yy[y]), _mm256_mullo_epi32(ty, ty));
   }
-  float a11 = 0, a12 = 0, a22 = 0;
+
+  Gradient Total(int rows) const {
+    float a11 = 0, a12 = 0, a22 = 0;
+    for (int y = 0; y < rows; ++y) {
+      for (int k = 0; k < kWindowWidth - kLaneBlock; ++k) {
+        a11 += static_cast<float>(tail_xx[y][k]);
+        a12 += static_cast<float>(tail_xy[y][k]);
+        a22 += static_cast<float>(tail_yy[y][k]);
+      }
+    }
+    alignas(16) float l11[4], l12[4], l22[4];
+    _mm_store_ps(l11, lane11);
+    _mm_store_ps(l12, lane12);
+    _mm_store_ps(l22, lane22);
+    a11 += (l11[0] + l11[2]) + (l11[1] + l11[3]);
+    a12 += (l12[0] + l12[2]) + (l12[1] + l12[3]);
+    a22 += (l22[0] + l22[2]) + (l22[1] + l22[3]);
+    return {a11 * kFltScale, a12 * kFltScale, a22 * kFltScale};
+  }
+};
+
+// Extracts the patch whose top-left pixel is `corner` and sums its gradient matrix, the derivatives
+// read from memory: `deriv` holds the (Ix, Iy) pair of the window's top-left pixel, `step_d` int16 per
+// row. Reads what OpenCV reads: columns 0..15 and rows 0..rows of the window (the last pixel pair
+// through a masked load).
+ROVO_TARGET_AVX2 Gradient ExtractPatch(const cv::Mat& image, const int16_t* deriv, size_t step_d, cv::Point corner,
+                                       const Weights& w, int rows, Patch* patch) {
+  const size_t step_i = image.step[0];
+  const __m256i w0 = PairWeights(w.w00, w.w01), w1 = PairWeights(w.w10, w.w11);
+  GradientSums sums;
   for (int y = 0; y < rows; ++y) {
-    for (int k = 0; k < kWindowWidth - kLaneBlock; ++k) {
-      a11 += static_cast<float>(tail_xx[y][k]);
-      a12 += static_cast<float>(tail_xy[y][k]);
-      a22 += static_cast<float>(tail_yy[y][k]);
+    const uint8_t* src = image.ptr<uint8_t>(corner.y + y) + corner.x;
+    __m256i upper_lo, upper_hi, lower_lo, lower_hi;
+    RowPairs(src, &upper_lo, &upper_hi);
+    RowPairs(src + step_i, &lower_lo, &lower_hi);
+    const __m256i intensity = InterpolateRow(upper_lo, upper_hi, lower_lo, lower_hi, w0, w1, kWBits - 5);
+    const int16_t* d = deriv + y * step_d;
+    const int16_t* e = d + step_d;
+    const __m256i g0 = InterpolatePairs(Load(d), Load(d + 2), Load(e), Load(e + 2), w0, w1);
+    const __m256i g1 = InterpolatePairs(Load(d + 16), Load7(d + 18), Load(e + 16), Load7(e + 18), w0, w1);
+    sums.AddRow(y, intensity, _mm256_permute2x128_si256(g0, g1, 0x20), _mm256_permute2x128_si256(g0, g1, 0x31),
+                patch);
+  }
+  return sums.Total(rows);
+}
+
+// An image row's 16 pixels from column x + offset, as int16.
+ROVO_TARGET_AVX2 inline __m256i Widen(const uint8_t* row, int offset) {
+  return _mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(row + offset)));
+}
+
+// An image row's pixels at columns x - 1, x, x + 1 and x + 2 (16 each, int16).
+struct ShiftedRow {
+  __m256i m1, p0, p1, p2;
+};
+ROVO_TARGET_AVX2 inline ShiftedRow LoadShifted(const uint8_t* row) {
+  return {Widen(row, -1), Widen(row, 0), Widen(row, 1), Widen(row, 2)};
+}
+
+// Scharr derivatives of a row of 16 pixels (columns x..x+15) and of the same row one pixel to the right,
+// from the image rows above, at and below it: as calcScharrDeriv (modules/video/src/lkpyramid.cpp),
+// vertical pass t0 = 3 (above + below) + 10 at, t1 = below - above, then Ix = t0(x + 1) - t0(x - 1),
+// Iy = 3 (t1(x - 1) + t1(x + 1)) + 10 t1(x), in int16 (|value| <= 16 * 255, no wrap).
+struct ScharrRow {
+  __m256i ix, iy, ix_right, iy_right;
+};
+// 3 (a + c) + 10 b, the Scharr smoothing, in int16.
+ROVO_TARGET_AVX2 inline __m256i Smooth(__m256i a, __m256i b, __m256i c) {
+  return _mm256_add_epi16(_mm256_mullo_epi16(_mm256_add_epi16(a, c), _mm256_set1_epi16(3)),
+                          _mm256_mullo_epi16(b, _mm256_set1_epi16(10)));
+}
+ROVO_TARGET_AVX2 inline ScharrRow Scharr(const ShiftedRow& above, const ShiftedRow& at, const ShiftedRow& below) {
+  const __m256i t0_m1 = Smooth(above.m1, at.m1, below.m1), t0_p0 = Smooth(above.p0, at.p0, below.p0);
+  const __m256i t0_p1 = Smooth(above.p1, at.p1, below.p1), t0_p2 = Smooth(above.p2, at.p2, below.p2);
+  const __m256i t1_m1 = _mm256_sub_epi16(below.m1, above.m1), t1_p0 = _mm256_sub_epi16(below.p0, above.p0);
+  const __m256i t1_p1 = _mm256_sub_epi16(below.p1, above.p1), t1_p2 = _mm256_sub_epi16(below.p2, above.p2);
+  ScharrRow r;
+  r.ix = _mm256_sub_epi16(t0_p1, t0_m1);
+  r.ix_right = _mm256_sub_epi16(t0_p2, t0_p0);
+  r.iy = Smooth(t1_m1, t1_p0, t1_p1);
+  r.iy_right = Smooth(t1_p0, t1_p1, t1_p2);
+  return r;
+}
+
+// Bilinear interpolation of one derivative over a window row from its values at the upper and lower
+// image rows (columns k and, right, k + 1).
+ROVO_TARGET_AVX2 inline __m256i InterpolateDerivative(__m256i upper, __m256i upper_right, __m256i lower,
+                                                      __m256i lower_right, __m256i w0, __m256i w1) {
+  return InterpolateRow(_mm256_unpacklo_epi16(upper, upper_right), _mm256_unpackhi_epi16(upper, upper_right),
+                        _mm256_unpacklo_epi16(lower, lower_right), _mm256_unpackhi_epi16(lower, lower_right), w0, w1,
+                        kWBits);
+}
+
+// ExtractPatch with the derivatives computed from the image, for a window whose Scharr stencils lie
+// inside it (ScharrInside): the values cv::buildOpticalFlowPyramid would have stored. Reads image
+// columns corner.x - 1 .. corner.x + 17 (the last two only for column 15, which is cleared) and rows
+// corner.y - 1 .. corner.y + rows + 1.
+ROVO_TARGET_AVX2 Gradient ExtractPatchScharr(const cv::Mat& image, cv::Point corner, const Weights& w, int rows,
+                                             Patch* patch) {
+  const size_t step_i = image.step[0];
+  const __m256i w0 = PairWeights(w.w00, w.w01), w1 = PairWeights(w.w10, w.w11);
+  const uint8_t* row = image.ptr<uint8_t>(corner.y) + corner.x;
+  ShiftedRow above = LoadShifted(row - step_i), at = LoadShifted(row), below = LoadShifted(row + step_i);
+  ScharrRow upper = Scharr(above, at, below);
+  GradientSums sums;
+  for (int y = 0; y < rows; ++y) {
+    above = at;
+    at = below;
+    below = LoadShifted(row + (y + 2) * step_i);
+    const ScharrRow lower = Scharr(above, at, below);
+    // The intensity's (k, k + 1) pairs are the widened pixels at columns 0 and 1 of rows y and y + 1.
+    const __m256i intensity =
+        InterpolateRow(_mm256_unpacklo_epi16(above.p0, above.p1), _mm256_unpackhi_epi16(above.p0, above.p1),
+                       _mm256_unpacklo_epi16(at.p0, at.p1), _mm256_unpackhi_epi16(at.p0, at.p1), w0, w1, kWBits - 5);
+    const __m256i ix = InterpolateDerivative(upper.ix, upper.ix_right, lower.ix, lower.ix_right, w0, w1);
+    const __m256i iy = InterpolateDerivative(upper.iy, upper.iy_right, lower.iy, lower.iy_right, w0, w1);
+    sums.AddRow(y, intensity, ix, iy, patch);
+    upper = lower;
+  }
+  return sums.Total(rows);
+}
+
+// Whether ExtractPatchScharr serves the window at `corner`: every stencil of the window's columns 0..15
+// and rows 0..rows lies inside the image, where calcScharrDeriv's border rule does not act.
+bool ScharrInside(const cv::Mat& image, cv::Point corner, int rows) {
+  return corner.x >= 1 && corner.x + kWindowWidth + 1 <= image.cols - 1 && corner.y >= 1 &&
+         corner.y + rows + 1 <= image.rows - 1;
+}
+
+// The stored derivatives of window rows 0..rows, columns 0..15 at `corner` (some outside the image), as
+// cv::buildOpticalFlowPyramid stores them: calcScharrDeriv's rule inside the image (the row and the
+// vertical pass's column beyond an edge reflected, 101), zero outside (BORDER_CONSTANT).
+constexpr int kBlockStep = 2 * kLanes;  // int16 per row: (Ix, Iy) of 16 pixels
+void ScharrBlock(const cv::Mat& image, cv::Point corner, int rows, int16_t (*block)[kBlockStep]) {
+  const int w = image.cols, h = image.rows;
+  const auto reflect = [](int i, int n) { return i < 0 ? (n > 1 ? 1 : 0) : i >= n ? (n > 1 ? n - 2 : 0) : i; };
+  for (int y = 0; y <= rows; ++y) {
+    const int iy = corner.y + y;
+    for (int x = 0; x < kLanes; ++x) {
+      const int ix = corner.x + x;
+      int16_t dx = 0, dy = 0;
+      if (ix >= 0 && ix < w && iy >= 0 && iy < h) {
+        const uint8_t* above = image.ptr<uint8_t>(reflect(iy - 1, h));
+        const uint8_t* at = image.ptr<uint8_t>(iy);
+        const uint8_t* below = image.ptr<uint8_t>(reflect(iy + 1, h));
+        const auto t0 = [&](int c) { return (above[c] + below[c]) * 3 + at[c] * 10; };
+        const auto t1 = [&](int c) { return below[c] - above[c]; };
+        const int left = reflect(ix - 1, w), right = reflect(ix + 1, w);
+        dx = static_cast<int16_t>(t0(right) - t0(left));
+        dy = static_cast<int16_t>((t1(left) + t1(right)) * 3 + t1(ix) * 10);
+      }
+      block[y][2 * x] = dx;
+      block[y][2 * x + 1] = dy;
     }
   }
-  alignas(16) float l11[4], l12[4], l22[4];
-  _mm_store_ps(l11, lane11);
-  _mm_store_ps(l12, lane12);
-  _mm_store_ps(l22, lane22);
-  a11 += (l11[0] + l11[2]) + (l11[1] + l11[3]);
-  a12 += (l12[0] + l12[2]) + (l12[1] + l12[3]);
-  a22 += (l22[0] + l22[2]) + (l22[1] + l22[3]);
-  return {a11 * kFltScale, a12 * kFltScale, a22 * kFltScale};
 }
 
 // The sum of the one-by-one columns (8..14) of `rows` rows, added in OpenCV's order (row by row, column
@@ -258,9 +385,21 @@ ROVO_TARGET_AVX2 void Mismatch(const Patch& patch, const uint8_t* j, size_t step
 
 struct Level {
   const cv::Mat* image;  // previous image
-  const cv::Mat* deriv;  // its derivatives
+  const cv::Mat* deriv;  // its derivatives; nullptr: computed here (ExtractPatchScharr, ScharrBlock)
   const cv::Mat* next;   // moving image
 };
+
+// The patch of the previous image at `corner` and its gradient matrix.
+Gradient PatchAt(const Level& lv, cv::Point corner, const Weights& w, int rows, Patch* patch) {
+  if (lv.deriv) {
+    const size_t step_d = lv.deriv->step[0] / sizeof(int16_t);
+    return ExtractPatch(*lv.image, lv.deriv->ptr<int16_t>(corner.y) + 2 * corner.x, step_d, corner, w, rows, patch);
+  }
+  if (ScharrInside(*lv.image, corner, rows)) return ExtractPatchScharr(*lv.image, corner, w, rows, patch);
+  alignas(32) int16_t block[kMaxRows + 1][kBlockStep];
+  ScharrBlock(*lv.image, corner, rows, block);
+  return ExtractPatch(*lv.image, block[0], kBlockStep, corner, w, rows, patch);
+}
 
 struct Settings {
   cv::Size window;
@@ -283,13 +422,13 @@ void TrackAtLevel(const Level& lv, const Settings& s, int level, int max_level, 
 
   prev_pt -= half_win;
   const cv::Point iprev(FloorInt(prev_pt.x), FloorInt(prev_pt.y));
-  if (iprev.x < -s.window.width || iprev.x >= lv.deriv->cols || iprev.y < -s.window.height ||
-      iprev.y >= lv.deriv->rows) {
+  if (iprev.x < -s.window.width || iprev.x >= lv.image->cols || iprev.y < -s.window.height ||
+      iprev.y >= lv.image->rows) {
     if (level == 0) *status = 0;
     return;
   }
-  const Gradient g = ExtractPatch(*lv.image, *lv.deriv, iprev,
-                                  BilinearWeights(prev_pt.x - iprev.x, prev_pt.y - iprev.y), s.window.height, patch);
+  const Gradient g = PatchAt(lv, iprev, BilinearWeights(prev_pt.x - iprev.x, prev_pt.y - iprev.y), s.window.height,
+                             patch);
   float d = g.a11 * g.a22 - g.a12 * g.a12;
   const float min_eig = (g.a22 + g.a11 - std::sqrt((g.a11 - g.a22) * (g.a11 - g.a22) + 4.f * g.a12 * g.a12)) /
                         static_cast<float>(2 * s.window.width * s.window.height);
@@ -353,19 +492,27 @@ bool Padded(const cv::Mat& m, cv::Size window) {
          offset.y + m.rows + window.height <= whole.height;
 }
 
+// The CPU and window PyrLk serves.
+bool ServesWindow(cv::Size window) {
+  return CpuHasAvx2() && window.width == kWindowWidth && window.height >= 3 && window.height <= kMaxRows;
+}
+
 }  // namespace
 
 bool PyrLkApplies(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid, cv::Size window) {
-  if (!CpuHasAvx2() || window.width != kWindowWidth || window.height < 3 || window.height > kMaxRows) return false;
+  if (!ServesWindow(window)) return false;
   const PyramidShape from = ShapeOf(from_pyramid), to = ShapeOf(to_pyramid);
-  if (from.step != 2 || to.levels < 0) return false;
+  if (from.levels < 0 || to.levels < 0) return false;
   for (int l = 0; l <= std::min(from.levels, to.levels); ++l) {
-    const cv::Mat& i = from_pyramid[2 * l];
-    const cv::Mat& d = from_pyramid[2 * l + 1];
+    const cv::Mat& i = from_pyramid[from.step * l];
     const cv::Mat& j = to_pyramid[to.step * l];
-    if (i.type() != CV_8UC1 || d.type() != CV_16SC2 || j.type() != CV_8UC1 || i.size() != j.size() ||
-        d.size() != i.size() || !Padded(i, window) || !Padded(d, window) || !Padded(j, window))
+    if (i.type() != CV_8UC1 || j.type() != CV_8UC1 || i.size() != j.size() || !Padded(i, window) ||
+        !Padded(j, window))
       return false;
+    if (from.step == 2) {
+      const cv::Mat& d = from_pyramid[2 * l + 1];
+      if (d.type() != CV_16SC2 || d.size() != i.size() || !Padded(d, window)) return false;
+    }
   }
   return true;
 }
@@ -393,12 +540,17 @@ void PyrLk(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>&
   s.epsilon2 = eps * eps;
   std::vector<Level> levels(max_level + 1);
   for (int l = 0; l <= max_level; ++l)
-    levels[l] = {&from_pyramid[2 * l], &from_pyramid[2 * l + 1], &to_pyramid[to_shape.step * l]};
+    levels[l] = {&from_pyramid[from_shape.step * l], from_shape.step == 2 ? &from_pyramid[2 * l + 1] : nullptr,
+                 &to_pyramid[to_shape.step * l]};
   Patch patch;
   for (int k = 0; k < n; ++k) {
     status[k] = 1;
     for (int l = max_level; l >= 0; --l) TrackAtLevel(levels[l], s, l, max_level, from[k], &to[k], &status[k], &patch);
   }
+}
+
+int BuildPyrLkPyramid(const cv::Mat& image, std::vector<cv::Mat>* pyramid, cv::Size window, int max_level) {
+  return cv::buildOpticalFlowPyramid(image, *pyramid, window, max_level, !ServesWindow(window));
 }
 
 }  // namespace rovo

@@ -136,8 +136,7 @@ void ViewTracker::ResetImage(const cv::Mat& image, const cv::Mat& mask, std::vec
   image_ = image;
   detect_mask_ = DetectionMask(mask, options_.border_px);
   pyramid_.clear();
-  cv::buildOpticalFlowPyramid(image_, pyramid_, cv::Size(options_.klt_window_px, options_.klt_window_px),
-                              options_.klt_levels);
+  BuildPyrLkPyramid(image_, &pyramid_, cv::Size(options_.klt_window_px, options_.klt_window_px), options_.klt_levels);
   points_.clear();
   for (TrackedPoint& p : points) {
     if (MaskAt(detect_mask_, p.px)) points_.push_back(std::move(p));
@@ -238,7 +237,7 @@ int ViewTracker::Track(const cv::Mat& image, const cv::Mat& mask) {
   if (mask.size() != image.size()) throw std::invalid_argument("ViewTracker: mask size differs from the image");
   const cv::Size window(options_.klt_window_px, options_.klt_window_px);
   std::vector<cv::Mat>& pyramid = spare_pyramid_;  // reuses the buffers of two frames ago
-  cv::buildOpticalFlowPyramid(image, pyramid, window, options_.klt_levels);
+  BuildPyrLkPyramid(image, &pyramid, window, options_.klt_levels);
   if (detect_mask_.size() != mask.size() || detect_mask_.empty()) {
     detect_mask_ = DetectionMask(mask, options_.border_px);
   }

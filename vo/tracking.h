@@ -79,7 +79,7 @@ class ViewTracker {
  private:
   TrackerOptions options_;
   cv::Mat image_, detect_mask_;
-  // KLT pyramids (cv::buildOpticalFlowPyramid with derivatives) of the current image and a spare
+  // KLT pyramids (BuildPyrLkPyramid) of the current image and a spare
   // whose buffers the next frame's pyramid reuses: each image's pyramid is built once and serves
   // the forward pass of the next frame and the backward pass of this one.
   std::vector<cv::Mat> pyramid_, spare_pyramid_;

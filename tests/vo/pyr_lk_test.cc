@@ -42,12 +42,14 @@ struct Case {
   bool initial_flow;
 };
 
-// PyrLk against cv::calcOpticalFlowPyrLK on the same pyramids: every point's coordinates bit for bit and
-// every status. Returns the number of points tracked (status 1).
-int ExpectSameAsOpenCv(const cv::Mat& from, const cv::Mat& to, const std::vector<cv::Point2f>& points,
-                       const std::vector<cv::Point2f>& starts, const Case& c) {
+// PyrLk against cv::calcOpticalFlowPyrLK on the same pyramids (`from`'s with its derivatives, or without
+// them: PyrLk computes those of each window, OpenCV all of them): every point's coordinates bit for bit
+// and every status. Returns the number of points tracked (status 1).
+int ExpectSameAsOpenCvFor(const cv::Mat& from, const cv::Mat& to, const std::vector<cv::Point2f>& points,
+                          const std::vector<cv::Point2f>& starts, const Case& c, bool from_derivatives) {
+  SCOPED_TRACE(from_derivatives ? "pyramid with derivatives" : "pyramid without derivatives");
   std::vector<cv::Mat> from_pyramid, to_pyramid;
-  cv::buildOpticalFlowPyramid(from, from_pyramid, c.window, c.levels);
+  cv::buildOpticalFlowPyramid(from, from_pyramid, c.window, c.levels, from_derivatives);
   cv::buildOpticalFlowPyramid(to, to_pyramid, c.window, c.levels);
   EXPECT_EQ(PyrLkApplies(from_pyramid, to_pyramid, c.window), __builtin_cpu_supports("avx2") != 0);
   const int flags = c.initial_flow ? cv::OPTFLOW_USE_INITIAL_FLOW : 0;
@@ -69,6 +71,13 @@ int ExpectSameAsOpenCv(const cv::Mat& from, const cv::Mat& to, const std::vector
     }
   }
   EXPECT_EQ(differ, 0) << "of " << points.size() << " points";
+  return tracked;
+}
+
+int ExpectSameAsOpenCv(const cv::Mat& from, const cv::Mat& to, const std::vector<cv::Point2f>& points,
+                       const std::vector<cv::Point2f>& starts, const Case& c) {
+  const int tracked = ExpectSameAsOpenCvFor(from, to, points, starts, c, true);
+  EXPECT_EQ(ExpectSameAsOpenCvFor(from, to, points, starts, c, false), tracked);
   return tracked;
 }
 
@@ -128,6 +137,41 @@ TEST(PyrLk, SameAsOpenCvUnderBrightnessChangesAndOtherSettings) {
   }
 }
 
+// Derivatives computed per window at and beyond the image's edges: calcScharrDeriv's border rule (rows
+// and columns reflected inside the image, zero outside it) on small images where most windows touch an
+// edge, and on an image that is a view into a larger one, whose base level the pyramid keeps without a
+// border of its own (the pixels around it are not the reflected ones).
+TEST(PyrLk, DerivativesAtTheEdgesAsOpenCv) {
+  cv::RNG rng(16);
+  for (const cv::Size size : {cv::Size(40, 33), cv::Size(19, 64), cv::Size(70, 17)}) {
+    const cv::Mat from = Texture(size.width, size.height, 6);
+    const cv::Mat to = Moved(from, 1.5, -0.75, 1.0, 0.0);
+    const std::vector<cv::Point2f> points = RandomPoints(800, size, 16, rng);
+    ExpectSameAsOpenCv(from, to, points, {}, {cv::Size(15, 15), 1, kTrackerCriteria, false});
+    ExpectSameAsOpenCv(from, to, points, {}, {cv::Size(15, 5), 0, kTrackerCriteria, false});
+  }
+  const cv::Mat whole = Texture(260, 220, 7);
+  const cv::Mat moved = Moved(whole, -2.25, 3.5, 1.0, 0.0);
+  const cv::Rect inner(20, 18, 200, 170);
+  const std::vector<cv::Point2f> points = RandomPoints(2000, inner.size(), 10, rng);
+  const int tracked =
+      ExpectSameAsOpenCv(whole(inner), moved(inner), points, {}, {cv::Size(15, 15), 2, kTrackerCriteria, false});
+  EXPECT_GT(tracked, 1000);
+}
+
+// The pyramid BuildPyrLkPyramid builds: without derivatives where PyrLk computes them (AVX2, a window 15
+// wide), else with them, as OpenCV needs them for every call.
+TEST(PyrLk, BuildsThePyramidItTracksFrom) {
+  const cv::Mat image = Texture(128, 96, 8);
+  std::vector<cv::Mat> pyramid;
+  EXPECT_EQ(BuildPyrLkPyramid(image, &pyramid, cv::Size(15, 15), 2), 2);
+  const bool avx2 = __builtin_cpu_supports("avx2") != 0;
+  EXPECT_EQ(pyramid.size(), avx2 ? 3u : 6u);
+  EXPECT_EQ(PyrLkApplies(pyramid, pyramid, cv::Size(15, 15)), avx2);
+  EXPECT_EQ(BuildPyrLkPyramid(image, &pyramid, cv::Size(21, 21), 2), 2);
+  EXPECT_EQ(pyramid.size(), 6u);
+}
+
 // Where it does not apply (a 21-pixel window), PyrLk hands the points to OpenCV and writes its results
 // into the caller's arrays.
 TEST(PyrLk, FallsBackToOpenCvWhereItDoesNotApply) {
@@ -162,7 +206,7 @@ TEST(PyrLk, AppliesOnlyWhereItMatchesOpenCv) {
   const bool avx2 = __builtin_cpu_supports("avx2") != 0;
   EXPECT_EQ(PyrLkApplies(with, with, cv::Size(15, 15)), avx2);
   EXPECT_EQ(PyrLkApplies(with, without, cv::Size(15, 15)), avx2);
-  EXPECT_FALSE(PyrLkApplies(without, with, cv::Size(15, 15)));  // OpenCV computes the derivatives itself
+  EXPECT_EQ(PyrLkApplies(without, with, cv::Size(15, 15)), avx2);  // the derivatives computed per window
   EXPECT_FALSE(PyrLkApplies(with, with, cv::Size(21, 21)));
   EXPECT_FALSE(PyrLkApplies(with, with, cv::Size(15, 33)));
   std::vector<cv::Mat> flat;  // a border of 3 rows: too little for a window 31 high
