@@ -43,6 +43,10 @@ void CheckRangeAndFolders(const VoOptions& options, const DatasetInfo& info, int
                                 " is not a non-empty range within the dataset's " + std::to_string(info.frame_count) +
                                 " frames (" + DatasetJsonPath(options.io.dataset_dir) + ": frame_count)");
   }
+  if (options.io.timed_from >= end - begin) {
+    throw std::invalid_argument("vo: --timed-from " + std::to_string(options.io.timed_from) + " leaves no frame of " +
+                                std::to_string(begin) + ":" + std::to_string(end) + " to time");
+  }
   for (const RigCamera& cam : info.rig.cameras) {
     const std::string folder = (std::filesystem::path(options.io.dataset_dir) / cam.name).string();
     if (!std::filesystem::is_directory(folder)) {
@@ -130,6 +134,21 @@ void AverageStageTimes(int frames, int total_hypotheses, VoStageTimes* ms) {
   }
   ms->ransac_us_per_hypothesis = total_hypotheses > 0 ? ms->ransac * n * 1000.0 / total_hypotheses : 0.0;
 }
+
+// The stage times of the frames from VoIoOptions::timed_from on, which the summary reports, and of
+// the frames before them, which it leaves out.
+struct StageSums {
+  explicit StageSums(int from_in) : from(from_in) {}
+  int from;  // index in the range of the first timed frame
+  VoStageTimes timed, untimed;
+  int timed_frames = 0, timed_hypotheses = 0;
+  VoStageTimes& Of(int index) { return index >= from ? timed : untimed; }
+  void Count(int index, int hypotheses) {
+    if (index < from) return;
+    ++timed_frames;
+    timed_hypotheses += hypotheses;
+  }
+};
 
 // Adds a frame's front-end and back-end stage times to the sums.
 void AddStageTimes(const FrontendFrame& features, const BackendFrameResult& result, VoStageTimes* ms) {
@@ -389,8 +408,7 @@ VoSummary RunVo(const VoOptions& options) {
   VoBackend backend(cam_from_rig, world_from_rig0, backend_options);
 
   RunData run;
-  VoStageTimes& ms = summary.stage_ms;
-  int total_hypotheses = 0;
+  StageSums sums(options.io.timed_from);
   double ok_ratio_sum = 0.0, ok_error_sum = 0.0;
   Progress progress("vo " + ExtrinsicsModeName(options.start.mode), end - begin, "frames", options.io.quiet);
   FrontendFeed feed(options, reader, &frontend, begin, end);
@@ -398,6 +416,7 @@ VoSummary RunVo(const VoOptions& options) {
   auto frame_start = Clock::now();
   for (int frame = begin; frame < end; ++frame) {
     const FrontendStep step = feed.Take(frame);  // started beside the previous frame's back-end, or computed now
+    VoStageTimes& ms = sums.Of(frame - begin);
     ms.load += step.ms_load;
     if (!step.loaded.problems.empty() && !options.io.quiet) {
       std::fprintf(stderr, "vo: frame %d: %s\n", frame, step.loaded.problems.c_str());
@@ -412,7 +431,7 @@ VoSummary RunVo(const VoOptions& options) {
     ms.backend_total += MsSince(backend_start);
     if (online && !feed.overlaps()) frontend.SetExtrinsics(backend.cam_from_rig());
     AddStageTimes(step.features, result, &ms);
-    total_hypotheses += result.ransac_hypotheses;
+    sums.Count(frame - begin, result.ransac_hypotheses);
 
     FrameRecord rec = result.record;
     NoteMissingImages(step.loaded, &rec, &summary);
@@ -425,9 +444,10 @@ VoSummary RunVo(const VoOptions& options) {
     AddToRun(rec, result.world_from_rig, vo_cameras, backend.cam_from_rig(), &run);
     progress.Add();
   }
-  if (auto update = backend.FinishPendingBa()) ApplyBaUpdate(*update, backend.cam_from_rig(), &run, &ms);
+  if (auto update = backend.FinishPendingBa()) ApplyBaUpdate(*update, backend.cam_from_rig(), &run, &sums.timed);
   progress.Finish();
-  AverageStageTimes(summary.frames, total_hypotheses, &ms);
+  AverageStageTimes(sums.timed_frames, sums.timed_hypotheses, &sums.timed);
+  summary.stage_ms = sums.timed;
   summary.mean_inlier_ratio = summary.frames_ok > 0 ? ok_ratio_sum / summary.frames_ok : 0.0;
   summary.mean_reproj_error_deg = summary.frames_ok > 0 ? ok_error_sum / summary.frames_ok : 0.0;
   summary.seconds = std::chrono::duration<double>(Clock::now() - run_start).count();

@@ -46,8 +46,9 @@ inline Weights BilinearWeights(float a, float b) {
   return w;
 }
 
-// The window of the previous image at a point: intensity (x 32) and Scharr derivatives, interpolated;
-// columns kWindowWidth.. are zero.
+// The window of the previous image at a point: intensity (x 32) and Scharr derivatives, interpolated.
+// Column 15 lies outside the window: its derivatives are zero, and its intensity, which Mismatch
+// multiplies only by them, is whatever the extraction left there.
 // The derivatives are stored for Mismatch's pairwise products (_mm256_madd_epi16 against the
 // mismatch shuffled by PairColumns): per row, x and y, (D0 D4 D1 D5 D2 D6 D3 D7 | D8 0 D9 0 D10 0 D11 0),
 // and (Dx12 0 Dx13 0 Dx14 0 0 0 | Dy12 0 Dy13 0 Dy14 0 0 0).
@@ -256,7 +257,7 @@ ROVO_TARGET_AVX2 inline __m256i InterpolateDerivative(__m256i upper, __m256i upp
 
 // ExtractPatch with the derivatives computed from the image, for a window whose Scharr stencils lie
 // inside it (ScharrInside): the values cv::buildOpticalFlowPyramid would have stored. Reads image
-// columns corner.x - 1 .. corner.x + 17 (the last two only for column 15, which is cleared) and rows
+// columns corner.x - 1 .. corner.x + 17 (the last only for column 15, which is cleared) and rows
 // corner.y - 1 .. corner.y + rows + 1.
 ROVO_TARGET_AVX2 Gradient ExtractPatchScharr(const cv::Mat& image, cv::Point corner, const Weights& w, int rows,
                                              Patch* patch) {

@@ -38,8 +38,8 @@ void PyrLk(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>&
            int flags);
 
 // cv::buildOpticalFlowPyramid(image, *pyramid, window, max_level), with the derivatives only where
-// PyrLk would hand the window to OpenCV (no AVX2, another width): the pyramid PyrLk tracks from fastest. Returns the
-// number of levels above the base.
+// PyrLk would hand the window to OpenCV (no AVX2, a window not 15 wide or not 3-32 high): the
+// pyramid PyrLk tracks from fastest. Returns the number of levels above the base.
 int BuildPyrLkPyramid(const cv::Mat& image, std::vector<cv::Mat>* pyramid, cv::Size window, int max_level);
 
 }  // namespace rovo

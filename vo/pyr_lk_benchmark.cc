@@ -1,6 +1,9 @@
 // PyrLk against cv::calcOpticalFlowPyrLK on the front-end's settings (window 15, 3 levels, 20
 // iterations, 0.03 px), 600 points of a textured 2417x985 image (the warped view's size) that moves by
-// (3.4, -1.7) px; the same pyramids for both. Run: build/vo/rovo_vo_benchmark --benchmark_filter=Lk
+// (3.4, -1.7) px; the same pyramids for both. BM_LkPyramid: the previous image's pyramid with its
+// derivatives (cv::buildOpticalFlowPyramid's default) and without them (BuildPyrLkPyramid, as the
+// tracker builds it), and BM_Lk600PointsComputedDerivatives PyrLk on the latter, so that pyramid + LK
+// compare as the tracker's two ways. Run: build/vo/rovo_vo_benchmark --benchmark_filter=Lk
 #include <benchmark/benchmark.h>
 
 #include <opencv2/imgproc.hpp>
@@ -13,7 +16,9 @@ namespace rovo {
 namespace {
 
 struct LkInput {
+  cv::Mat image;
   std::vector<cv::Mat> from_pyramid, to_pyramid;
+  std::vector<cv::Mat> from_pyramid_plain;  // without derivatives
   std::vector<cv::Point2f> points;
 };
 
@@ -29,7 +34,9 @@ const LkInput& Input() {
     cv::Mat moved;
     cv::warpAffine(image, moved, shift, image.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT_101);
     LkInput in;
+    in.image = image;
     cv::buildOpticalFlowPyramid(image, in.from_pyramid, cv::Size(15, 15), 3);
+    cv::buildOpticalFlowPyramid(image, in.from_pyramid_plain, cv::Size(15, 15), 3, false);
     cv::buildOpticalFlowPyramid(moved, in.to_pyramid, cv::Size(15, 15), 3);
     for (int k = 0; k < 600; ++k)
       in.points.emplace_back(rng.uniform(20.f, image.cols - 20.f), rng.uniform(20.f, image.rows - 20.f));
@@ -58,6 +65,32 @@ void BM_Lk600Points(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_Lk600Points)->ArgName("pyr_lk")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+// PyrLk from the pyramid without derivatives: each window's derivatives computed as it is extracted.
+void BM_Lk600PointsComputedDerivatives(benchmark::State& state) {
+  const LkInput& in = Input();
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.03);
+  std::vector<cv::Point2f> to(in.points.size());
+  std::vector<uint8_t> status(in.points.size());
+  for (auto _ : state) {
+    PyrLk(in.from_pyramid_plain, in.to_pyramid, in.points.data(), to.data(), status.data(),
+          static_cast<int>(in.points.size()), cv::Size(15, 15), 3, criteria, 0);
+    benchmark::DoNotOptimize(to.data());
+  }
+}
+BENCHMARK(BM_Lk600PointsComputedDerivatives)->Unit(benchmark::kMicrosecond);
+
+// Arg 1: with derivatives (cv::buildOpticalFlowPyramid's default), 0: without.
+void BM_LkPyramid(benchmark::State& state) {
+  const LkInput& in = Input();
+  std::vector<cv::Mat> pyramid;
+  cv::setNumThreads(1);
+  for (auto _ : state) {
+    cv::buildOpticalFlowPyramid(in.image, pyramid, cv::Size(15, 15), 3, state.range(0) != 0);
+    benchmark::DoNotOptimize(pyramid.data());
+  }
+}
+BENCHMARK(BM_LkPyramid)->ArgName("derivatives")->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace rovo

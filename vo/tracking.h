@@ -79,9 +79,9 @@ class ViewTracker {
  private:
   TrackerOptions options_;
   cv::Mat image_, detect_mask_;
-  // KLT pyramids (BuildPyrLkPyramid) of the current image and a spare
-  // whose buffers the next frame's pyramid reuses: each image's pyramid is built once and serves
-  // the forward pass of the next frame and the backward pass of this one.
+  // KLT pyramids (BuildPyrLkPyramid) of the current image and a spare whose buffers the next
+  // frame's pyramid reuses: each image's pyramid is built once and serves the forward pass of the
+  // next frame and the backward pass of this one.
   std::vector<cv::Mat> pyramid_, spare_pyramid_;
   std::vector<TrackedPoint> points_;
   cv::Mat descriptors_;

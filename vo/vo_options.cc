@@ -29,6 +29,7 @@ std::string ExtrinsicsModeName(ExtrinsicsMode mode) {
 void VoIoOptions::Check() const {
   if (dataset_dir.empty()) throw std::invalid_argument("vo: no dataset folder given");
   if (out_dir.empty()) throw std::invalid_argument("vo: no output (run) folder given");
+  if (timed_from < 0) throw std::invalid_argument("vo: --timed-from must be >= 0");
 }
 
 std::vector<int> VoCameraIndices(const std::string& cameras, const Rig& rig) {

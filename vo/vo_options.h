@@ -34,6 +34,7 @@ struct VoIoOptions {
   int threads = 0;       // 0: all cores
   bool quiet = false;    // no progress output
   bool preload = false;  // decode all frames before the loop (timing without PNG decoding)
+  int timed_from = 0;    // VoSummary::stage_ms over the frames from this index of the range on
   // The dataset cameras the VO uses: "auto" (the cameras whose lens sees more than 180 degrees, the
   // fisheye ring ROVO is made for, when the rig has any; else all), "all", or indices "0,1,2,3"
   // (increasing, with camera 0, the gauge of the extrinsics). run.json "vo_cameras" lists them.

@@ -60,6 +60,10 @@ void RunVoBenchmark(VoOptions options) {
   const VoStageTimes& t = s.stage_ms;
   std::printf("rovo bench vo: %s, mode %s, %d frames, threads %d\n", options.io.dataset_dir.c_str(),
               ExtrinsicsModeName(options.start.mode).c_str(), s.frames, options.io.threads);
+  if (options.io.timed_from > 0) {
+    std::printf("stage times: the frames from index %d of the range on (%d of %d frames)\n", options.io.timed_from,
+                std::max(0, s.frames - options.io.timed_from), s.frames);
+  }
   // CPU = process CPU time of all threads (FrontendFrame::cpu_ms_*); measured for the front-end only. It
   // includes the image decoder and, with async BA, the BA and the previous frame's back-end running
   // meanwhile: use --preload --sync-ba for the front-end's own CPU time. "load images (wait)" is the

@@ -150,6 +150,8 @@ TEST(PyrLk, DerivativesAtTheEdgesAsOpenCv) {
     ExpectSameAsOpenCv(from, to, points, {}, {cv::Size(15, 15), 1, kTrackerCriteria, false});
     ExpectSameAsOpenCv(from, to, points, {}, {cv::Size(15, 5), 0, kTrackerCriteria, false});
   }
+  // The view's pixels beyond its edges are the larger image's, not reflections of its own: only here
+  // does a window the fast path took one pixel too close to an edge read values calcScharrDeriv would not.
   const cv::Mat whole = Texture(260, 220, 7);
   const cv::Mat moved = Moved(whole, -2.25, 3.5, 1.0, 0.0);
   const cv::Rect inner(20, 18, 200, 170);
@@ -157,6 +159,24 @@ TEST(PyrLk, DerivativesAtTheEdgesAsOpenCv) {
   const int tracked =
       ExpectSameAsOpenCv(whole(inner), moved(inner), points, {}, {cv::Size(15, 15), 2, kTrackerCriteria, false});
   EXPECT_GT(tracked, 1000);
+}
+
+// Images one and two pixels wide or high (calcScharrDeriv reflects onto the other pixel, or the same
+// one), and windows three rows high.
+TEST(PyrLk, TinyImagesAndLowWindowsAsOpenCv) {
+  cv::RNG rng(17);
+  for (const cv::Size size : {cv::Size(1, 30), cv::Size(2, 30), cv::Size(30, 1), cv::Size(30, 2), cv::Size(2, 2)}) {
+    cv::Mat from(size, CV_8UC1), to(size, CV_8UC1);
+    rng.fill(from, cv::RNG::UNIFORM, 0, 256);
+    rng.fill(to, cv::RNG::UNIFORM, 0, 256);
+    const std::vector<cv::Point2f> points = RandomPoints(200, size, 3, rng);
+    ExpectSameAsOpenCv(from, to, points, {}, {cv::Size(15, 15), 0, kTrackerCriteria, false});
+    ExpectSameAsOpenCv(from, to, points, {}, {cv::Size(15, 3), 0, kTrackerCriteria, false});
+  }
+  const cv::Mat from = Texture(160, 120, 9);
+  const cv::Mat to = Moved(from, 1.25, 0.5, 1.0, 0.0);
+  const std::vector<cv::Point2f> points = RandomPoints(1500, from.size(), 8, rng);
+  EXPECT_GT(ExpectSameAsOpenCv(from, to, points, {}, {cv::Size(15, 3), 2, kTrackerCriteria, false}), 500);
 }
 
 // The pyramid BuildPyrLkPyramid builds: without derivatives where PyrLk computes them (AVX2, a window 15

@@ -81,6 +81,38 @@ TEST_F(PipelinePrefetch, PngReplayEqualsPreloadedImagesByteForByte) {
   }
 }
 
+// Timing from a later frame (--timed-from) changes what the summary averages, not the run; a start that
+// leaves no frame to time is refused before any work.
+TEST_F(PipelinePrefetch, TimedFromAveragesTheLaterFramesOfTheSameRun) {
+  VoOptions options;
+  options.io.dataset_dir = Dataset();
+  options.io.frames.begin = 0;
+  options.io.frames.end = kFrames;
+  options.io.threads = 2;
+  options.io.quiet = true;
+  options.io.preload = true;
+  std::vector<std::string> runs;
+  for (const int timed_from : {0, kFrames - 4}) {
+    options.io.timed_from = timed_from;
+    options.io.out_dir = (Root() / ("timed_from_" + std::to_string(timed_from))).string();
+    const VoSummary summary = RunVo(options);
+    EXPECT_EQ(summary.frames, kFrames);
+    EXPECT_GT(summary.stage_ms.total, 0.0);
+    EXPECT_GT(summary.stage_ms.track, 0.0);
+    runs.push_back(options.io.out_dir);
+  }
+  EXPECT_EQ(ReadText(fs::path(runs[0]) / "trajectory.tum"), ReadText(fs::path(runs[1]) / "trajectory.tum"));
+  options.io.timed_from = kFrames;
+  options.io.out_dir = (Root() / "timed_from_all").string();
+  try {
+    RunVo(options);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--timed-from"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(options.io.out_dir));
+}
+
 // `rovo bench vo --floor` prints its table and a ratio of two measured CPU times.
 TEST_F(PipelinePrefetch, FloorBenchmarkPrintsTheFrontEndAgainstTheFloor) {
   const std::string out = (Root() / "floor.txt").string();
