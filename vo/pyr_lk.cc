@@ -202,8 +202,7 @@ ROVO_TARGET_AVX2 Gradient ExtractPatch(const cv::Mat& image, const int16_t* deri
     const int16_t* e = d + step_d;
     const __m256i g0 = InterpolatePairs(Load(d), Load(d + 2), Load(e), Load(e + 2), w0, w1);
     const __m256i g1 = InterpolatePairs(Load(d + 16), Load7(d + 18), Load(e + 16), Load7(e + 18), w0, w1);
-    sums.AddRow(y, intensity, _mm256_permute2x128_si256(g0, g1, 0x20), _mm256_permute2x128_si256(g0, g1, 0x31),
-                patch);
+    sums.AddRow(y, intensity, _mm256_permute2x128_si256(g0, g1, 0x20), _mm256_permute2x128_si256(g0, g1, 0x31), patch);
   }
   return sums.Total(rows);
 }
@@ -428,8 +427,8 @@ void TrackAtLevel(const Level& lv, const Settings& s, int level, int max_level, 
     if (level == 0) *status = 0;
     return;
   }
-  const Gradient g = PatchAt(lv, iprev, BilinearWeights(prev_pt.x - iprev.x, prev_pt.y - iprev.y), s.window.height,
-                             patch);
+  const Gradient g =
+      PatchAt(lv, iprev, BilinearWeights(prev_pt.x - iprev.x, prev_pt.y - iprev.y), s.window.height, patch);
   float d = g.a11 * g.a22 - g.a12 * g.a12;
   const float min_eig = (g.a22 + g.a11 - std::sqrt((g.a11 - g.a22) * (g.a11 - g.a22) + 4.f * g.a12 * g.a12)) /
                         static_cast<float>(2 * s.window.width * s.window.height);
@@ -507,8 +506,7 @@ bool PyrLkApplies(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv
   for (int l = 0; l <= std::min(from.levels, to.levels); ++l) {
     const cv::Mat& i = from_pyramid[from.step * l];
     const cv::Mat& j = to_pyramid[to.step * l];
-    if (i.type() != CV_8UC1 || j.type() != CV_8UC1 || i.size() != j.size() || !Padded(i, window) ||
-        !Padded(j, window))
+    if (i.type() != CV_8UC1 || j.type() != CV_8UC1 || i.size() != j.size() || !Padded(i, window) || !Padded(j, window))
       return false;
     if (from.step == 2) {
       const cv::Mat& d = from_pyramid[2 * l + 1];

@@ -66,9 +66,10 @@ void AddBenchCommands(CommandTree& tree) {
   bench->add_flag("--preload", bench_args->options.io.preload,
                   "Decode every frame's images before timing (a live rig delivers decoded images; without it, the "
                   "replay decodes PNGs ahead on a thread of its own). Keeps all frames in memory: use --frames");
-  bench->add_option("--timed-from", bench_args->options.io.timed_from,
-                    "Average the stage times over the frames from this index of the range on (the frames before it "
-                    "run as usual), e.g. OnlineExt after its settle phase (--online-settle)")
+  bench
+      ->add_option("--timed-from", bench_args->options.io.timed_from,
+                   "Average the stage times over the frames from this index of the range on (the frames before it "
+                   "run as usual), e.g. OnlineExt after its settle phase (--online-settle)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   auto floor = std::make_shared<bool>(false);
