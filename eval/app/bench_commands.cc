@@ -66,18 +66,20 @@ void AddBenchCommands(CommandTree& tree) {
   bench->add_flag("--preload", bench_args->options.io.preload,
                   "Decode every frame's images before timing (a live rig delivers decoded images; without it, the "
                   "replay decodes PNGs ahead on a thread of its own). Keeps all frames in memory: use --frames");
-  bench
-      ->add_option("--timed-from", bench_args->options.io.timed_from,
-                   "Average the stage times over the frames from this index of the range on (the frames before it "
-                   "run as usual), e.g. OnlineExt after its settle phase (--online-settle)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+  CLI::Option* timed_from =
+      bench
+          ->add_option("--timed-from", bench_args->options.io.timed_from,
+                       "Average the stage times over the frames from this index of the range on (the frames before it "
+                       "run as usual), e.g. OnlineExt after its settle phase (--online-settle)")
+          ->check(CLI::NonNegativeNumber)
+          ->capture_default_str();
   auto floor = std::make_shared<bool>(false);
-  bench->add_flag(
+  CLI::Option* floor_flag = bench->add_flag(
       "--floor", *floor,
       "Instead of the pipeline: the front-end's CPU per frame against the floor, the bare OpenCV calls it "
       "is made of (remap in bands of rows, pyramid, LK with a backward pass, FAST, ORB, Hamming matching) with its "
       "parameters on the same images on one thread, by stage, and their ratio (eval/bench/vo_floor.h)");
+  timed_from->excludes(floor_flag);
   bench->callback([bench, bench_args, floor] {
     FinaliseVoArgs(bench, bench_args.get());
     if (*floor) {
