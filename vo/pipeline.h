@@ -11,7 +11,7 @@
 
 namespace rovo {
 
-// Mean wall time per processed frame, by stage, in milliseconds.
+// Mean wall time per frame, by stage, in milliseconds: over the frames from VoIoOptions::timed_from on.
 struct VoStageTimes {
   double warp = 0, detect = 0, track = 0, match = 0;                  // front-end (FrontendFrame::ms_*)
   double cpu_warp = 0, cpu_detect = 0, cpu_track = 0, cpu_match = 0;  // front-end CPU, all threads (cpu_ms_*)

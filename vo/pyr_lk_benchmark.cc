@@ -1,8 +1,8 @@
 // PyrLk against cv::calcOpticalFlowPyrLK on the front-end's settings (window 15, 3 levels, 20
 // iterations, 0.03 px), 600 points of a textured 2417x985 image (the warped view's size) that moves by
 // (3.4, -1.7) px; the same pyramids for both. BM_LkPyramid: the previous image's pyramid with its
-// derivatives (cv::buildOpticalFlowPyramid's default) and without them (BuildPyrLkPyramid, as the
-// tracker builds it), and BM_Lk600PointsComputedDerivatives PyrLk on the latter, so that pyramid + LK
+// derivatives (cv::buildOpticalFlowPyramid's default) and without them (what BuildPyrLkPyramid builds
+// where PyrLk applies), and BM_Lk600PointsComputedDerivatives PyrLk on the latter, so that pyramid + LK
 // compare as the tracker's two ways. Run: build/vo/rovo_vo_benchmark --benchmark_filter=Lk
 #include <benchmark/benchmark.h>
 
