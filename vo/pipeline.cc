@@ -421,11 +421,12 @@ VoSummary RunVo(const VoOptions& options) {
     if (!step.loaded.problems.empty() && !options.io.quiet) {
       std::fprintf(stderr, "vo: frame %d: %s\n", frame, step.loaded.problems.c_str());
     }
+    // The next front-end beside this back-end (async BA): now, or for OnlineExt with the BA's extrinsics.
+    if (!online && frame + 1 < end) feed.Start(frame + 1, std::nullopt);
     auto backend_start = Clock::now();
     if (auto update = backend.FinishPendingBa()) ApplyBaUpdate(*update, backend.cam_from_rig(), &run, &ms);
     ms.backend_total += MsSince(backend_start);
-    // Beside this frame's back-end (with async BA), the next front-end with the extrinsics it would see in turn.
-    if (frame + 1 < end) feed.Start(frame + 1, online ? std::optional(backend.cam_from_rig()) : std::nullopt);
+    if (online && frame + 1 < end) feed.Start(frame + 1, backend.cam_from_rig());
     backend_start = Clock::now();
     BackendFrameResult result = backend.ProcessFrame(frame, step.features);
     ms.backend_total += MsSince(backend_start);
