@@ -57,9 +57,8 @@ void AddBenchCommands(CommandTree& tree) {
   CLI::App* bench = tree.bench->add_subcommand(
       "vo",
       "Time the whole pipeline on a dataset (full image size) and print a table of mean ms per frame by stage, "
-      "with a machine reference taken before and after the run (full-size hybrid warps by cv::remap, one per core at "
-      "once); "
-      "compare speeds only between runs whose references agree");
+      "with a machine reference taken before and after the run (full-size hybrid warps by cv::remap, one per core "
+      "at once); compare speeds only between runs whose references agree");
   AddVoRunOptions(bench, bench_args.get());
   bench->add_option("--out", bench_args->options.io.out_dir,
                     "Run folder to write (default: DATASET_bench_vo_run, beside the dataset)");
