@@ -100,6 +100,30 @@ struct Frontend::Impl {
   void UnifyIds(const std::vector<std::vector<InterviewMatch>>& pair_matches, FrontendFrame* frame);
   void CollectFeatures(const ViewBearings& bearings_in_cam, FrontendFrame* frame) const;
 
+  // What the per-view stages change, to undo them (Frontend::Process with late extrinsics). The
+  // trackers' copies share their images' pixels; the stages write only into new buffers and the
+  // spare pyramids, which hold no state.
+  struct ViewState {
+    std::vector<ViewTracker> trackers;
+    std::vector<cv::Mat> warped, fisheye_gray;
+    uint64_t last_id = 0;
+  };
+  ViewState SaveViews() const { return {trackers, warped, fisheye_gray, last_id}; }
+  void RestoreViews(ViewState&& saved) {
+    trackers = std::move(saved.trackers);
+    warped = std::move(saved.warped);
+    fisheye_gray = std::move(saved.fisheye_gray);
+    last_id = saved.last_id;
+  }
+  void CheckExtrinsicsCount(const std::vector<Rigid3>& cam_from_rig) const;
+  // Whether SetExtrinsics(cam_from_rig) would rebuild view i's warp maps, given the layouts it computes.
+  bool Rebuilds(int i, const std::vector<HybridLayout>& new_layouts, const std::vector<Rigid3>& cam_from_rig) const {
+    return HybridLayoutChangeDeg(projections[i].layout(), projections[i].cam_from_rig(), new_layouts[i],
+                                 cam_from_rig[i]) > options.projection.rebuild_threshold_deg;
+  }
+  void ApplyExtrinsics(const std::vector<Rigid3>& cam_from_rig);
+  void RebuildView(int i, const Rigid3& cam_from_rig);
+
   // The detection and tracking mask of view i for its current projection.
   void UpdateViewMask(int i) {
     if (static_masks.empty()) {
@@ -172,42 +196,55 @@ const FrontendOptions& Frontend::options() const { return impl_->options; }
 
 void Frontend::SetExtrinsics(const std::vector<Rigid3>& cam_from_rig) {
   Impl& s = *impl_;
-  if (static_cast<int>(cam_from_rig.size()) != s.rig.NumCameras()) {
-    throw std::invalid_argument("Frontend::SetExtrinsics: " + std::to_string(cam_from_rig.size()) + " extrinsics for " +
-                                std::to_string(s.rig.NumCameras()) + " cameras");
-  }
+  s.CheckExtrinsicsCount(cam_from_rig);
   const ScopedOpenCvThreads serial_opencv;
-  s.rig = s.rig.WithExtrinsics(cam_from_rig);
-  s.layouts = ComputeHybridLayouts(s.rig);
-  s.UpdatePairs();
-  tbb::parallel_for(0, s.rig.NumCameras(), [&](int i) {
-    const HybridProjection& old = s.projections[i];
-    if (HybridLayoutChangeDeg(old.layout(), old.cam_from_rig(), s.layouts[i], cam_from_rig[i]) <=
-        s.options.projection.rebuild_threshold_deg) {
-      return;
-    }
-    HybridProjection rebuilt(s.rig.cameras[i].camera, cam_from_rig[i], s.layouts[i], s.options.projection);
-    // Carry tracked features over through their bearings, and re-warp the last image so that KLT
-    // continues between images of the same warp.
-    std::vector<TrackedPoint> carried;
-    for (const TrackedPoint& p : s.trackers[i].points()) {
-      const auto bearing = old.BearingFromWarped(Eigen::Vector2d(p.px.x, p.px.y));
-      if (!bearing) continue;
-      const auto px = rebuilt.WarpedInImageFromBearing(*bearing);
-      if (!px) continue;
-      TrackedPoint q = p;
-      q.px = cv::Point2f(static_cast<float>(px->x()), static_cast<float>(px->y()));
-      carried.push_back(std::move(q));
-    }
-    s.projections[i] = std::move(rebuilt);
-    s.UpdateViewMask(i);
-    if (!s.fisheye_gray[i].empty()) {
-      s.projections[i].Warp(s.fisheye_gray[i], &s.warped[i]);
-      s.trackers[i].ResetImage(s.warped[i], s.view_masks[i], std::move(carried));
-    } else {
-      s.trackers[i].Clear();
-    }
-  });
+  s.ApplyExtrinsics(cam_from_rig);
+}
+
+void Frontend::Impl::CheckExtrinsicsCount(const std::vector<Rigid3>& cam_from_rig) const {
+  if (static_cast<int>(cam_from_rig.size()) != rig.NumCameras()) {
+    throw std::invalid_argument("Frontend::SetExtrinsics: " + std::to_string(cam_from_rig.size()) + " extrinsics for " +
+                                std::to_string(rig.NumCameras()) + " cameras");
+  }
+}
+
+// The epipolar/y filters at once; the warp maps of the views whose layout moves past the threshold.
+void Frontend::Impl::ApplyExtrinsics(const std::vector<Rigid3>& cam_from_rig) {
+  rig = rig.WithExtrinsics(cam_from_rig);
+  const std::vector<HybridLayout> new_layouts = ComputeHybridLayouts(rig);
+  std::vector<int> rebuilt;
+  for (int i = 0; i < rig.NumCameras(); ++i) {
+    if (Rebuilds(i, new_layouts, cam_from_rig)) rebuilt.push_back(i);
+  }
+  layouts = new_layouts;
+  UpdatePairs();
+  tbb::parallel_for(0, static_cast<int>(rebuilt.size()),
+                    [&](int k) { RebuildView(rebuilt[k], cam_from_rig[rebuilt[k]]); });
+}
+
+// View i's warp maps for its new layout; its tracked features are carried over through their bearings
+// and the last image is warped again, so that KLT continues between images of the same warp.
+void Frontend::Impl::RebuildView(int i, const Rigid3& cam_from_rig) {
+  const HybridProjection& old = projections[i];
+  HybridProjection rebuilt(rig.cameras[i].camera, cam_from_rig, layouts[i], options.projection);
+  std::vector<TrackedPoint> carried;
+  for (const TrackedPoint& p : trackers[i].points()) {
+    const auto bearing = old.BearingFromWarped(Eigen::Vector2d(p.px.x, p.px.y));
+    if (!bearing) continue;
+    const auto px = rebuilt.WarpedInImageFromBearing(*bearing);
+    if (!px) continue;
+    TrackedPoint q = p;
+    q.px = cv::Point2f(static_cast<float>(px->x()), static_cast<float>(px->y()));
+    carried.push_back(std::move(q));
+  }
+  projections[i] = std::move(rebuilt);
+  UpdateViewMask(i);
+  if (!fisheye_gray[i].empty()) {
+    projections[i].Warp(fisheye_gray[i], &warped[i]);
+    trackers[i].ResetImage(warped[i], view_masks[i], std::move(carried));
+  } else {
+    trackers[i].Clear();
+  }
 }
 
 namespace {
@@ -450,7 +487,10 @@ void Frontend::Impl::CollectFeatures(const ViewBearings& bearings_in_cam, Fronte
   }
 }
 
-FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
+FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) { return Process(fisheye_images, nullptr); }
+
+FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images,
+                                const std::function<std::vector<Rigid3>()>& late_cam_from_rig) {
   Impl& s = *impl_;
   s.CheckImages(fisheye_images);
   FrontendFrame frame;
@@ -458,7 +498,22 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images) {
   // Bearings of all points (exact, from the warped pixels), shared by matching and the output.
   Impl::ViewBearings bearings_in_cam;
   double bearings_ms = 0, bearings_cpu_ms = 0;
+  Impl::ViewState saved;
+  if (late_cam_from_rig) saved = s.SaveViews();
   s.RunViewStages(fisheye_images, &bearings_in_cam, &frame, &bearings_ms, &bearings_cpu_ms);
+  if (late_cam_from_rig) {
+    const std::vector<Rigid3> cam_from_rig = late_cam_from_rig();
+    s.CheckExtrinsicsCount(cam_from_rig);
+    const std::vector<HybridLayout> new_layouts = ComputeHybridLayouts(s.rig.WithExtrinsics(cam_from_rig));
+    bool rebuilds = false;
+    for (int i = 0; i < s.rig.NumCameras(); ++i) rebuilds = rebuilds || s.Rebuilds(i, new_layouts, cam_from_rig);
+    if (rebuilds) s.RestoreViews(std::move(saved));
+    s.ApplyExtrinsics(cam_from_rig);
+    if (rebuilds) {
+      frame = FrontendFrame();
+      s.RunViewStages(fisheye_images, &bearings_in_cam, &frame, &bearings_ms, &bearings_cpu_ms);
+    }
+  }
 
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = CpuMs();

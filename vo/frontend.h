@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <utility>
@@ -92,6 +93,13 @@ class Frontend {
   // on a wrong count, size or type.
   FrontendFrame Process(const std::vector<cv::Mat>& fisheye_images);
   void SetExtrinsics(const std::vector<Rigid3>& cam_from_rig);
+  // The same as SetExtrinsics(late_cam_from_rig()) then Process(fisheye_images), for extrinsics that
+  // arrive while the frame is processed (OnlineExt's local BA): the per-view stages (warp, KLT,
+  // detection) run first, then `late_cam_from_rig` is called (it may wait). Where those extrinsics
+  // rebuild no view's warp maps, the per-view stages did not depend on them; where they do, the stages
+  // are undone and run again after them. Throws as both calls would.
+  FrontendFrame Process(const std::vector<cv::Mat>& fisheye_images,
+                        const std::function<std::vector<Rigid3>()>& late_cam_from_rig);
   // Per-camera static masks of the fisheye images (8-bit, the camera's size, 0 = invalid: rig body,
   // vehicle, operator), or none. No feature is detected or tracked where a mask is 0: they are
   // warped with each view and eroded by half an ORB patch.

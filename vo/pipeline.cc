@@ -201,7 +201,9 @@ struct FrontendStep {
 
 // The front-end's steps, frame by frame in order. With async BA, frame k + 1's step runs on its own
 // thread beside frame k's back-end (Start, then Take): it sees the extrinsics it would see in turn, as the
-// back-end changes them only when it joins a BA (VoBackend::FinishPendingBa, before Start). With
+// back-end changes them only when it joins a BA (VoBackend::FinishPendingBa). GTExt and NoisyExt start it
+// before that join; OnlineExt starts it before the join too and hands it the joined extrinsics
+// (SetExtrinsics) while its per-view stages run (Frontend::Process with late extrinsics). With
 // synchronous BA, the back-end changes them in ProcessFrame, so the steps run in turn (Take computes).
 class FrontendFeed {
  public:
@@ -213,25 +215,34 @@ class FrontendFeed {
         prefetcher_(reader, begin, options.io.preload ? begin : end) {}
   FrontendFeed(const FrontendFeed&) = delete;
   FrontendFeed& operator=(const FrontendFeed&) = delete;
+  // A step still waiting for its extrinsics (a back-end step threw) gets std::future_error from its
+  // promise, which is broken before the step is joined.
+  ~FrontendFeed() { extrinsics_ = std::promise<std::vector<Rigid3>>(); }
 
   bool overlaps() const { return options_.backend.async_ba; }
-  // With `cam_from_rig`, the step first hands the front-end these extrinsics (OnlineExt).
-  void Start(int frame, std::optional<std::vector<Rigid3>> cam_from_rig) {
-    if (overlaps()) {
-      next_ = std::async(std::launch::async,
-                         [this, frame, extrinsics = std::move(cam_from_rig)] { return Run(frame, extrinsics); });
+  // With `late_extrinsics`, the step's extrinsics come from SetExtrinsics, once its images are in hand.
+  void Start(int frame, bool late_extrinsics) {
+    if (!overlaps()) return;
+    std::shared_future<std::vector<Rigid3>> extrinsics;
+    if (late_extrinsics) {
+      extrinsics_ = std::promise<std::vector<Rigid3>>();
+      extrinsics = extrinsics_.get_future().share();
     }
+    next_ = std::async(std::launch::async, [this, frame, extrinsics] { return Run(frame, extrinsics); });
   }
-  FrontendStep Take(int frame) { return next_.valid() ? next_.get() : Run(frame, std::nullopt); }
+  void SetExtrinsics(const std::vector<Rigid3>& cam_from_rig) { extrinsics_.set_value(cam_from_rig); }
+  FrontendStep Take(int frame) { return next_.valid() ? next_.get() : Run(frame, {}); }
 
  private:
-  FrontendStep Run(int frame, const std::optional<std::vector<Rigid3>>& cam_from_rig) {
-    if (cam_from_rig) frontend_->SetExtrinsics(*cam_from_rig);
+  FrontendStep Run(int frame, const std::shared_future<std::vector<Rigid3>>& extrinsics) {
     FrontendStep step;
     const auto start = Clock::now();
     step.loaded = options_.io.preload ? std::move(preloaded_[frame - begin_]) : prefetcher_.Get(frame);
     step.ms_load = MsSince(start);
-    step.features = frontend_->Process(step.loaded.images);
+    if (extrinsics.valid())
+      step.features = frontend_->Process(step.loaded.images, [&extrinsics] { return extrinsics.get(); });
+    else
+      step.features = frontend_->Process(step.loaded.images);
     return step;
   }
 
@@ -241,6 +252,7 @@ class FrontendFeed {
   std::vector<LoadedFrame> preloaded_;
   ImagePrefetcher prefetcher_;
   std::future<FrontendStep> next_;  // joined by its destructor if a back-end step throws
+  std::promise<std::vector<Rigid3>> extrinsics_;
 };
 
 // The cameras whose image was missing or unreadable, in the record and the summary.
@@ -421,12 +433,12 @@ VoSummary RunVo(const VoOptions& options) {
     if (!step.loaded.problems.empty() && !options.io.quiet) {
       std::fprintf(stderr, "vo: frame %d: %s\n", frame, step.loaded.problems.c_str());
     }
-    // The next front-end beside this back-end (async BA): now, or for OnlineExt with the BA's extrinsics.
-    if (!online && frame + 1 < end) feed.Start(frame + 1, std::nullopt);
+    // The next front-end beside this back-end (async BA); OnlineExt's gets the joined BA's extrinsics.
+    if (frame + 1 < end) feed.Start(frame + 1, online);
     auto backend_start = Clock::now();
     if (auto update = backend.FinishPendingBa()) ApplyBaUpdate(*update, backend.cam_from_rig(), &run, &ms);
     ms.backend_total += MsSince(backend_start);
-    if (online && frame + 1 < end) feed.Start(frame + 1, backend.cam_from_rig());
+    if (online && frame + 1 < end && feed.overlaps()) feed.SetExtrinsics(backend.cam_from_rig());
     backend_start = Clock::now();
     BackendFrameResult result = backend.ProcessFrame(frame, step.features);
     ms.backend_total += MsSince(backend_start);

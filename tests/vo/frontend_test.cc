@@ -340,6 +340,54 @@ TEST_F(FrontendBox, ExtrinsicUpdatesRebuildOnlyPastTheThreshold) {
   EXPECT_GT(aged, 0.6 * before);
 }
 
+// Extrinsics handed over while the frame is processed (OnlineExt beside its BA) give what
+// SetExtrinsics before Process gives: a small turn (maps kept: the per-view stages stand) and a 3-degree
+// turn of camera 1 (its maps rebuilt: the stages are undone and run again), then a frame without a
+// change, whose tracking starts from the state either path left.
+TEST_F(FrontendBox, LateExtrinsicsAsSetBeforeProcess) {
+  FrontendOptions options;
+  options.target_features_per_view = 300;
+  const auto turned = [&](double deg) {
+    std::vector<Rigid3> extrinsics = rig_->Extrinsics();
+    extrinsics[1] = Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(deg * M_PI / 180, Eigen::Vector3d::UnitY())),
+                           Eigen::Vector3d::Zero()) *
+                    extrinsics[1];
+    return extrinsics;
+  };
+  const std::vector<std::vector<Rigid3>> updates = {turned(0.3), turned(3.0), turned(3.0)};
+  Frontend before(*rig_, options), late(*rig_, options);
+  before.Process(frames_[0]);
+  late.Process(frames_[0]);
+  for (int k = 0; k < 3; ++k) {
+    before.SetExtrinsics(updates[k]);
+    const FrontendFrame expected = before.Process(frames_[1 + k % 2]);
+    int calls = 0;
+    const FrontendFrame got = late.Process(frames_[1 + k % 2], [&] {
+      ++calls;
+      return updates[k];
+    });
+    EXPECT_EQ(calls, 1);
+    EXPECT_EQ(got.merged_ids, expected.merged_ids) << "update " << k;
+    for (int c = 0; c < rig_->NumCameras(); ++c) {
+      const auto& x = expected.features_per_camera[c];
+      const auto& y = got.features_per_camera[c];
+      ASSERT_EQ(x.size(), y.size()) << "update " << k << ", camera " << c;
+      for (size_t j = 0; j < x.size(); ++j) {
+        EXPECT_EQ(x[j].track_id, y[j].track_id);
+        EXPECT_EQ(x[j].warped_px, y[j].warped_px);
+        EXPECT_EQ(x[j].age, y[j].age);
+        EXPECT_EQ(x[j].bearing_in_cam, y[j].bearing_in_cam);
+      }
+      EXPECT_EQ(cv::norm(before.warped_image(c), late.warped_image(c), cv::NORM_INF), 0.0);
+    }
+    ASSERT_EQ(late.last_matches().size(), before.last_matches().size());
+    EXPECT_NEAR(
+        RotationDistanceDeg(late.projection(1).cam_from_rig().rotation, before.projection(1).cam_from_rig().rotation),
+        0.0, 1e-12);
+  }
+  EXPECT_THROW(late.Process(frames_[0], [] { return std::vector<Rigid3>(); }), std::invalid_argument);
+}
+
 // A static mask blanking the lower half of camera 1's fisheye image (a rig body, an operator): no
 // feature of camera 1 is detected, tracked or matched there, over frames; the other views are unchanged.
 TEST_F(FrontendBox, StaticMasksKeepFeaturesOut) {
