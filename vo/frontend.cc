@@ -100,9 +100,9 @@ struct Frontend::Impl {
   void UnifyIds(const std::vector<std::vector<InterviewMatch>>& pair_matches, FrontendFrame* frame);
   void CollectFeatures(const ViewBearings& bearings_in_cam, FrontendFrame* frame) const;
 
-  // What the per-view stages change, to undo them (Frontend::Process with late extrinsics). The
-  // trackers' copies share their images' pixels; the stages write only into new buffers and the
-  // spare pyramids, which hold no state.
+  // What the per-view stages change, to undo them (Frontend::Process with late extrinsics): a shallow
+  // copy, whose Mats share their pixels with the live state. The stages write into new buffers, but
+  // for the trackers' spare pyramids, which they rewrite whole before reading (no state).
   struct ViewState {
     std::vector<ViewTracker> trackers;
     std::vector<cv::Mat> warped, fisheye_gray;
@@ -122,6 +122,9 @@ struct Frontend::Impl {
                                  cam_from_rig[i]) > options.projection.rebuild_threshold_deg;
   }
   void ApplyExtrinsics(const std::vector<Rigid3>& cam_from_rig);
+  void ApplyLateExtrinsics(const std::function<std::vector<Rigid3>()>& late_cam_from_rig, ViewState&& saved,
+                           const std::vector<cv::Mat>& fisheye_images, ViewBearings* bearings_in_cam,
+                           FrontendFrame* frame, double* bearings_ms, double* bearings_cpu_ms);
   void RebuildView(int i, const Rigid3& cam_from_rig);
 
   // The detection and tracking mask of view i for its current projection.
@@ -199,6 +202,44 @@ void Frontend::SetExtrinsics(const std::vector<Rigid3>& cam_from_rig) {
   s.CheckExtrinsicsCount(cam_from_rig);
   const ScopedOpenCvThreads serial_opencv;
   s.ApplyExtrinsics(cam_from_rig);
+}
+
+// Frontend::Process's late extrinsics, after the per-view stages ran on the state `saved` holds: applied
+// as they are where they rebuild no view's warp maps; otherwise the stages are undone, the extrinsics
+// applied and the stages run again (the undone run's times added to the frame's). An exception from
+// `late_cam_from_rig` or a wrong count leaves the state as before the stages.
+void Frontend::Impl::ApplyLateExtrinsics(const std::function<std::vector<Rigid3>()>& late_cam_from_rig,
+                                         ViewState&& saved, const std::vector<cv::Mat>& fisheye_images,
+                                         ViewBearings* bearings_in_cam, FrontendFrame* frame, double* bearings_ms,
+                                         double* bearings_cpu_ms) {
+  std::vector<Rigid3> cam_from_rig;
+  bool rebuilds = false;
+  try {
+    cam_from_rig = late_cam_from_rig();
+    CheckExtrinsicsCount(cam_from_rig);
+    const std::vector<HybridLayout> new_layouts = ComputeHybridLayouts(rig.WithExtrinsics(cam_from_rig));
+    for (int i = 0; i < rig.NumCameras(); ++i) rebuilds = rebuilds || Rebuilds(i, new_layouts, cam_from_rig);
+  } catch (...) {
+    RestoreViews(std::move(saved));
+    throw;
+  }
+  if (!rebuilds) {
+    ApplyExtrinsics(cam_from_rig);
+    return;
+  }
+  RestoreViews(std::move(saved));
+  ApplyExtrinsics(cam_from_rig);
+  const FrontendFrame undone = *frame;
+  const double undone_bearings_ms = *bearings_ms, undone_bearings_cpu_ms = *bearings_cpu_ms;
+  RunViewStages(fisheye_images, bearings_in_cam, frame, bearings_ms, bearings_cpu_ms);
+  frame->ms_warp += undone.ms_warp;
+  frame->ms_track += undone.ms_track;
+  frame->ms_detect += undone.ms_detect;
+  frame->cpu_ms_warp += undone.cpu_ms_warp;
+  frame->cpu_ms_track += undone.cpu_ms_track;
+  frame->cpu_ms_detect += undone.cpu_ms_detect;
+  *bearings_ms += undone_bearings_ms;
+  *bearings_cpu_ms += undone_bearings_cpu_ms;
 }
 
 void Frontend::Impl::CheckExtrinsicsCount(const std::vector<Rigid3>& cam_from_rig) const {
@@ -501,19 +542,9 @@ FrontendFrame Frontend::Process(const std::vector<cv::Mat>& fisheye_images,
   Impl::ViewState saved;
   if (late_cam_from_rig) saved = s.SaveViews();
   s.RunViewStages(fisheye_images, &bearings_in_cam, &frame, &bearings_ms, &bearings_cpu_ms);
-  if (late_cam_from_rig) {
-    const std::vector<Rigid3> cam_from_rig = late_cam_from_rig();
-    s.CheckExtrinsicsCount(cam_from_rig);
-    const std::vector<HybridLayout> new_layouts = ComputeHybridLayouts(s.rig.WithExtrinsics(cam_from_rig));
-    bool rebuilds = false;
-    for (int i = 0; i < s.rig.NumCameras(); ++i) rebuilds = rebuilds || s.Rebuilds(i, new_layouts, cam_from_rig);
-    if (rebuilds) s.RestoreViews(std::move(saved));
-    s.ApplyExtrinsics(cam_from_rig);
-    if (rebuilds) {
-      frame = FrontendFrame();
-      s.RunViewStages(fisheye_images, &bearings_in_cam, &frame, &bearings_ms, &bearings_cpu_ms);
-    }
-  }
+  if (late_cam_from_rig)
+    s.ApplyLateExtrinsics(late_cam_from_rig, std::move(saved), fisheye_images, &bearings_in_cam, &frame, &bearings_ms,
+                          &bearings_cpu_ms);
 
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = CpuMs();

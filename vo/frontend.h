@@ -97,7 +97,8 @@ class Frontend {
   // arrive while the frame is processed (OnlineExt's local BA): the per-view stages (warp, KLT,
   // detection) run first, then `late_cam_from_rig` is called (it may wait). Where those extrinsics
   // rebuild no view's warp maps, the per-view stages did not depend on them; where they do, the stages
-  // are undone and run again after them. Throws as both calls would.
+  // are undone and run again after them. Throws what both calls would throw; an exception from
+  // `late_cam_from_rig` or a wrong count of extrinsics leaves the front-end as before the call.
   FrontendFrame Process(const std::vector<cv::Mat>& fisheye_images,
                         const std::function<std::vector<Rigid3>()>& late_cam_from_rig);
   // Per-camera static masks of the fisheye images (8-bit, the camera's size, 0 = invalid: rig body,

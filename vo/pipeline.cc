@@ -203,7 +203,7 @@ struct FrontendStep {
 // thread beside frame k's back-end (Start, then Take): it sees the extrinsics it would see in turn, as the
 // back-end changes them only when it joins a BA (VoBackend::FinishPendingBa). GTExt and NoisyExt start it
 // before that join; OnlineExt starts it before the join too and hands it the joined extrinsics
-// (SetExtrinsics) while its per-view stages run (Frontend::Process with late extrinsics). With
+// (FrontendFeed::SetExtrinsics) for its matching (Frontend::Process with late extrinsics). With
 // synchronous BA, the back-end changes them in ProcessFrame, so the steps run in turn (Take computes).
 class FrontendFeed {
  public:
@@ -220,9 +220,11 @@ class FrontendFeed {
   ~FrontendFeed() { extrinsics_ = std::promise<std::vector<Rigid3>>(); }
 
   bool overlaps() const { return options_.backend.async_ba; }
-  // With `late_extrinsics`, the step's extrinsics come from SetExtrinsics, once its images are in hand.
+  // With `late_extrinsics`, the step asks for its extrinsics (SetExtrinsics below) after its per-view
+  // stages. One step at a time: Take the last one first.
   void Start(int frame, bool late_extrinsics) {
     if (!overlaps()) return;
+    if (next_.valid()) throw std::logic_error("FrontendFeed::Start: the previous step was not taken");
     std::shared_future<std::vector<Rigid3>> extrinsics;
     if (late_extrinsics) {
       extrinsics_ = std::promise<std::vector<Rigid3>>();

@@ -10,6 +10,7 @@
 #include <map>
 #include <opencv2/core/utility.hpp>
 #include <set>
+#include <string>
 #include <thread>
 
 #include "datasets/rig.h"
@@ -340,10 +341,49 @@ TEST_F(FrontendBox, ExtrinsicUpdatesRebuildOnlyPastTheThreshold) {
   EXPECT_GT(aged, 0.6 * before);
 }
 
+namespace {
+
+// Two front-ends in the same state: their trackers point by point (descriptor bytes included), their
+// warped images, last matches and warp maps' extrinsics.
+void ExpectSameFrontendState(const Frontend& a, const Frontend& b, const std::string& where) {
+  for (int c = 0; c < a.NumCameras(); ++c) {
+    const auto& x = a.tracker(c).points();
+    const auto& y = b.tracker(c).points();
+    ASSERT_EQ(x.size(), y.size()) << where << ", camera " << c;
+    for (size_t j = 0; j < x.size(); ++j) {
+      EXPECT_EQ(x[j].track_id, y[j].track_id) << where;
+      EXPECT_EQ(x[j].px, y[j].px) << where;
+      EXPECT_EQ(x[j].age, y[j].age) << where;
+      EXPECT_EQ(x[j].flow, y[j].flow) << where;
+      EXPECT_EQ(x[j].angle_deg, y[j].angle_deg) << where;
+      ASSERT_EQ(x[j].has_descriptor, y[j].has_descriptor) << where;
+      if (x[j].has_descriptor) {
+        EXPECT_EQ(cv::norm(x[j].descriptor, y[j].descriptor, cv::NORM_HAMMING), 0.0) << where;
+      }
+    }
+    EXPECT_EQ(cv::norm(a.warped_image(c), b.warped_image(c), cv::NORM_INF), 0.0) << where << ", camera " << c;
+    EXPECT_EQ(RotationDistanceDeg(a.projection(c).cam_from_rig().rotation, b.projection(c).cam_from_rig().rotation),
+              0.0)
+        << where << ", camera " << c;
+  }
+  const auto& ma = a.last_matches();
+  const auto& mb = b.last_matches();
+  ASSERT_EQ(ma.size(), mb.size()) << where;
+  for (size_t k = 0; k < ma.size(); ++k) {
+    EXPECT_EQ(ma[k].camera_a, mb[k].camera_a) << where;
+    EXPECT_EQ(ma[k].camera_b, mb[k].camera_b) << where;
+    EXPECT_EQ(ma[k].index_a, mb[k].index_a) << where;
+    EXPECT_EQ(ma[k].index_b, mb[k].index_b) << where;
+  }
+}
+
+}  // namespace
+
 // Extrinsics handed over while the frame is processed (OnlineExt beside its BA) give what
-// SetExtrinsics before Process gives: a small turn (maps kept: the per-view stages stand) and a 3-degree
-// turn of camera 1 (its maps rebuilt: the stages are undone and run again), then a frame without a
-// change, whose tracking starts from the state either path left.
+// SetExtrinsics before Process gives: a 0.3-degree turn of camera 1 (maps kept: the per-view stages
+// stand), a 3-degree turn (its maps rebuilt: the stages are undone and run again), then the same
+// extrinsics again (no change), whose tracking starts from the state the undo path left. Extrinsics
+// that throw, or of the wrong count, leave the front-end as it was.
 TEST_F(FrontendBox, LateExtrinsicsAsSetBeforeProcess) {
   FrontendOptions options;
   options.target_features_per_view = 300;
@@ -355,10 +395,13 @@ TEST_F(FrontendBox, LateExtrinsicsAsSetBeforeProcess) {
     return extrinsics;
   };
   const std::vector<std::vector<Rigid3>> updates = {turned(0.3), turned(3.0), turned(3.0)};
+  // Camera 1's warp maps after each update: kept, rebuilt, kept.
+  const std::vector<Rigid3> maps_of_camera1 = {rig_->cameras[1].cam_from_rig, updates[1][1], updates[1][1]};
   Frontend before(*rig_, options), late(*rig_, options);
   before.Process(frames_[0]);
   late.Process(frames_[0]);
   for (int k = 0; k < 3; ++k) {
+    const std::string where = "update " + std::to_string(k);
     before.SetExtrinsics(updates[k]);
     const FrontendFrame expected = before.Process(frames_[1 + k % 2]);
     int calls = 0;
@@ -367,25 +410,26 @@ TEST_F(FrontendBox, LateExtrinsicsAsSetBeforeProcess) {
       return updates[k];
     });
     EXPECT_EQ(calls, 1);
-    EXPECT_EQ(got.merged_ids, expected.merged_ids) << "update " << k;
+    EXPECT_LT(RotationDistanceDeg(late.projection(1).cam_from_rig().rotation, maps_of_camera1[k].rotation), 1e-9)
+        << where;
+    EXPECT_EQ(got.merged_ids, expected.merged_ids) << where;
     for (int c = 0; c < rig_->NumCameras(); ++c) {
       const auto& x = expected.features_per_camera[c];
       const auto& y = got.features_per_camera[c];
-      ASSERT_EQ(x.size(), y.size()) << "update " << k << ", camera " << c;
+      ASSERT_EQ(x.size(), y.size()) << where << ", camera " << c;
       for (size_t j = 0; j < x.size(); ++j) {
         EXPECT_EQ(x[j].track_id, y[j].track_id);
         EXPECT_EQ(x[j].warped_px, y[j].warped_px);
-        EXPECT_EQ(x[j].age, y[j].age);
         EXPECT_EQ(x[j].bearing_in_cam, y[j].bearing_in_cam);
       }
-      EXPECT_EQ(cv::norm(before.warped_image(c), late.warped_image(c), cv::NORM_INF), 0.0);
     }
-    ASSERT_EQ(late.last_matches().size(), before.last_matches().size());
-    EXPECT_NEAR(
-        RotationDistanceDeg(late.projection(1).cam_from_rig().rotation, before.projection(1).cam_from_rig().rotation),
-        0.0, 1e-12);
+    ExpectSameFrontendState(before, late, where);
   }
-  EXPECT_THROW(late.Process(frames_[0], [] { return std::vector<Rigid3>(); }), std::invalid_argument);
+  EXPECT_THROW(late.Process(frames_[1], [] { return std::vector<Rigid3>(); }), std::invalid_argument);
+  ExpectSameFrontendState(before, late, "after a wrong count");
+  EXPECT_THROW(late.Process(frames_[1], []() -> std::vector<Rigid3> { throw std::runtime_error("no BA"); }),
+               std::runtime_error);
+  ExpectSameFrontendState(before, late, "after a throw");
 }
 
 // A static mask blanking the lower half of camera 1's fisheye image (a rig body, an operator): no
