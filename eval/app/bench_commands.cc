@@ -1,6 +1,7 @@
 // `rovo bench render | vo`: speed tables (eval/bench/).
 #include <CLI/CLI.hpp>
 #include <memory>
+#include <string>
 
 #include "eval/app/commands.h"
 #include "eval/app/vo_args.h"
@@ -79,10 +80,30 @@ void AddBenchCommands(CommandTree& tree) {
       "is made of (remap in bands of rows, pyramid, LK with a backward pass, FAST, ORB, Hamming matching) with its "
       "parameters on the same images on one thread, by stage, and their ratio (eval/bench/vo_floor.h)");
   timed_from->excludes(floor_flag);
-  bench->callback([bench, bench_args, floor] {
+  auto against_mode = std::make_shared<std::string>();
+  auto rounds = std::make_shared<int>(3);
+  CLI::Option* against =
+      bench
+          ->add_option(
+              "--against-mode", *against_mode,
+              "Instead of the stage table: run this extrinsics mode and the run's own (--extrinsics) in turn, "
+              "--rounds times, and print each round's whole frame in both with their ratio and the median "
+              "ratio (e.g. --extrinsics online --against-mode gt --timed-from 60: OnlineExt after its start-up "
+              "against GTExt)")
+          ->check(CLI::IsMember({"gt", "noisy", "online"}));
+  against->excludes(floor_flag);
+  bench->add_option("--rounds", *rounds, "Rounds of --against-mode")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->needs(against);
+  bench->callback([bench, bench_args, floor, against_mode, rounds] {
     FinaliseVoArgs(bench, bench_args.get());
     if (*floor) {
       RunVoFloorBenchmark(bench_args->options);
+      return;
+    }
+    if (!against_mode->empty()) {
+      RunVoModeComparison(bench_args->options, ExtrinsicsModeFromName(*against_mode), *rounds);
       return;
     }
     RunVoBenchmark(bench_args->options);

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -122,6 +124,50 @@ void RunVoBenchmark(VoOptions options) {
         "warning: the machine's speed changed by more than 20 %% during the run; repeat it before "
         "comparing\n");
   }
+}
+
+namespace {
+
+double Median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+}  // namespace
+
+void RunVoModeComparison(VoOptions options, ExtrinsicsMode against, int rounds) {
+  if (rounds < 1) throw std::invalid_argument("bench vo: --rounds must be >= 1");
+  const ExtrinsicsMode mode = options.start.mode;
+  const std::string name = ExtrinsicsModeName(mode), other = ExtrinsicsModeName(against);
+  if (against == mode) throw std::invalid_argument("bench vo: --against-mode " + other + " is the run's own mode");
+  if (options.io.out_dir.empty()) options.io.out_dir = options.io.dataset_dir + "_bench_vo_run";
+  const std::string out_dir = options.io.out_dir;
+  const int cores =
+      options.io.threads > 0 ? options.io.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  options.io.quiet = true;
+  std::vector<double> ms_mode, ms_other, ratios, references;
+  for (int r = 0; r < rounds; ++r) {
+    references.push_back(MachineReferenceWarpMs(cores));
+    for (const ExtrinsicsMode m : {mode, against}) {
+      std::fprintf(stderr, "bench vo: round %d/%d, %s\n", r + 1, rounds, ExtrinsicsModeName(m).c_str());
+      options.start.mode = m;
+      options.io.out_dir = out_dir + "_" + ExtrinsicsModeName(m);
+      (m == mode ? ms_mode : ms_other).push_back(RunVo(options).stage_ms.total);
+    }
+    ratios.push_back(ms_mode.back() / ms_other.back());
+  }
+  std::printf("rovo bench vo: %s, %s against %s in turn, %d round%s, threads %d", options.io.dataset_dir.c_str(),
+              name.c_str(), other.c_str(), rounds, rounds == 1 ? "" : "s", options.io.threads);
+  if (options.io.timed_from > 0) std::printf(", the frames from index %d of the range on", options.io.timed_from);
+  std::printf("\n| round | %s ms/frame | %s ms/frame | %s / %s | machine ref ms |\n|---|---:|---:|---:|---:|\n",
+              name.c_str(), other.c_str(), name.c_str(), other.c_str());
+  for (int r = 0; r < rounds; ++r) {
+    std::printf("| %d | %.2f | %.2f | %.3f | %.2f |\n", r + 1, ms_mode[r], ms_other[r], ratios[r], references[r]);
+  }
+  std::printf("%s / %s: median %.3f (%.3f-%.3f over %d rounds); median ms per frame %.2f against %.2f\n", name.c_str(),
+              other.c_str(), Median(ratios), *std::min_element(ratios.begin(), ratios.end()),
+              *std::max_element(ratios.begin(), ratios.end()), rounds, Median(ms_mode), Median(ms_other));
 }
 
 }  // namespace rovo

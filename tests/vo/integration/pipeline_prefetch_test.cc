@@ -4,6 +4,7 @@
 // decodes to what cv::imread gives.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -143,6 +144,42 @@ TEST_F(PipelinePrefetch, FloorBenchmarkPrintsTheFrontEndAgainstTheFloor) {
                          " --floor --timed-from 2 --frames 0:4 --quiet > /dev/null 2>&1")
                             .c_str()),
             0);
+}
+
+// `rovo bench vo --against-mode`: both modes run in turn each round, into their own run folders, and
+// the printed ratio of a round is the quotient of the two times printed beside it.
+TEST_F(PipelinePrefetch, ModeComparisonPrintsPairedRatios) {
+  const std::string out = (Root() / "against.txt").string();
+  const std::string runs = (Root() / "against_run").string();
+  ASSERT_EQ(std::system((std::string(ROVO_BINARY) + " bench vo " + Dataset() +
+                         " --frames 0:4 --threads 1 --against-mode noisy --rounds 2 --out " + runs + " > " + out +
+                         " 2> /dev/null")
+                            .c_str()),
+            0);
+  const std::string text = ReadText(out);
+  EXPECT_NE(text.find("gt against noisy in turn, 2 rounds"), std::string::npos) << text;
+  for (const char* mode : {"gt", "noisy"}) {
+    EXPECT_TRUE(fs::exists(fs::path(runs + "_" + mode) / "trajectory.tum")) << mode;
+  }
+  for (const char* round : {"\n| 1 | ", "\n| 2 | "}) {
+    const size_t at = text.find(round);
+    ASSERT_NE(at, std::string::npos) << round << " missing from:\n" << text;
+    double a = 0, b = 0, ratio = 0;
+    ASSERT_EQ(std::sscanf(text.c_str() + at + std::string(round).size(), "%lf | %lf | %lf", &a, &b, &ratio), 3) << text;
+    EXPECT_GT(a, 0.0);
+    EXPECT_GT(b, 0.0);
+    EXPECT_NEAR(ratio, a / b, 1e-3 * ratio + 1e-3) << text;
+  }
+  EXPECT_NE(text.find("gt / noisy: median "), std::string::npos) << text;
+  // The run's own mode is no comparison; --rounds needs --against-mode.
+  EXPECT_NE(std::system((std::string(ROVO_BINARY) + " bench vo " + Dataset() +
+                         " --frames 0:4 --against-mode gt --quiet > /dev/null 2>&1")
+                            .c_str()),
+            0);
+  EXPECT_NE(
+      std::system(
+          (std::string(ROVO_BINARY) + " bench vo " + Dataset() + " --frames 0:4 --rounds 2 > /dev/null 2>&1").c_str()),
+      0);
 }
 
 }  // namespace
