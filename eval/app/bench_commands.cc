@@ -62,7 +62,8 @@ void AddBenchCommands(CommandTree& tree) {
       "at once); compare speeds only between runs whose references agree");
   AddVoRunOptions(bench, bench_args.get());
   bench->add_option("--out", bench_args->options.io.out_dir,
-                    "Run folder to write (default: DATASET_bench_vo_run, beside the dataset)");
+                    "Run folder to write (default: DATASET_bench_vo_run, beside the dataset; with --against-mode "
+                    "one folder per mode, OUT_<mode>)");
   bench->add_flag("--preload", bench_args->options.io.preload,
                   "Decode every frame's images before timing (a live rig delivers decoded images; without it, the "
                   "replay decodes PNGs ahead on a thread of its own). Keeps all frames in memory: use --frames");
@@ -84,12 +85,11 @@ void AddBenchCommands(CommandTree& tree) {
   auto rounds = std::make_shared<int>(3);
   CLI::Option* against =
       bench
-          ->add_option(
-              "--against-mode", *against_mode,
-              "Instead of the stage table: run this extrinsics mode and the run's own (--extrinsics) in turn, "
-              "--rounds times, and print each round's whole frame in both with their ratio and the median "
-              "ratio (e.g. --extrinsics online --against-mode gt --timed-from 60: OnlineExt after its start-up "
-              "against GTExt)")
+          ->add_option("--against-mode", *against_mode,
+                       "Instead of the stage table: run the run's own extrinsics mode (--extrinsics) and this one in "
+                       "turn, --rounds times (which runs first alternates; run folders OUT_<mode>), and print each "
+                       "round's whole frame in both with their ratio, then the median ratio (e.g. --extrinsics online "
+                       "--against-mode gt --timed-from 60: OnlineExt after its start-up against GTExt)")
           ->check(CLI::IsMember({"gt", "noisy", "online"}));
   against->excludes(floor_flag);
   bench->add_option("--rounds", *rounds, "Rounds of --against-mode")

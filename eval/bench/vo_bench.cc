@@ -136,34 +136,48 @@ double Median(std::vector<double> values) {
 
 }  // namespace
 
+// One run of the comparison in `mode` (run folder <out_dir>_<mode>, progress off): its whole frame's mean
+// ms; images it could not read are reported on stderr.
+double TimeModeRun(VoOptions options, ExtrinsicsMode mode, const std::string& out_dir) {
+  options.start.mode = mode;
+  options.io.out_dir = out_dir + "_" + ExtrinsicsModeName(mode);
+  options.io.quiet = true;
+  const VoSummary s = RunVo(options);
+  if (s.missing_images > 0) {
+    std::fprintf(stderr, "bench vo: %s run: %d images missing or unreadable (in %d frames)\n",
+                 ExtrinsicsModeName(mode).c_str(), s.missing_images, s.frames_with_missing_images);
+  }
+  return s.stage_ms.total;
+}
+
 void RunVoModeComparison(VoOptions options, ExtrinsicsMode against, int rounds) {
   if (rounds < 1) throw std::invalid_argument("bench vo: --rounds must be >= 1");
   const ExtrinsicsMode mode = options.start.mode;
   const std::string name = ExtrinsicsModeName(mode), other = ExtrinsicsModeName(against);
   if (against == mode) throw std::invalid_argument("bench vo: --against-mode " + other + " is the run's own mode");
   if (options.io.out_dir.empty()) options.io.out_dir = options.io.dataset_dir + "_bench_vo_run";
-  const std::string out_dir = options.io.out_dir;
   const int cores =
       options.io.threads > 0 ? options.io.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  options.io.quiet = true;
-  std::vector<double> ms_mode, ms_other, ratios, references;
-  for (int r = 0; r < rounds; ++r) {
-    references.push_back(MachineReferenceWarpMs(cores));
-    for (const ExtrinsicsMode m : {mode, against}) {
-      std::fprintf(stderr, "bench vo: round %d/%d, %s\n", r + 1, rounds, ExtrinsicsModeName(m).c_str());
-      options.start.mode = m;
-      options.io.out_dir = out_dir + "_" + ExtrinsicsModeName(m);
-      (m == mode ? ms_mode : ms_other).push_back(RunVo(options).stage_ms.total);
-    }
-    ratios.push_back(ms_mode.back() / ms_other.back());
-  }
-  std::printf("rovo bench vo: %s, %s against %s in turn, %d round%s, threads %d", options.io.dataset_dir.c_str(),
-              name.c_str(), other.c_str(), rounds, rounds == 1 ? "" : "s", options.io.threads);
+  std::printf("rovo bench vo: %s, %s against %s, %d round%s (odd rounds %s first, even rounds %s first), threads %d",
+              options.io.dataset_dir.c_str(), name.c_str(), other.c_str(), rounds, rounds == 1 ? "" : "s", name.c_str(),
+              other.c_str(), cores);
   if (options.io.timed_from > 0) std::printf(", the frames from index %d of the range on", options.io.timed_from);
   std::printf("\n| round | %s ms/frame | %s ms/frame | %s / %s | machine ref ms |\n|---|---:|---:|---:|---:|\n",
               name.c_str(), other.c_str(), name.c_str(), other.c_str());
+  std::fflush(stdout);
+  std::vector<double> ms_mode, ms_other, ratios;
   for (int r = 0; r < rounds; ++r) {
-    std::printf("| %d | %.2f | %.2f | %.3f | %.2f |\n", r + 1, ms_mode[r], ms_other[r], ratios[r], references[r]);
+    const double reference_ms = MachineReferenceWarpMs(cores);
+    // Alternating order: neither mode always runs first, next to the reference or the process's warm-up.
+    const bool mode_first = r % 2 == 0;
+    for (const ExtrinsicsMode m : mode_first ? std::vector{mode, against} : std::vector{against, mode}) {
+      std::fprintf(stderr, "bench vo: round %d/%d, %s\n", r + 1, rounds, ExtrinsicsModeName(m).c_str());
+      (m == mode ? ms_mode : ms_other).push_back(TimeModeRun(options, m, options.io.out_dir));
+    }
+    ratios.push_back(ms_mode.back() / ms_other.back());
+    std::printf("| %d | %.2f | %.2f | %.3f | %.2f |\n", r + 1, ms_mode.back(), ms_other.back(), ratios.back(),
+                reference_ms);
+    std::fflush(stdout);
   }
   std::printf("%s / %s: median %.3f (%.3f-%.3f over %d rounds); median ms per frame %.2f against %.2f\n", name.c_str(),
               other.c_str(), Median(ratios), *std::min_element(ratios.begin(), ratios.end()),

@@ -13,10 +13,10 @@ double MachineReferenceWarpMs(int cores);
 void RunVoBenchmark(VoOptions options);
 
 // `rovo bench vo --against-mode M --rounds N`: the options' extrinsics mode and mode M run in turn, N
-// rounds (run folders <out_dir>_<mode>), and a table of each round's whole frame (mean ms per frame,
-// over the frames from io.timed_from on) in both modes with their ratio, then the median ratio and its
-// range: a paired comparison, as the machine's speed drifts between runs. Throws std::invalid_argument
-// for rounds < 1 or M equal to the options' mode.
+// rounds, the first of a round alternating (run folders <out_dir>_<mode>), and a table of each round's
+// whole frame (mean ms per frame, over the frames from io.timed_from on) in both modes with their ratio,
+// printed as each round ends, then the median ratio and its range: a paired comparison, as the machine's
+// speed drifts between runs. Throws std::invalid_argument for rounds < 1 or M equal to the options' mode.
 void RunVoModeComparison(VoOptions options, ExtrinsicsMode against, int rounds);
 
 }  // namespace rovo
