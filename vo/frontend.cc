@@ -116,12 +116,15 @@ struct Frontend::Impl {
     last_id = saved.last_id;
   }
   void CheckExtrinsicsCount(const std::vector<Rigid3>& cam_from_rig) const;
-  // Whether SetExtrinsics(cam_from_rig) would rebuild view i's warp maps, given the layouts it computes.
-  bool Rebuilds(int i, const std::vector<HybridLayout>& new_layouts, const std::vector<Rigid3>& cam_from_rig) const {
-    return HybridLayoutChangeDeg(projections[i].layout(), projections[i].cam_from_rig(), new_layouts[i],
-                                 cam_from_rig[i]) > options.projection.rebuild_threshold_deg;
-  }
-  void ApplyExtrinsics(const std::vector<Rigid3>& cam_from_rig);
+  // New extrinsics, their layouts, and the views whose warp maps they rebuild (layout moved past the
+  // threshold).
+  struct ExtrinsicsUpdate {
+    std::vector<Rigid3> cam_from_rig;
+    std::vector<HybridLayout> layouts;
+    std::vector<int> rebuilt;
+  };
+  ExtrinsicsUpdate PlanExtrinsics(std::vector<Rigid3> cam_from_rig) const;
+  void ApplyExtrinsics(const ExtrinsicsUpdate& update);
   void ApplyLateExtrinsics(const std::function<std::vector<Rigid3>()>& late_cam_from_rig, ViewState&& saved,
                            const std::vector<cv::Mat>& fisheye_images, ViewBearings* bearings_in_cam,
                            FrontendFrame* frame, double* bearings_ms, double* bearings_cpu_ms);
@@ -201,45 +204,33 @@ void Frontend::SetExtrinsics(const std::vector<Rigid3>& cam_from_rig) {
   Impl& s = *impl_;
   s.CheckExtrinsicsCount(cam_from_rig);
   const ScopedOpenCvThreads serial_opencv;
-  s.ApplyExtrinsics(cam_from_rig);
+  s.ApplyExtrinsics(s.PlanExtrinsics(cam_from_rig));
 }
 
 // Frontend::Process's late extrinsics, after the per-view stages ran on the state `saved` holds: applied
 // as they are where they rebuild no view's warp maps; otherwise the stages are undone, the extrinsics
-// applied and the stages run again (the undone run's times added to the frame's). An exception from
-// `late_cam_from_rig` or a wrong count leaves the state as before the stages.
+// applied and the stages run again (their times add up). An exception from `late_cam_from_rig` or a
+// wrong count leaves the state as before the stages.
 void Frontend::Impl::ApplyLateExtrinsics(const std::function<std::vector<Rigid3>()>& late_cam_from_rig,
                                          ViewState&& saved, const std::vector<cv::Mat>& fisheye_images,
                                          ViewBearings* bearings_in_cam, FrontendFrame* frame, double* bearings_ms,
                                          double* bearings_cpu_ms) {
-  std::vector<Rigid3> cam_from_rig;
-  bool rebuilds = false;
+  ExtrinsicsUpdate update;
   try {
-    cam_from_rig = late_cam_from_rig();
+    std::vector<Rigid3> cam_from_rig = late_cam_from_rig();
     CheckExtrinsicsCount(cam_from_rig);
-    const std::vector<HybridLayout> new_layouts = ComputeHybridLayouts(rig.WithExtrinsics(cam_from_rig));
-    for (int i = 0; i < rig.NumCameras(); ++i) rebuilds = rebuilds || Rebuilds(i, new_layouts, cam_from_rig);
+    update = PlanExtrinsics(std::move(cam_from_rig));
   } catch (...) {
     RestoreViews(std::move(saved));
     throw;
   }
-  if (!rebuilds) {
-    ApplyExtrinsics(cam_from_rig);
+  if (update.rebuilt.empty()) {
+    ApplyExtrinsics(update);
     return;
   }
   RestoreViews(std::move(saved));
-  ApplyExtrinsics(cam_from_rig);
-  const FrontendFrame undone = *frame;
-  const double undone_bearings_ms = *bearings_ms, undone_bearings_cpu_ms = *bearings_cpu_ms;
+  ApplyExtrinsics(update);
   RunViewStages(fisheye_images, bearings_in_cam, frame, bearings_ms, bearings_cpu_ms);
-  frame->ms_warp += undone.ms_warp;
-  frame->ms_track += undone.ms_track;
-  frame->ms_detect += undone.ms_detect;
-  frame->cpu_ms_warp += undone.cpu_ms_warp;
-  frame->cpu_ms_track += undone.cpu_ms_track;
-  frame->cpu_ms_detect += undone.cpu_ms_detect;
-  *bearings_ms += undone_bearings_ms;
-  *bearings_cpu_ms += undone_bearings_cpu_ms;
 }
 
 void Frontend::Impl::CheckExtrinsicsCount(const std::vector<Rigid3>& cam_from_rig) const {
@@ -249,18 +240,28 @@ void Frontend::Impl::CheckExtrinsicsCount(const std::vector<Rigid3>& cam_from_ri
   }
 }
 
-// The epipolar/y filters at once; the warp maps of the views whose layout moves past the threshold.
-void Frontend::Impl::ApplyExtrinsics(const std::vector<Rigid3>& cam_from_rig) {
-  rig = rig.WithExtrinsics(cam_from_rig);
-  const std::vector<HybridLayout> new_layouts = ComputeHybridLayouts(rig);
-  std::vector<int> rebuilt;
+Frontend::Impl::ExtrinsicsUpdate Frontend::Impl::PlanExtrinsics(std::vector<Rigid3> cam_from_rig) const {
+  ExtrinsicsUpdate update;
+  update.layouts = ComputeHybridLayouts(rig.WithExtrinsics(cam_from_rig));
   for (int i = 0; i < rig.NumCameras(); ++i) {
-    if (Rebuilds(i, new_layouts, cam_from_rig)) rebuilt.push_back(i);
+    if (HybridLayoutChangeDeg(projections[i].layout(), projections[i].cam_from_rig(), update.layouts[i],
+                              cam_from_rig[i]) > options.projection.rebuild_threshold_deg) {
+      update.rebuilt.push_back(i);
+    }
   }
-  layouts = new_layouts;
+  update.cam_from_rig = std::move(cam_from_rig);
+  return update;
+}
+
+// The epipolar/y filters at once; the warp maps of the views the update rebuilds.
+void Frontend::Impl::ApplyExtrinsics(const ExtrinsicsUpdate& update) {
+  rig = rig.WithExtrinsics(update.cam_from_rig);
+  layouts = update.layouts;
   UpdatePairs();
-  tbb::parallel_for(0, static_cast<int>(rebuilt.size()),
-                    [&](int k) { RebuildView(rebuilt[k], cam_from_rig[rebuilt[k]]); });
+  tbb::parallel_for(0, static_cast<int>(update.rebuilt.size()), [&](int k) {
+    const int i = update.rebuilt[k];
+    RebuildView(i, update.cam_from_rig[i]);
+  });
 }
 
 // View i's warp maps for its new layout; its tracked features are carried over through their bearings
@@ -366,10 +367,10 @@ cv::Mat Frontend::Impl::WarpView(int i) const {
 
 // The per-view stages (warp, track, detect + describe, bearings) run fused in one parallel loop
 // over the views, without a barrier between stages. Stage times are the section's wall and CPU
-// time apportioned by each stage's share of the per-view wall durations summed over the views; the
-// bearings' share is returned for the matching time. On more than one thread the split is
-// approximate: idle workers help with a view's warp and KLT, which shortens their wall more than
-// their CPU.
+// time apportioned by each stage's share of the per-view wall durations summed over the views, added
+// to the frame's; the bearings' share is added to *bearings_ms (*bearings_cpu_ms) for the matching time. On more than
+// one thread the split is approximate: idle workers help with a view's warp and KLT, which shortens their wall more
+// than their CPU.
 void Frontend::Impl::RunViewStages(const std::vector<cv::Mat>& fisheye_images, ViewBearings* bearings_in_cam,
                                    FrontendFrame* frame, double* bearings_ms, double* bearings_cpu_ms) {
   const int n = rig.NumCameras();
@@ -413,14 +414,14 @@ void Frontend::Impl::RunViewStages(const std::vector<cv::Mat>& fisheye_images, V
   double all_stages = 0;
   for (double t : stage_sum) all_stages += t;
   const auto share = [&](int stage) { return all_stages > 0 ? stage_sum[stage] / all_stages : 0.25; };
-  frame->ms_warp = section_ms * share(kWarp);
-  frame->ms_track = section_ms * share(kTrack);
-  frame->ms_detect = section_ms * share(kDetect);
-  frame->cpu_ms_warp = section_cpu_ms * share(kWarp);
-  frame->cpu_ms_track = section_cpu_ms * share(kTrack);
-  frame->cpu_ms_detect = section_cpu_ms * share(kDetect);
-  *bearings_ms = section_ms * share(kBearings);
-  *bearings_cpu_ms = section_cpu_ms * share(kBearings);
+  frame->ms_warp += section_ms * share(kWarp);
+  frame->ms_track += section_ms * share(kTrack);
+  frame->ms_detect += section_ms * share(kDetect);
+  frame->cpu_ms_warp += section_cpu_ms * share(kWarp);
+  frame->cpu_ms_track += section_cpu_ms * share(kTrack);
+  frame->cpu_ms_detect += section_cpu_ms * share(kDetect);
+  *bearings_ms += section_ms * share(kBearings);
+  *bearings_cpu_ms += section_cpu_ms * share(kBearings);
 }
 
 std::vector<MatchView> Frontend::Impl::MakeMatchViews(const ViewBearings& bearings_in_cam) const {
